@@ -1,0 +1,56 @@
+"""dirac: constrained Hamiltonian mechanics.
+
+The Dirac–Bergmann algorithm on a Lagrangian with holonomic constraints (multipliers as
+dynamical variables), Dirac brackets, and structure-preserving flows; the flagship is the
+free asymmetric rigid body, whose Dirac bracket is the Chetaev bracket.
+
+Heavy dependencies (sympy, numba, scipy) load on first use of the names that need them.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+from dirac.errors import (
+    AnalysisError,
+    DiracError,
+    DiracWarning,
+    InconsistentSystemError,
+    InputError,
+    IntegrationError,
+)
+
+__all__ = [
+    "DiracError",
+    "InputError",
+    "InconsistentSystemError",
+    "AnalysisError",
+    "IntegrationError",
+    "DiracWarning",
+    "Lagrangian",
+    "load_system",
+    "builtin_systems",
+    "analyze",
+]
+
+#: public name -> module that defines it (imported on first access)
+_LAZY: dict[str, str] = {
+    "Lagrangian": "dirac.lagrangian",
+    "load_system": "dirac.registry",
+    "builtin_systems": "dirac.registry",
+    "analyze": "dirac.symbolic.analysis",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'dirac' has no attribute {name!r}")
+    value = getattr(import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -1,0 +1,99 @@
+"""The ``dirac`` command line: one dispatcher, one module per sub-command.
+
+Each sub-command lives in ``dirac/commands/<name>.py`` and provides
+
+* ``register(subparsers) -> argparse.ArgumentParser`` — declare its arguments (cheap:
+  no sympy, numba or scipy imports at module level, so ``dirac --help`` stays fast);
+* ``main(args: argparse.Namespace) -> int`` — do the work and return the exit status.
+
+Exit status (CONTRACTS §2): 0 success; 2 bad input, with one ``error:`` line on stderr;
+1 an internal failure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from dirac.errors import DiracError, install_warning_printer
+
+#: sub-command name -> (module, one-line help)
+COMMANDS: dict[str, tuple[str, str]] = {
+    "demo": ("dirac.commands.demo", "run the flagship free-rigid-body scene and print a summary"),
+    "systems": ("dirac.commands.systems", "list the built-in systems"),
+    "analyze": ("dirac.commands.analyze", "run the Dirac-Bergmann algorithm on a system"),
+    "run": ("dirac.commands.run", "run a scene file and write its results"),
+    "bench": ("dirac.commands.bench", "work-precision benchmark against scipy baselines"),
+}
+
+
+class _ErrorExitParser(argparse.ArgumentParser):
+    """argparse with the project's error format: one ``error:`` line, exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        print(f"error: {message} (see '{self.prog} --help')", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("dirac-mechanics")
+    except PackageNotFoundError:  # running from a source tree that is not installed
+        return "unknown"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full argument parser, with every available sub-command registered."""
+    parser = _ErrorExitParser(
+        prog="dirac",
+        description="Constrained Hamiltonian mechanics: the Dirac-Bergmann algorithm, "
+        "Dirac brackets and structure-preserving flows.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_ErrorExitParser)
+    for name, (module_name, help_text) in COMMANDS.items():
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            if exc.name != module_name:
+                raise
+            sub = subparsers.add_parser(name, help=f"{help_text} (not available yet)")
+            sub.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+            sub.set_defaults(handler=_not_available(name))
+            continue
+        sub = module.register(subparsers)
+        sub.set_defaults(handler=module.main)
+    return parser
+
+
+def _not_available(name: str):
+    def handler(args: argparse.Namespace) -> int:
+        print(f"error: 'dirac {name}' is not available in this version yet", file=sys.stderr)
+        return 2
+
+    return handler
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``dirac`` console script and of ``python -m dirac``."""
+    install_warning_printer()
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if getattr(args, "handler", None) is None:
+        parser.print_help()
+        return 2
+    try:
+        return int(args.handler(args) or 0)
+    except DiracError as exc:
+        message = " ".join(str(exc).split())
+        print(f"error: {message}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0

@@ -1,0 +1,1 @@
+"""One module per ``dirac`` sub-command (see :mod:`dirac.cli`)."""

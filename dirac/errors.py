@@ -1,0 +1,89 @@
+"""The `DiracError` family of exceptions and the one way to warn.
+
+Every error that `dirac` raises on purpose is a :class:`DiracError`. The command line
+turns it into one ``error: …`` line on stderr and exit status 2; anything else is an
+internal failure (exit status 1). Messages name the offending item and say what to do.
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+
+__all__ = [
+    "DiracError",
+    "InputError",
+    "InconsistentSystemError",
+    "AnalysisError",
+    "IntegrationError",
+    "DiracWarning",
+    "warn",
+    "install_warning_printer",
+]
+
+
+class DiracError(Exception):
+    """Base class of every error `dirac` raises on purpose."""
+
+
+class InputError(DiracError, ValueError):
+    """Bad input: a system, scene, expression, parameter or argument that cannot be used."""
+
+
+class InconsistentSystemError(InputError):
+    """The Dirac–Bergmann algorithm met a condition such as ``1 = 0``.
+
+    The Lagrangian has no motion at all (for example ``L = x_dot**2/2 + y`` with no
+    kinetic term for ``y``: the consistency of ``p_y = 0`` demands ``1 = 0``).
+    """
+
+
+class AnalysisError(DiracError):
+    """The symbolic analysis cannot be carried out in closed form (e.g. primary
+    constraints of a Lagrangian that is not quadratic in the velocities)."""
+
+
+class IntegrationError(DiracError):
+    """A numerical integration had to stop (non-finite state, Newton non-convergence,
+    constraint drift). ``partial`` holds what was computed up to that point, if any."""
+
+    def __init__(self, message: str, partial: object | None = None) -> None:
+        super().__init__(message)
+        self.partial = partial
+
+
+class DiracWarning(UserWarning):
+    """Input that is legal but suspicious (e.g. an inertia no physical body has)."""
+
+
+def warn(message: str) -> None:
+    """Report legal but suspicious input as a :class:`DiracWarning`.
+
+    Library callers see an ordinary Python warning (catch it with
+    ``warnings.catch_warnings`` or ``pytest.warns``); the command line shows each one as a
+    single ``warning: …`` line on stderr (see :func:`install_warning_printer`).
+
+    Parameters
+    ----------
+    message
+        One line that names the suspicious item and why it is suspicious.
+    """
+    line = " ".join(str(message).split())
+    warnings.warn(line, DiracWarning, stacklevel=2)
+
+
+def install_warning_printer() -> None:
+    """Show every :class:`DiracWarning` as one ``warning: …`` line on stderr (CLI use).
+
+    Other warnings keep Python's default display.
+    """
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        if issubclass(category, DiracWarning):
+            print(f"warning: {message}", file=sys.stderr)
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    warnings.simplefilter("always", DiracWarning)
+    warnings.showwarning = show

@@ -1,0 +1,156 @@
+"""Safe parsing of user expressions into sympy.
+
+User input (system files, ``--param``, scene files) is parsed with Python's :mod:`ast`
+and walked against a whitelist: numbers, known names, ``+ - * / **``, parentheses and a
+fixed set of elementary functions. Nothing is ever evaluated with :func:`eval` (sympy's
+own ``parse_expr`` evaluates code, so it is not used either).
+
+Decimal literals become exact rationals (``0.5`` -> ``1/2``), so the symbolic analysis is
+not disturbed by binary round-off.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Mapping
+
+import sympy
+
+from dirac.errors import InputError
+
+__all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS"]
+
+#: function name -> sympy function; the only calls an expression may make
+ALLOWED_FUNCTIONS: dict[str, object] = {
+    "sin": sympy.sin,
+    "cos": sympy.cos,
+    "tan": sympy.tan,
+    "asin": sympy.asin,
+    "acos": sympy.acos,
+    "atan": sympy.atan,
+    "atan2": sympy.atan2,
+    "sinh": sympy.sinh,
+    "cosh": sympy.cosh,
+    "tanh": sympy.tanh,
+    "exp": sympy.exp,
+    "log": sympy.log,
+    "sqrt": sympy.sqrt,
+    "Abs": sympy.Abs,
+    "abs": sympy.Abs,
+}
+
+#: constant name -> value
+ALLOWED_CONSTANTS: dict[str, sympy.Expr] = {"pi": sympy.pi, "E": sympy.E}
+
+_BINARY = {
+    ast.Add: lambda a, b: a + b,
+    ast.Sub: lambda a, b: a - b,
+    ast.Mult: lambda a, b: a * b,
+    ast.Div: lambda a, b: a / b,
+    ast.Pow: lambda a, b: a**b,
+}
+_MAX_LENGTH = 100_000
+_MAX_EXPONENT = 1000
+
+
+def parse_expression(text: str, names: Mapping[str, sympy.Symbol], *, what: str = "expression") -> sympy.Expr:
+    """Parse ``text`` into a sympy expression, allowing only the given ``names``.
+
+    Parameters
+    ----------
+    text
+        The expression, in Python syntax (``**`` for powers).
+    names
+        Every symbol the expression may use, by name (coordinates, velocities
+        ``<q>_dot``, parameters). Elementary functions and ``pi``, ``E`` are always allowed.
+    what
+        How to call the expression in error messages, e.g. ``"constraint 2"``.
+
+    Returns
+    -------
+    sympy.Expr
+
+    Raises
+    ------
+    InputError
+        On a syntax error, an unknown name, a disallowed construct or an empty string;
+        the message quotes the offending piece and lists the allowed names.
+    """
+    if not isinstance(text, str):
+        if isinstance(text, (int, float)) and not isinstance(text, bool):
+            text = repr(text)
+        else:
+            raise InputError(f"{what} must be a string, got {type(text).__name__} {text!r}")
+    stripped = text.strip()
+    if not stripped:
+        raise InputError(f"{what} is empty: write an expression such as 'm/2*x_dot**2'")
+    if len(stripped) > _MAX_LENGTH:
+        raise InputError(f"{what} is longer than {_MAX_LENGTH} characters")
+    if "^" in stripped:
+        raise InputError(f"{what} {stripped!r} uses '^': write powers as '**'")
+    try:
+        tree = ast.parse(stripped, mode="eval")
+    except SyntaxError as exc:
+        raise InputError(f"{what} {stripped!r} is not a valid expression: {exc.msg}") from None
+    return _Converter(names, what, stripped).visit(tree.body)
+
+
+class _Converter:
+    def __init__(self, names: Mapping[str, sympy.Symbol], what: str, text: str) -> None:
+        self.names = names
+        self.what = what
+        self.text = text
+
+    def fail(self, message: str) -> InputError:
+        return InputError(f"{self.what} {self.text!r}: {message}")
+
+    def visit(self, node: ast.AST) -> sympy.Expr:
+        if isinstance(node, ast.Constant):
+            value = node.value
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise self.fail(f"{value!r} is not a number")
+            if isinstance(value, int):
+                return sympy.Integer(value)
+            if value != value or value in (float("inf"), float("-inf")):
+                raise self.fail("non-finite number")
+            return sympy.Rational(repr(value))
+        if isinstance(node, ast.Name):
+            name = node.id
+            if name in self.names:
+                return self.names[name]
+            if name in ALLOWED_CONSTANTS:
+                return ALLOWED_CONSTANTS[name]
+            if name in ALLOWED_FUNCTIONS:
+                raise self.fail(f"function {name!r} is used without arguments")
+            known = ", ".join(sorted(self.names)) or "(none)"
+            raise self.fail(f"unknown name {name!r}; the names allowed here are: {known}")
+        if isinstance(node, ast.BinOp):
+            op = _BINARY.get(type(node.op))
+            if op is None:
+                raise self.fail(f"operator {type(node.op).__name__} is not allowed (use + - * / **)")
+            left, right = self.visit(node.left), self.visit(node.right)
+            if isinstance(node.op, ast.Pow) and right.is_number and abs(right) > _MAX_EXPONENT:
+                raise self.fail(f"exponent {right} is too large")
+            if isinstance(node.op, ast.Div) and right == 0:
+                raise self.fail("division by zero")
+            return op(left, right)
+        if isinstance(node, ast.UnaryOp):
+            operand = self.visit(node.operand)
+            if isinstance(node.op, ast.USub):
+                return -operand
+            if isinstance(node.op, ast.UAdd):
+                return operand
+            raise self.fail(f"operator {type(node.op).__name__} is not allowed")
+        if isinstance(node, ast.Call):
+            if not isinstance(node.func, ast.Name) or node.func.id not in ALLOWED_FUNCTIONS:
+                called = ast.unparse(node.func)
+                allowed = ", ".join(sorted(ALLOWED_FUNCTIONS))
+                raise self.fail(f"call of {called!r} is not allowed; allowed functions: {allowed}")
+            if node.keywords:
+                raise self.fail("keyword arguments are not allowed")
+            args = [self.visit(arg) for arg in node.args]
+            expected = 2 if node.func.id == "atan2" else 1
+            if len(args) != expected:
+                raise self.fail(f"{node.func.id} takes {expected} argument(s), got {len(args)}")
+            return ALLOWED_FUNCTIONS[node.func.id](*args)  # type: ignore[operator]
+        raise self.fail(f"{ast.unparse(node)!r} is not allowed in an expression")

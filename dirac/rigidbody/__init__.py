@@ -1,0 +1,15 @@
+"""Numerical kernels of the free rigid body (PHYSICS.md §2, paper Sect. IX).
+
+Modules, one job each:
+
+- :mod:`dirac.rigidbody.inertia` -- validation of inertia, rotation matrix, momentum;
+- :mod:`dirac.rigidbody.euler_poisson` -- invariants and the Euler–Poisson vector field
+  (250)–(251), plus lean scipy right-hand sides for baselines;
+- :mod:`dirac.rigidbody.splitting` -- Lie–Poisson splitting methods (numba kernels,
+  composition schemes as data);
+- :mod:`dirac.rigidbody.exact` -- the exact flow in Jacobi elliptic functions and an
+  elliptic integral of the third kind;
+- :mod:`dirac.rigidbody.closed_forms` -- the paper's elementary solutions (165), (183).
+
+Heavy modules (numba, scipy) are imported only when used; importing this package is cheap.
+"""
