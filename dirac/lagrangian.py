@@ -114,37 +114,7 @@ class Lagrangian:
                 f"system {self.name!r} has {len(self.coordinates)} coordinates but "
                 f"{len(self.velocities)} velocities: give one velocity per coordinate"
             )
-        seen: dict[str, str] = {}
-
-        def claim(sym: object, role: str) -> None:
-            if not isinstance(sym, sympy.Symbol):
-                raise InputError(f"{role} {sym!r} of system {self.name!r} must be a sympy Symbol")
-            label = sym.name
-            if not _IDENTIFIER.match(label) or keyword.iskeyword(label):
-                raise InputError(
-                    f"{role} name {label!r} is not a valid name: use letters, digits and '_', starting with a letter"
-                )
-            if label in ALLOWED_FUNCTIONS or label in ALLOWED_CONSTANTS:
-                raise InputError(f"{role} name {label!r} is reserved for a function or constant: rename it")
-            if label in seen:
-                raise InputError(f"name {label!r} is used twice (as {seen[label]} and as {role}): names must be distinct")
-            seen[label] = role
-
-        for q in self.coordinates:
-            claim(q, "coordinate")
-        for v in self.velocities:
-            claim(v, "velocity")
-        for p in self.parameters:
-            claim(p, "parameter")
-        generated = {momentum_name(q.name) for q in self.coordinates}
-        generated |= {multiplier_name(k + 1) for k in range(len(self.constraints))}
-        generated |= {momentum_name(multiplier_name(k + 1)) for k in range(len(self.constraints))}
-        for label, role in seen.items():
-            if label in generated:
-                raise InputError(
-                    f"{role} name {label!r} clashes with a name the engine generates "
-                    "(momenta p_<q>, multipliers lambda_<k>): rename it"
-                )
+        _check_names(self.coordinates, self.velocities, tuple(self.parameters), len(self.constraints))
         for p, value in self.parameters.items():
             if value is None:
                 continue
@@ -216,6 +186,8 @@ class Lagrangian:
         q = tuple(sympy.Symbol(c, real=True) for c in labels)
         v = tuple(sympy.Symbol(velocity_name(c), real=True) for c in labels)
         psyms = {label: sympy.Symbol(label, real=True) for label in parameters}
+        constraints = list(constraints)
+        _check_names(q, v, tuple(psyms.values()), len(constraints))
         names = {s.name: s for s in (*q, *v, *psyms.values())}
         expr = parse_expression(lagrangian, names, what="lagrangian")
         chis = tuple(
@@ -287,6 +259,46 @@ class Lagrangian:
         lines = [f"{self.name}: L = {self.expression}"]
         lines += [f"  constraint {k}: {c} = 0" for k, c in enumerate(self.constraints, start=1)]
         return "\n".join(lines)
+
+
+def _check_names(
+    coordinates: Sequence[sympy.Symbol],
+    velocities: Sequence[sympy.Symbol],
+    parameters: Sequence[sympy.Symbol],
+    n_constraints: int,
+) -> None:
+    """Every name is a valid identifier, used once, and clashes with no generated name."""
+    seen: dict[str, str] = {}
+
+    def claim(sym: object, role: str) -> None:
+        if not isinstance(sym, sympy.Symbol):
+            raise InputError(f"{role} {sym!r} must be a sympy Symbol")
+        label = sym.name
+        if not _IDENTIFIER.match(label) or keyword.iskeyword(label):
+            raise InputError(
+                f"{role} name {label!r} is not a valid name: use letters, digits and '_', starting with a letter"
+            )
+        if label in ALLOWED_FUNCTIONS or label in ALLOWED_CONSTANTS:
+            raise InputError(f"{role} name {label!r} is reserved for a function or constant: rename it")
+        if label in seen:
+            raise InputError(f"name {label!r} is used twice (as {seen[label]} and as {role}): names must be distinct")
+        seen[label] = role
+
+    for q in coordinates:
+        claim(q, "coordinate")
+    for v in velocities:
+        claim(v, "velocity")
+    for p in parameters:
+        claim(p, "parameter")
+    generated = {momentum_name(q.name) for q in coordinates}
+    generated |= {multiplier_name(k + 1) for k in range(n_constraints)}
+    generated |= {momentum_name(multiplier_name(k + 1)) for k in range(n_constraints)}
+    for label, role in seen.items():
+        if label in generated:
+            raise InputError(
+                f"{role} name {label!r} clashes with a name the engine generates "
+                "(momenta p_<q>, multipliers lambda_<k>): rename it"
+            )
 
 
 def read_system_file(path: str | Path) -> Lagrangian:

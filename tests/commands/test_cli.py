@@ -1,0 +1,40 @@
+"""The dispatcher: help, exit statuses, one error line (CONTRACTS §2)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+
+def test_help_lists_every_contract_command(run_cli):
+    status, out, _ = run_cli("--help")
+    assert status == 0
+    for command in ("demo", "systems", "analyze", "run", "bench"):
+        assert command in out
+
+
+def test_unknown_command_is_bad_input_with_one_error_line(run_cli):
+    status, _, err = run_cli("frobnicate")
+    assert status == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error:")
+
+
+def test_systems_lists_builtins_with_descriptions(run_cli):
+    status, out, _ = run_cli("systems")
+    assert status == 0
+    line = next(l for l in out.splitlines() if l.strip().startswith("pendulum"))
+    assert "pendulum" in line and len(line.split()) > 2
+
+
+def test_python_dash_m_runs_the_same_cli():
+    result = subprocess.run([sys.executable, "-m", "dirac", "systems"], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "pendulum" in result.stdout
+
+
+def test_help_does_not_import_sympy_or_numba():
+    code = "import sys; from dirac.cli import build_parser; build_parser(); print(sorted(m for m in ('sympy', 'numba', 'scipy') if m in sys.modules))"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
