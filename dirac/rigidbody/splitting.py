@@ -1,0 +1,400 @@
+"""Lie–Poisson splitting methods for the free rigid body (numba kernels).
+
+Two splittings of ``H_0 = sum_i M_i^2 / (2 I_i)`` (247), each sub-flow exact for ``M``
+and ``R`` (so ``|M|^2``, ``R^T R = 1`` and ``m = R M`` are kept to round-off):
+
+``axes`` (the plain 3-term split, McLachlan 1993; Reich 1994; Touma & Wisdom 1994)
+    ``H = H_1 + H_2 + H_3`` with ``H_k = M_k^2 / (2 I_k)``. The flow of ``H_k`` has
+    ``Omega = (M_k / I_k) e_k`` constant, so (250)–(251) give
+    ``M(t) = exp(-theta hat(e_k)) M(0)``, ``R(t) = R(0) exp(theta hat(e_k))`` with
+    ``theta = t M_k / I_k``: ``M`` turns about body axis ``e_k`` by ``-theta`` and ``R``
+    turns on the right by ``+theta`` (``m = R M`` fixed). Base step (Strang):
+    ``H_1(h/2) H_2(h/2) H_3(h) H_2(h/2) H_1(h/2)``.
+
+``symmetric`` (symmetric-top split, Fassò 2003, J. Comput. Phys. 189, 527;
+Celledoni, Fassò, Säfström & Zanna 2008)
+    ``H = |M|^2 / (2 I_a) + sum_{i != a} (1/I_i - 1/I_a) M_i^2 / 2``. The Casimir term
+    commutes with everything; its flow leaves ``M`` fixed and turns ``R`` on the left by
+    ``exp(t (|m| / I_a) hat(m/|m|))`` about the conserved lab vector ``m``, and it commutes
+    with the right-multiplications of the other sub-flows, so it is applied exactly, once,
+    at the end of :func:`advance_sequence`. Only the two-term remainder is split, with
+    coefficients ``1/I_i - 1/I_a`` that are small when ``a`` is the middle axis; the
+    base step is ``H_b(h/2) H_c(h) H_b(h/2)``, two rotations per step after merging.
+
+Higher order comes from symmetric compositions of the base step ``S(h)``:
+``S(gamma_s h) ... S(gamma_1 h)``; a :class:`CompositionScheme` holds the ``gamma`` as data,
+so a new scheme is a new table row. Adjacent half-steps of the same sub-flow are merged,
+also across steps (first-same-as-last).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+import math
+
+import numpy as np
+from numba import njit
+
+from dirac.errors import InputError
+
+__all__ = [
+    "CompositionScheme",
+    "COMPOSITIONS",
+    "SCHEMES",
+    "build_sequence",
+    "advance",
+    "advance_scheme",
+    "advance_sequence",
+]
+
+
+@dataclass(frozen=True)
+class CompositionScheme:
+    """A symmetric composition of a symmetric (Strang) base step, as data.
+
+    Attributes
+    ----------
+    name : str
+        Method name (CONTRACTS.md §7a), e.g. ``"lie-poisson-4"``.
+    order : int
+        Classical order of the composed method.
+    coefficients : tuple of float
+        Step fractions ``gamma_1, ..., gamma_s`` (palindromic, ``sum = 1``).
+    splitting : str
+        ``"axes"`` (3-term split) or ``"symmetric"`` (symmetric-top split).
+    reference : str
+        Source of the coefficients.
+    """
+
+    name: str
+    order: int
+    coefficients: tuple[float, ...]
+    splitting: str = "axes"
+    reference: str = ""
+
+
+_CBRT2 = 2.0 ** (1.0 / 3.0)
+_YOSHIDA4 = (1.0 / (2.0 - _CBRT2), -_CBRT2 / (2.0 - _CBRT2), 1.0 / (2.0 - _CBRT2))
+_SUZUKI_G = 1.0 / (4.0 - 4.0 ** (1.0 / 3.0))
+_SUZUKI5 = (_SUZUKI_G, _SUZUKI_G, 1.0 - 4.0 * _SUZUKI_G, _SUZUKI_G, _SUZUKI_G)
+
+
+def _palindrome(half: tuple[float, ...]) -> tuple[float, ...]:
+    """Complete ``gamma_1..gamma_k`` to ``gamma_1..gamma_k, gamma_mid, gamma_k..gamma_1``."""
+    middle = 1.0 - 2.0 * math.fsum(half)
+    return tuple(half) + (middle,) + tuple(reversed(half))
+
+
+# Kahan & Li (1997), Math. Comp. 66, 1089; as printed in Hairer, Lubich & Wanner,
+# Geometric Numerical Integration (2nd ed.), Sect. V.3.2, methods p6 s9 and p8 s17.
+_KAHAN_LI_6_9 = _palindrome(
+    (
+        0.39216144400731413927925056,
+        0.33259913678935943859974864,
+        -0.70624617255763935980996482,
+        0.08221359629355080023149045,
+    )
+)
+_KAHAN_LI_8_17 = _palindrome(
+    (
+        0.13020248308889008087881763,
+        0.56116298177510838456196441,
+        -0.38947496264484728640807860,
+        0.15884190655515560089621075,
+        -0.39590389413323757733623154,
+        0.18453964097831570709183254,
+        0.25837438768632204729397911,
+        0.29501172360931029887096624,
+    )
+)
+# Suzuki & Umeno (1993) / McLachlan (1995), p8 s15, as printed in Hairer, Lubich & Wanner,
+# Sect. V.3.2.
+_SUZUKI_UMENO_8_15 = _palindrome(
+    (
+        0.74167036435061295344822780,
+        -0.40910082580003159399730010,
+        0.19075471029623837995387626,
+        -0.57386247111608226665638773,
+        0.29906418130365592384446354,
+        0.33462491824529818378495798,
+        0.31529309239676659663205666,
+    )
+)
+
+#: The composition table: ``(name suffix, order, coefficients, reference)``.
+COMPOSITIONS: tuple[tuple[str, int, tuple[float, ...], str], ...] = (
+    ("2", 2, (1.0,), "Strang (1968) symmetric splitting"),
+    ("4", 4, _YOSHIDA4, "Yoshida (1990) / Creutz & Gocksch triple jump"),
+    ("4-suzuki", 4, _SUZUKI5, "Suzuki (1990) 5-stage fractal composition"),
+    ("6", 6, _KAHAN_LI_6_9, "Kahan & Li (1997) p6 s9"),
+    ("8", 8, _KAHAN_LI_8_17, "Kahan & Li (1997) p8 s17"),
+    ("8-s15", 8, _SUZUKI_UMENO_8_15, "Suzuki & Umeno (1993), McLachlan (1995) p8 s15"),
+)
+
+
+def _make_schemes() -> dict[str, CompositionScheme]:
+    schemes: dict[str, CompositionScheme] = {}
+    for suffix, order, coefficients, reference in COMPOSITIONS:
+        for splitting, prefix in (("axes", "lie-poisson-"), ("symmetric", "lie-poisson-sym-")):
+            name = prefix + suffix
+            schemes[name] = CompositionScheme(name, order, coefficients, splitting, reference)
+    return schemes
+
+
+#: Every named Lie–Poisson method: ``lie-poisson-{2,4,6,8}`` (3-term split) and extras
+#: (``lie-poisson-4-suzuki``, ``lie-poisson-8-s15``, ``lie-poisson-sym-*``).
+SCHEMES: dict[str, CompositionScheme] = _make_schemes()
+
+
+def _middle_axis(inv_inertia: np.ndarray) -> int:
+    order = np.argsort(inv_inertia, kind="stable")
+    return int(order[1])
+
+
+def build_sequence(
+    inv_inertia: np.ndarray,
+    coefficients: tuple[float, ...],
+    splitting: str = "axes",
+    casimir_axis: int | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The merged sub-step sequence of one composed step.
+
+    Parameters
+    ----------
+    inv_inertia : numpy.ndarray, shape (3,)
+        ``1 / I_i``.
+    coefficients : tuple of float
+        Composition fractions ``gamma``.
+    splitting : {"axes", "symmetric"}
+        Which splitting (module docstring).
+    casimir_axis : int, optional
+        The axis ``a`` of the symmetric split; default: the middle moment.
+
+    Returns
+    -------
+    axes : numpy.ndarray of int64, shape (L,)
+        Body axis of each sub-step; the first and the last are the same axis.
+    rates : numpy.ndarray, shape (L,)
+        Rotation rate per unit ``M_k`` (``1/I_k`` or ``1/I_k - 1/I_a``).
+    fractions : numpy.ndarray, shape (L,)
+        Sub-step lengths as fractions of the step ``dt``.
+    casimir_rate : float
+        ``1/I_a`` for the symmetric split, 0 for the 3-term split.
+    """
+    inv = np.asarray(inv_inertia, dtype=float)
+    if splitting == "axes":
+        base = ((0, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5))
+        rate_of = {k: float(inv[k]) for k in range(3)}
+        casimir_rate = 0.0
+    elif splitting == "symmetric":
+        a = _middle_axis(inv) if casimir_axis is None else int(casimir_axis)
+        b, c = [k for k in range(3) if k != a]
+        base = ((b, 0.5), (c, 1.0), (b, 0.5))
+        rate_of = {k: float(inv[k] - inv[a]) for k in (b, c)}
+        casimir_rate = float(inv[a])
+    else:
+        raise InputError(f"splitting = {splitting!r} is unknown; use 'axes' or 'symmetric'")
+    merged: list[list[float]] = []
+    for gamma in coefficients:
+        for axis, fraction in base:
+            if merged and merged[-1][0] == axis:
+                merged[-1][1] += gamma * fraction
+            else:
+                merged.append([axis, gamma * fraction])
+    axes = np.array([int(entry[0]) for entry in merged], dtype=np.int64)
+    fractions = np.array([entry[1] for entry in merged], dtype=float)
+    rates = np.array([rate_of[int(axis)] for axis in axes], dtype=float)
+    return axes, rates, fractions, casimir_rate
+
+
+@njit(cache=True, inline="always")
+def _turn_M(M, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
+    mj = M[j]
+    ml = M[l]
+    M[j] = c * mj + s * ml
+    M[l] = c * ml - s * mj
+
+
+@njit(cache=True, inline="always")
+def _turn_R(R, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
+    for row in range(3):
+        rj = R[row, j]
+        rl = R[row, l]
+        R[row, j] = c * rj + s * rl
+        R[row, l] = c * rl - s * rj
+
+
+@njit(cache=True)
+def advance_sequence(M, R, axes, rates, fractions, casimir_rate, dt, n_steps, with_R):  # noqa: ANN001, N803, PLR0913
+    """Advance ``(M, R)`` in place by ``n_steps`` composed steps of size ``dt``.
+
+    Each sub-step ``(k, rate, fraction)`` turns ``M`` about body axis ``e_k`` by
+    ``-theta`` and ``R`` on the right by ``+theta``, ``theta = fraction dt rate M_k``
+    (exact flow of ``rate M_k^2 / 2`` under (250)–(251)). The last sub-step of a step is
+    merged with the first of the next. With ``casimir_rate != 0`` the exact Casimir flow
+    ``R <- exp(n_steps dt casimir_rate |m| hat(m/|m|)) R`` (``m = R M`` at entry) is applied
+    at the end. With ``with_R = False``, ``R`` is never read or written.
+    """
+    length = axes.shape[0]
+    if n_steps <= 0:
+        return
+    h = np.empty(length)
+    for j in range(length):
+        h[j] = fractions[j] * dt * rates[j]
+    h_join = (fractions[0] + fractions[length - 1]) * dt * rates[0]
+    # (k, j, l) cyclic: the sub-step about e_k mixes components j and l
+    js = np.empty(length, dtype=np.int64)
+    ls = np.empty(length, dtype=np.int64)
+    for j in range(length):
+        js[j] = (axes[j] + 1) % 3
+        ls[j] = (axes[j] + 2) % 3
+    last = length - 1
+    m0 = 0.0
+    m1 = 0.0
+    m2 = 0.0
+    if with_R and casimir_rate != 0.0:
+        m0 = R[0, 0] * M[0] + R[0, 1] * M[1] + R[0, 2] * M[2]
+        m1 = R[1, 0] * M[0] + R[1, 1] * M[1] + R[1, 2] * M[2]
+        m2 = R[2, 0] * M[0] + R[2, 1] * M[1] + R[2, 2] * M[2]
+    q = 0
+    k = axes[q]
+    theta = h[q] * M[k]
+    c = math.cos(theta)
+    s = math.sin(theta)
+    _turn_M(M, js[q], ls[q], c, s)
+    if with_R:
+        _turn_R(R, js[q], ls[q], c, s)
+        for step in range(n_steps):
+            for q in range(1, last):
+                k = axes[q]
+                theta = h[q] * M[k]
+                c = math.cos(theta)
+                s = math.sin(theta)
+                _turn_M(M, js[q], ls[q], c, s)
+                _turn_R(R, js[q], ls[q], c, s)
+            q = last
+            k = axes[q]
+            theta = (h_join if step < n_steps - 1 else h[last]) * M[k]
+            c = math.cos(theta)
+            s = math.sin(theta)
+            _turn_M(M, js[q], ls[q], c, s)
+            _turn_R(R, js[q], ls[q], c, s)
+    else:
+        for step in range(n_steps):
+            for q in range(1, last):
+                k = axes[q]
+                theta = h[q] * M[k]
+                c = math.cos(theta)
+                s = math.sin(theta)
+                _turn_M(M, js[q], ls[q], c, s)
+            q = last
+            k = axes[q]
+            theta = (h_join if step < n_steps - 1 else h[last]) * M[k]
+            c = math.cos(theta)
+            s = math.sin(theta)
+            _turn_M(M, js[q], ls[q], c, s)
+    if with_R and casimir_rate != 0.0:
+        norm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+        if norm > 0.0:
+            n0 = m0 / norm
+            n1 = m1 / norm
+            n2 = m2 / norm
+            angle = n_steps * dt * casimir_rate * norm
+            c = math.cos(angle)
+            s = math.sin(angle)
+            t = 1.0 - c
+            q00 = c + t * n0 * n0
+            q01 = t * n0 * n1 - s * n2
+            q02 = t * n0 * n2 + s * n1
+            q10 = t * n1 * n0 + s * n2
+            q11 = c + t * n1 * n1
+            q12 = t * n1 * n2 - s * n0
+            q20 = t * n2 * n0 - s * n1
+            q21 = t * n2 * n1 + s * n0
+            q22 = c + t * n2 * n2
+            for col in range(3):
+                r0 = R[0, col]
+                r1 = R[1, col]
+                r2 = R[2, col]
+                R[0, col] = q00 * r0 + q01 * r1 + q02 * r2
+                R[1, col] = q10 * r0 + q11 * r1 + q12 * r2
+                R[2, col] = q20 * r0 + q21 * r1 + q22 * r2
+
+
+@lru_cache(maxsize=64)
+def _cached_sequence(
+    inv_key: tuple[float, float, float], coefficients: tuple[float, ...], splitting: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    return build_sequence(np.array(inv_key), coefficients, splitting)
+
+
+def advance(
+    M: np.ndarray,
+    R: np.ndarray,
+    inv_inertia: np.ndarray,
+    dt: float,
+    n_steps: int,
+    coefficients: tuple[float, ...],
+    with_R: bool = True,
+    splitting: str = "axes",
+) -> None:
+    """Advance ``(M, R)`` in place with a composed Lie–Poisson splitting method.
+
+    Parameters
+    ----------
+    M : numpy.ndarray, shape (3,), float64, C-contiguous
+        Body angular momentum; overwritten.
+    R : numpy.ndarray, shape (3, 3), float64
+        Attitude (body to lab); overwritten when ``with_R``.
+    inv_inertia : array_like, shape (3,)
+        ``1 / I_i``.
+    dt : float
+        Step size (negative steps run backwards).
+    n_steps : int
+        Number of steps; the loop runs inside compiled code.
+    coefficients : tuple of float
+        Composition fractions of the Strang base step (``SCHEMES[name].coefficients``).
+    with_R : bool
+        Also advance ``R`` (otherwise ``R`` is not touched).
+    splitting : {"axes", "symmetric"}
+        3-term split or symmetric-top split (module docstring).
+    """
+    key = tuple(float(x) for x in np.asarray(inv_inertia, dtype=float))
+    axes, rates, fractions, casimir_rate = _cached_sequence(key, tuple(coefficients), splitting)
+    advance_sequence(M, R, axes, rates, fractions, casimir_rate, float(dt), int(n_steps), bool(with_R))
+
+
+def advance_scheme(
+    name: str,
+    M: np.ndarray,
+    R: np.ndarray,
+    inertia: np.ndarray,
+    dt: float,
+    n_steps: int,
+    with_R: bool = True,
+) -> None:
+    """Advance ``(M, R)`` in place with the named method of :data:`SCHEMES`.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`SCHEMES`, e.g. ``"lie-poisson-4"``.
+    M, R, dt, n_steps, with_R
+        As in :func:`advance`.
+    inertia : array_like, shape (3,)
+        Principal moments ``I_i``.
+
+    Raises
+    ------
+    InputError
+        Unknown method name.
+    """
+    try:
+        scheme = SCHEMES[name]
+    except KeyError:
+        raise InputError(
+            f"method {name!r} is not a Lie-Poisson splitting; choose one of {sorted(SCHEMES)}"
+        ) from None
+    inv = 1.0 / np.asarray(inertia, dtype=float)
+    advance(M, R, inv, dt, n_steps, scheme.coefficients, with_R, scheme.splitting)
