@@ -1,0 +1,1 @@
+"""``dirac bench``: work-precision benchmarks against baselines measured in the same run."""
