@@ -26,6 +26,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "analyze": ("dirac.commands.analyze", "run the Dirac-Bergmann algorithm on a system"),
     "run": ("dirac.commands.run", "run a scene file and write its results"),
     "bench": ("dirac.commands.bench", "work-precision benchmark against scipy baselines"),
+    "ensemble": ("dirac.commands.ensemble", "run an ensemble scene (many bodies, chunked, resumable)"),
 }
 
 
