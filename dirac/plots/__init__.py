@@ -1,0 +1,1 @@
+"""Pictures of the motion (matplotlib, headless): polhodes, body axes, conserved-quantity errors."""
