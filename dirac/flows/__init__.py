@@ -1,2 +1,47 @@
 """Numerical flows: problems, methods, the one ``integrate`` loop, solutions, scenes and
-result files."""
+result files.
+
+Public names (imported on first use, so ``import dirac.flows`` stays cheap):
+:func:`integrate`, :class:`Solution`, :class:`RigidBodyProblem`, :class:`HeavyTopProblem`,
+:class:`ConstrainedProblem`, :class:`MechanicalSystem`, :func:`load_scene`,
+:func:`write_results`, :func:`read_results`, :func:`get_method`, :func:`method_names`.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+_LAZY = {
+    "integrate": "dirac.flows.integrate",
+    "IntegrationInterrupted": "dirac.flows.integrate",
+    "Solution": "dirac.flows.solution",
+    "RigidBodyProblem": "dirac.flows.problem",
+    "HeavyTopProblem": "dirac.flows.problem",
+    "ConstrainedProblem": "dirac.flows.problem",
+    "MechanicalSystem": "dirac.flows.mechanics",
+    "load_scene": "dirac.flows.scene",
+    "scene_from_dict": "dirac.flows.scene",
+    "write_results": "dirac.flows.results",
+    "read_results": "dirac.flows.results",
+    "get_method": "dirac.flows.methods",
+    "method_names": "dirac.flows.methods",
+    "METHODS": "dirac.flows.methods",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'dirac.flows' has no attribute {name!r}")
+    value = getattr(import_module(module), name)
+    if name == "METHODS":
+        import_module("dirac.flows.methods")._load_all()
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

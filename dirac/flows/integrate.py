@@ -1,0 +1,367 @@
+"""The one integration loop: sampling, counters, CPU time, progress and guard rails.
+
+:func:`integrate` is the only place that loops over output times. Methods
+(:mod:`dirac.flows.methods`) only know how to advance a state; here the loop
+
+* samples the requested outputs at ``samples`` uniformly spaced times in ``[0, t_end]``
+  (both ends included; ``samples = 1`` means the final time only), computing only the
+  requested outputs and nothing in between;
+* adapts a fixed step ``dt`` so that it divides the sample spacing exactly;
+* counts steps and vector-field evaluations, and measures the CPU time of the loop after
+  the kernels have been compiled (``warm_up``);
+* draws a tqdm progress bar when asked;
+* stops at the first non-finite state, Newton non-convergence or constraint drift beyond
+  ``drift_limit`` with an :class:`IntegrationError` that names the time, the step and the
+  method, carrying the samples computed so far (``error.partial``, a :class:`Solution`
+  with ``complete = False``). Ctrl-C raises :class:`IntegrationInterrupted` the same way.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+from dirac.errors import InputError, IntegrationError
+from dirac.flows.methods import Method, Stepper, StepFailure, get_method
+from dirac.flows.solution import Solution
+
+__all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS"]
+
+#: Steps per call into a compiled kernel between checks (divided by the batch size).
+CHUNK_STEPS = 20_000
+#: Exact-flow samples evaluated per call.
+CHUNK_SAMPLES = 2_000
+
+DEFAULT_OUTPUTS = {
+    "rigid_body": ("M", "R", "energy"),
+    "heavy_top": ("M", "R", "energy"),
+    "constrained": ("q", "p", "energy", "constraint_residual"),
+}
+
+
+class IntegrationInterrupted(IntegrationError):
+    """The run was interrupted (Ctrl-C, SIGTERM); ``partial`` holds what was computed."""
+
+
+def problem_kind(problem: object) -> str:
+    """``"rigid_body"``, ``"heavy_top"`` or ``"constrained"``."""
+    from dirac.flows.problem import ConstrainedProblem, HeavyTopProblem, RigidBodyProblem
+
+    if isinstance(problem, HeavyTopProblem):
+        return "heavy_top"
+    if isinstance(problem, RigidBodyProblem):
+        return "rigid_body"
+    if isinstance(problem, ConstrainedProblem):
+        return "constrained"
+    raise InputError(f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem or ConstrainedProblem")
+
+
+def sample_times(t_end: float, samples: int) -> np.ndarray:
+    """``samples`` uniformly spaced times in ``[0, t_end]``, both ends included.
+
+    ``samples = 1`` gives ``[t_end]`` (only the final state is stored).
+    """
+    if samples == 1:
+        return np.array([float(t_end)])
+    return np.linspace(0.0, float(t_end), int(samples))
+
+
+def _validate(t_end: object, samples: object, dt: object, tolerance: object) -> tuple[float, int, float | None, float]:
+    if isinstance(t_end, bool) or not isinstance(t_end, (int, float)) or not math.isfinite(t_end) or t_end <= 0:
+        raise InputError(f"t_end = {t_end!r} must be a finite number > 0")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise InputError(f"samples = {samples!r} must be an integer >= 1 (1 stores only the final state)")
+    if dt is not None:
+        if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt) or dt <= 0:
+            raise InputError(f"dt = {dt!r} must be a finite number > 0")
+        dt = float(dt)
+    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not (0 < tolerance < 1):
+        raise InputError(f"tolerance = {tolerance!r} must be a number in (0, 1)")
+    return float(t_end), int(samples), dt, float(tolerance)
+
+
+def _validate_outputs(outputs: Sequence[str] | None, kind: str, available: Sequence[str]) -> tuple[str, ...]:
+    if outputs is None:
+        return DEFAULT_OUTPUTS[kind]
+    if isinstance(outputs, str):
+        outputs = [outputs]
+    chosen = tuple(dict.fromkeys(outputs))
+    if not chosen:
+        raise InputError("outputs is empty: request at least one output, e.g. [\"M\"]")
+    unknown = [name for name in chosen if name not in available]
+    if unknown:
+        raise InputError(
+            f"output(s) {', '.join(map(repr, unknown))} not available for a {kind.replace('_', ' ')} problem; "
+            f"choose from {', '.join(available)}"
+        )
+    return chosen
+
+
+def integrate(
+    problem: object,
+    method: str | Method = "auto",
+    *,
+    t_end: float,
+    dt: float | None = None,
+    samples: int = 101,
+    outputs: Sequence[str] | None = None,
+    tolerance: float = 1e-8,
+    progress: bool = False,
+    drift_limit: float = 1e-6,
+    newton_tolerance: float = 1e-12,
+    max_newton_iterations: int = 50,
+) -> Solution:
+    """Integrate ``problem`` with ``method`` and sample the requested outputs.
+
+    Parameters
+    ----------
+    problem
+        A :class:`RigidBodyProblem`, :class:`HeavyTopProblem` or :class:`ConstrainedProblem`
+        (initial states may be batched along a leading axis).
+    method
+        A name from :data:`dirac.flows.methods.METHODS` (``dirac run --help`` lists them)
+        or ``"auto"`` (:func:`dirac.flows.auto.choose_method`).
+    t_end
+        Final time (> 0).
+    dt
+        Step size of fixed-step methods; reduced to ``spacing / ceil(spacing / dt)`` so
+        that it divides the sample spacing.
+    samples
+        Number of output times, uniformly spaced in ``[0, t_end]`` (both ends); 1 stores
+        the final state only.
+    outputs
+        Names of the outputs to compute and store (default: see ``DEFAULT_OUTPUTS``).
+    tolerance
+        Target error of ``auto`` and the ``rtol = atol`` of the scipy baselines.
+    progress
+        Draw a tqdm progress bar on stderr.
+    drift_limit
+        Stop when a structural constraint (``R^T R = 1``; holonomic constraints and their
+        time derivatives) is violated by more than this.
+    newton_tolerance
+        Tolerance of the Newton iterations of ``rattle-*`` and ``midpoint``.
+    max_newton_iterations
+        Newton iterations per step before the step is declared failed.
+
+    Returns
+    -------
+    Solution
+
+    Raises
+    ------
+    InputError
+        Bad arguments (named in the message).
+    IntegrationError
+        The run had to stop; ``error.partial`` is the :class:`Solution` so far
+        (``complete = False``). :class:`IntegrationInterrupted` on Ctrl-C.
+    """
+    t_end, samples, dt, tolerance = _validate(t_end, samples, dt, tolerance)
+    kind = problem_kind(problem)
+    chosen_outputs = _validate_outputs(outputs, kind, problem.outputs)  # type: ignore[attr-defined]
+    extra: dict[str, object] = {}
+    if (isinstance(method, str) and method == "auto"):
+        from dirac.flows.auto import choose_method
+
+        choice = choose_method(problem, kind, t_end=t_end, samples=samples, tolerance=tolerance, dt=dt,
+                               outputs=chosen_outputs)
+        method_object, dt = get_method(choice.method), choice.dt
+        extra["auto"] = {"chosen": choice.method, "reason": choice.reason, "estimated_error": choice.estimated_error}
+    else:
+        method_object = get_method(method)  # type: ignore[arg-type]
+    if not method_object.accepts(kind):
+        usable = [m for m in _names_for(kind)]
+        raise InputError(
+            f"method {method_object.name!r} cannot integrate a {kind.replace('_', ' ')} problem; use one of: {', '.join(usable)}"
+        )
+    if method_object.kind == "fixed" and dt is None:
+        raise InputError(f"method {method_object.name!r} takes fixed steps: give dt (the step size)")
+    if method_object.kind != "fixed":
+        dt = None
+    options = {
+        "t_end": t_end,
+        "tolerance": tolerance,
+        "newton_tolerance": float(newton_tolerance),
+        "max_newton_iterations": int(max_newton_iterations),
+    }
+    stepper = method_object.start(problem, chosen_outputs, options)
+    stepper.warm_up()
+    return _Loop(problem, method_object, stepper, chosen_outputs, t_end, samples, dt, progress, drift_limit, extra).run()
+
+
+def _names_for(kind: str) -> list[str]:
+    from dirac.flows.methods import METHODS, method_names
+
+    return ["auto"] + [n for n in method_names() if n in METHODS and METHODS[n].accepts(kind)]
+
+
+class _Loop:
+    """One run of the loop (keeps the bookkeeping out of :func:`integrate`)."""
+
+    def __init__(self, problem, method: Method, stepper: Stepper, outputs, t_end, samples, dt, progress,  # noqa: ANN001
+                 drift_limit, extra) -> None:  # noqa: ANN001
+        self.problem = problem
+        self.method = method
+        self.stepper = stepper
+        self.outputs = outputs
+        self.times = sample_times(t_end, samples)
+        self.t_end = t_end
+        self.dt = dt
+        self.progress = progress
+        self.drift_limit = float(drift_limit)
+        self.extra = extra
+        self.store: dict[str, np.ndarray] = {}
+        self.stored = 0
+        self.t_now = 0.0
+        self.cpu = 0.0
+
+    # ------------------------------------------------------------------ storage
+    def _keep(self, index: int, values: dict[str, np.ndarray]) -> None:
+        for name in self.outputs:
+            value = np.asarray(values[name])
+            if name not in self.store:
+                self.store[name] = np.empty((len(self.times),) + value.shape, dtype=float)
+            self.store[name][index] = value
+        self.stored = index + 1
+
+    def _solution(self, complete: bool, message: str = "") -> Solution:
+        n = self.stored
+        outputs = {}
+        for name in self.outputs:
+            array = self.store.get(name)
+            if array is None:
+                continue
+            array = array[:n]
+            if not getattr(self.problem, "batched", False):
+                array = array[:, 0]
+            outputs[name] = np.ascontiguousarray(array)
+        extra = dict(self.extra)
+        if not complete:
+            extra["t_reached"] = self.t_now
+        return Solution(
+            t=self.times[:n].copy(),
+            outputs=outputs,
+            system=str(self.problem.system),
+            method=self.method.name,
+            order=self.method.order,
+            dt=self.dt,
+            steps=int(self.stepper.steps),
+            evaluations=int(self.stepper.evaluations),
+            cpu_seconds=self.cpu,
+            complete=complete,
+            message=message,
+            parameters=self.problem.parameters(),
+            extra=extra,
+        )
+
+    def _where(self) -> str:
+        return f"at t = {self.t_now:.6g} (step {self.stepper.steps}) with method {self.method.name}"
+
+    def _check(self) -> None:
+        if not self.stepper.finite():
+            raise _Stop(f"non-finite values (inf or nan) appeared in the state {self._where()}; reduce dt or check the initial data")
+        drift = self.stepper.drift()
+        if not drift <= self.drift_limit:
+            raise _Stop(
+                f"constraint drift {drift:.3g} exceeds the limit {self.drift_limit:.3g} {self._where()}; "
+                "reduce dt, tighten the Newton tolerance, or raise drift_limit"
+            )
+
+    # ------------------------------------------------------------------ the loop
+    def run(self) -> Solution:
+        from tqdm import tqdm
+
+        kind = self.stepper.kind
+        total = self._total_steps() if kind == "fixed" else len(self.times)
+        bar = tqdm(total=total, disable=not self.progress, unit=("step" if kind == "fixed" else "sample"),
+                   file=sys.stderr, leave=False, dynamic_ncols=True, desc=self.method.name)
+        start = time.process_time()
+        try:
+            if kind == "exact":
+                self._run_exact(bar)
+            elif kind == "fixed":
+                self._run_fixed(bar)
+            else:
+                self._run_adaptive(bar)
+        except _Stop as stop:
+            self.cpu = time.process_time() - start
+            raise IntegrationError(str(stop), partial=self._solution(False, str(stop))) from None
+        except StepFailure as failure:
+            self.cpu = time.process_time() - start
+            message = f"{failure} {self._where()}"
+            raise IntegrationError(message, partial=self._solution(False, message)) from None
+        except KeyboardInterrupt:
+            self.cpu = time.process_time() - start
+            message = f"interrupted {self._where()}"
+            raise IntegrationInterrupted(message, partial=self._solution(False, message)) from None
+        finally:
+            bar.close()
+        self.cpu = time.process_time() - start
+        return self._solution(True)
+
+    def _intervals(self) -> list[tuple[float, float, int]]:
+        """(start, end, steps) of each sampling interval (one for ``samples = 1``)."""
+        starts = np.concatenate([[0.0], self.times[:-1]]) if self.times[0] != 0.0 else self.times[:-1]
+        ends = self.times if self.times[0] != 0.0 else self.times[1:]
+        spacing = float(ends[0] - starts[0])
+        per_interval = max(1, int(math.ceil(spacing / self.dt * (1.0 - 1e-12))))
+        self.dt = spacing / per_interval
+        return [(float(a), float(b), per_interval) for a, b in zip(starts, ends)]
+
+    def _total_steps(self) -> int:
+        return sum(n for _, _, n in self._intervals())
+
+    def _run_fixed(self, bar) -> None:  # noqa: ANN001
+        intervals = self._intervals()
+        if self.times[0] == 0.0:
+            self._keep(0, self.stepper.observe())
+        first = 1 if self.times[0] == 0.0 else 0
+        batch = int(getattr(self.problem, "batch", 1))
+        chunk = max(1, CHUNK_STEPS // max(1, batch))
+        dt = float(self.dt)  # type: ignore[arg-type]
+        for index, (a, _b, n_steps) in enumerate(intervals):
+            done = 0
+            while done < n_steps:
+                n = min(chunk, n_steps - done)
+                try:
+                    self.stepper.step(n, dt)
+                except StepFailure as failure:
+                    self.t_now = a + (done + failure.steps_done) * dt
+                    raise
+                done += n
+                self.t_now = a + done * dt
+                self._check()
+                bar.update(n)
+            self.t_now = float(self.times[first + index])
+            self._keep(first + index, self.stepper.observe())
+
+    def _run_adaptive(self, bar) -> None:  # noqa: ANN001
+        for index, t in enumerate(self.times):
+            if t > 0.0:
+                self.stepper.advance_to(float(t))
+                self.t_now = float(t)
+                self._check()
+            self._keep(index, self.stepper.observe())
+            bar.update(1)
+
+    def _run_exact(self, bar) -> None:  # noqa: ANN001
+        for begin in range(0, len(self.times), CHUNK_SAMPLES):
+            chunk = self.times[begin : begin + CHUNK_SAMPLES]
+            values = self.stepper.evaluate(chunk)
+            for name in self.outputs:
+                array = np.asarray(values[name])
+                if name not in self.store:
+                    self.store[name] = np.empty((len(self.times),) + array.shape[1:], dtype=float)
+                self.store[name][begin : begin + len(chunk)] = array
+            self.stored = begin + len(chunk)
+            self.t_now = float(chunk[-1])
+            if not all(np.all(np.isfinite(values[name])) for name in self.outputs):
+                raise _Stop(f"non-finite values (inf or nan) in the exact solution {self._where()}")
+            bar.update(len(chunk))
+
+
+class _Stop(Exception):
+    """A guard rail fired (internal; becomes an IntegrationError)."""

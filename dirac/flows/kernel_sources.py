@@ -1,0 +1,444 @@
+"""numba source of the step loops of general systems, compiled together with the
+generated functions of each system (:mod:`dirac.flows.codegen`).
+
+The loops call the generated functions ``mass``, ``mass_derivative``, ``potential``,
+``grad_potential``, ``constraints``, ``constraint_jacobian`` and ``constraint_hessian``
+by name, so the text below is appended to each system's generated module and the whole
+step loop compiles (and is cached on disk) as one unit: no Python call per step.
+
+Notation: ``n`` coordinates, ``m`` holonomic constraints ``chi(q) = 0`` with Jacobian
+``G = dchi/dq``; ``H = 1/2 p^T M(q)^{-1} p + V(q)``, ``v = M^{-1} p = dH/dp``,
+``f = dH/dq = dV/dq - 1/2 v^T (dM/dq_k) v``.
+
+``info`` arrays (float64) report back: ``[steps_done, failed (0/1), evaluations,
+last_residual]``.
+"""
+
+SOURCE = r'''
+# ---------------------------------------------------------------- shared helpers
+@numba.njit(cache=True)
+def _velocity(q, p, params, v):
+    """v = M(q)^{-1} p."""
+    n = q.shape[0]
+    mm = np.empty((n, n))
+    mass(q, params, mm)
+    sol = np.linalg.solve(mm, p)
+    for i in range(n):
+        v[i] = sol[i]
+
+
+@numba.njit(cache=True)
+def _force(q, v, params, f):
+    """f = dH/dq = dV/dq - 1/2 v^T dM/dq_k v."""
+    n = q.shape[0]
+    grad_potential(q, params, f)
+    dm = np.empty((n, n, n))
+    mass_derivative(q, params, dm)
+    for k in range(n):
+        s = 0.0
+        for i in range(n):
+            for j in range(n):
+                s += v[i] * dm[k, i, j] * v[j]
+        f[k] -= 0.5 * s
+
+
+@numba.njit(cache=True)
+def _scale(q):
+    s = 1.0
+    for i in range(q.shape[0]):
+        s += q[i] * q[i]
+    return s
+
+
+@numba.njit(cache=True)
+def _max_abs(x):
+    r = 0.0
+    for i in range(x.shape[0]):
+        a = abs(x[i])
+        if a > r or a != a:
+            r = a if a == a else np.inf
+    return r
+
+
+# ---------------------------------------------------------------- RATTLE, constant mass
+@numba.njit(cache=True)
+def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max_iter, info):
+    """RATTLE (Andersen 1983; Hairer, Lubich & Wanner VII.1.4) with constant M.
+
+    p_half = p - h/2 (grad V(q) + G(q)^T lam),  q1 = q + h M^{-1} p_half,  chi(q1) = 0,
+    p1 = p_half - h/2 (grad V(q1) + G(q1)^T mu),  G(q1) M^{-1} p1 = 0.
+    One step of the composed method runs h = dt * fractions[s] for each s.
+    Newton on lam (m unknowns); mu from an m x m linear solve.
+    """
+    n = q.shape[0]
+    q_save = q.copy()
+    p_save = p.copy()
+    gv = np.empty(n)
+    G0 = np.zeros((m, n))
+    G1 = np.zeros((m, n))
+    chi = np.zeros(m)
+    A = np.zeros((n, m))
+    lam = np.zeros(m)
+    ph = np.empty(n)
+    qp = np.empty(n)
+    q1 = np.empty(n)
+    evals = 0.0
+    residual = 0.0
+    for step in range(n_steps):
+        q_save[:] = q
+        p_save[:] = p
+        for s in range(fractions.shape[0]):
+            h = dt * fractions[s]
+            grad_potential(q, params, gv)
+            evals += 1.0
+            for i in range(n):
+                ph[i] = p[i] - 0.5 * h * gv[i]
+            for i in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += minv[i, j] * ph[j]
+                qp[i] = q[i] + h * acc
+            if m > 0:
+                constraint_jacobian(q, params, G0)
+                for i in range(n):
+                    for a in range(m):
+                        acc = 0.0
+                        for j in range(n):
+                            acc += minv[i, j] * G0[a, j]
+                        A[i, a] = acc
+                for a in range(m):
+                    lam[a] = 0.0
+                q1[:] = qp
+                converged = False
+                for it in range(max_iter):
+                    constraints(q1, params, chi)
+                    evals += 1.0
+                    residual = _max_abs(chi)
+                    if residual <= tol * _scale(q1):
+                        converged = True
+                        break
+                    if residual != residual:
+                        break
+                    constraint_jacobian(q1, params, G1)
+                    J = np.empty((m, m))
+                    for a in range(m):
+                        for b in range(m):
+                            acc = 0.0
+                            for i in range(n):
+                                acc += G1[a, i] * A[i, b]
+                            J[a, b] = -0.5 * h * h * acc
+                    d = np.linalg.solve(J, chi)
+                    for a in range(m):
+                        lam[a] -= d[a]
+                    for i in range(n):
+                        acc = 0.0
+                        for a in range(m):
+                            acc += A[i, a] * lam[a]
+                        q1[i] = qp[i] - 0.5 * h * h * acc
+                if not converged:
+                    q[:] = q_save
+                    p[:] = p_save
+                    info[0] = step
+                    info[1] = 1.0
+                    info[2] = evals
+                    info[3] = residual
+                    return
+                for i in range(n):
+                    acc = 0.0
+                    for a in range(m):
+                        acc += G0[a, i] * lam[a]
+                    ph[i] -= 0.5 * h * acc
+                q[:] = q1
+            else:
+                q[:] = qp
+            grad_potential(q, params, gv)
+            evals += 1.0
+            for i in range(n):
+                p[i] = ph[i] - 0.5 * h * gv[i]
+            if m > 0:
+                constraint_jacobian(q, params, G1)
+                for i in range(n):
+                    for a in range(m):
+                        acc = 0.0
+                        for j in range(n):
+                            acc += minv[i, j] * G1[a, j]
+                        A[i, a] = acc
+                S = np.empty((m, m))
+                rhs = np.empty(m)
+                for a in range(m):
+                    for b in range(m):
+                        acc2 = 0.0
+                        for i in range(n):
+                            acc2 += G1[a, i] * A[i, b]
+                        S[a, b] = 0.5 * h * acc2
+                    acc = 0.0
+                    for i in range(n):
+                        acc += A[i, a] * p[i]
+                    rhs[a] = acc
+                mu = np.linalg.solve(S, rhs)
+                for i in range(n):
+                    acc = 0.0
+                    for a in range(m):
+                        acc += G1[a, i] * mu[a]
+                    p[i] -= 0.5 * h * acc
+    info[0] = n_steps
+    info[1] = 0.0
+    info[2] = evals
+    info[3] = residual
+
+
+# ---------------------------------------------------------------- RATTLE, general mass
+@numba.njit(cache=True)
+def _rattle_residual(x, q, p, h, params, n, m, r):
+    ph = x[:n]
+    q1 = x[n:2 * n]
+    v0 = np.empty(n)
+    f0 = np.empty(n)
+    v1 = np.empty(n)
+    _velocity(q, ph, params, v0)
+    _force(q, v0, params, f0)
+    G0 = np.zeros((m, n))
+    if m > 0:
+        constraint_jacobian(q, params, G0)
+    for i in range(n):
+        acc = 0.0
+        for a in range(m):
+            acc += G0[a, i] * x[2 * n + a]
+        r[i] = ph[i] - p[i] + 0.5 * h * (f0[i] + acc)
+    _velocity(q1, ph, params, v1)
+    for i in range(n):
+        r[n + i] = q1[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+    if m > 0:
+        chi = np.empty(m)
+        constraints(q1, params, chi)
+        for a in range(m):
+            r[2 * n + a] = chi[a]
+
+
+@numba.njit(cache=True)
+def rattle_general(q, p, params, m, fractions, dt, n_steps, tol, max_iter, info):
+    """RATTLE for H = 1/2 p^T M(q)^{-1} p + V(q) (Jay 1996; Hairer, Lubich & Wanner
+    VII.1.4, eq. (1.26)):
+
+    p_half = p - h/2 (H_q(q, p_half) + G(q)^T lam)
+    q1 = q + h/2 (H_p(q, p_half) + H_p(q1, p_half)),  chi(q1) = 0
+    p1 = p_half - h/2 (H_q(q1, p_half) + G(q1)^T mu),  G(q1) H_p(q1, p1) = 0.
+
+    Simplified Newton on (p_half, q1, lam) with a finite-difference Jacobian formed once
+    per sub-step; mu from an m x m linear solve.
+    """
+    n = q.shape[0]
+    N = 2 * n + m
+    q_save = q.copy()
+    p_save = p.copy()
+    x = np.empty(N)
+    xx = np.empty(N)
+    r = np.empty(N)
+    rr = np.empty(N)
+    J = np.empty((N, N))
+    v = np.empty(n)
+    f = np.empty(n)
+    evals = 0.0
+    residual = 0.0
+    for step in range(n_steps):
+        q_save[:] = q
+        p_save[:] = p
+        for s in range(fractions.shape[0]):
+            h = dt * fractions[s]
+            _velocity(q, p, params, v)
+            for i in range(n):
+                x[i] = p[i]
+                x[n + i] = q[i] + h * v[i]
+            for a in range(m):
+                x[2 * n + a] = 0.0
+            _rattle_residual(x, q, p, h, params, n, m, r)
+            evals += 1.0
+            for j in range(N):
+                xx[:] = x
+                d = 1e-7 * (1.0 + abs(x[j]))
+                xx[j] += d
+                _rattle_residual(xx, q, p, h, params, n, m, rr)
+                for i in range(N):
+                    J[i, j] = (rr[i] - r[i]) / d
+            evals += N
+            converged = False
+            for it in range(max_iter):
+                delta = np.linalg.solve(J, r)
+                for i in range(N):
+                    x[i] -= delta[i]
+                _rattle_residual(x, q, p, h, params, n, m, r)
+                evals += 1.0
+                residual = _max_abs(r)
+                if residual <= tol * _scale(x[:2 * n]):
+                    converged = True
+                    break
+                if residual != residual:
+                    break
+            if not converged:
+                q[:] = q_save
+                p[:] = p_save
+                info[0] = step
+                info[1] = 1.0
+                info[2] = evals
+                info[3] = residual
+                return
+            ph = x[:n].copy()
+            q[:] = x[n:2 * n]
+            _velocity(q, ph, params, v)
+            _force(q, v, params, f)
+            evals += 1.0
+            for i in range(n):
+                p[i] = ph[i] - 0.5 * h * f[i]
+            if m > 0:
+                G1 = np.empty((m, n))
+                constraint_jacobian(q, params, G1)
+                mm = np.empty((n, n))
+                mass(q, params, mm)
+                W = np.linalg.solve(mm, np.ascontiguousarray(G1.T))
+                u = np.linalg.solve(mm, p)
+                S = np.empty((m, m))
+                rhs = np.empty(m)
+                for a in range(m):
+                    acc = 0.0
+                    for i in range(n):
+                        acc += G1[a, i] * u[i]
+                    rhs[a] = acc
+                    for b in range(m):
+                        acc = 0.0
+                        for i in range(n):
+                            acc += G1[a, i] * W[i, b]
+                        S[a, b] = 0.5 * h * acc
+                mu = np.linalg.solve(S, rhs)
+                for i in range(n):
+                    acc = 0.0
+                    for a in range(m):
+                        acc += G1[a, i] * mu[a]
+                    p[i] -= 0.5 * h * acc
+    info[0] = n_steps
+    info[1] = 0.0
+    info[2] = evals
+    info[3] = residual
+
+
+# ---------------------------------------------------------------- Dirac vector field
+@numba.njit(cache=True)
+def dirac_field(z, params, n, m, out):
+    """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H), C = grad Phi J grad Phi^T,
+    on z = (q, p) with the second-class constraints Phi = (chi(q), G(q) M(q)^{-1} p)
+    (the paper's second and third stages; Dirac bracket (240)). C is evaluated and
+    solved numerically at z.
+    """
+    q = z[:n]
+    p = z[n:2 * n]
+    v = np.empty(n)
+    f = np.empty(n)
+    _velocity(q, p, params, v)
+    _force(q, v, params, f)
+    for i in range(n):
+        out[i] = v[i]
+        out[n + i] = -f[i]
+    if m == 0:
+        return
+    G = np.empty((m, n))
+    constraint_jacobian(q, params, G)
+    hc = np.empty((m, n, n))
+    constraint_hessian(q, params, hc)
+    mm = np.empty((n, n))
+    mass(q, params, mm)
+    W = np.linalg.solve(mm, np.ascontiguousarray(G.T))  # (n, m) = M^{-1} G^T
+    dm = np.empty((n, n, n))
+    mass_derivative(q, params, dm)
+    D = np.zeros((2 * m, 2 * n))
+    for a in range(m):
+        for k in range(n):
+            D[a, k] = G[a, k]
+            s = 0.0
+            for j in range(n):
+                s += hc[a, k, j] * v[j]
+            t = 0.0
+            for i in range(n):
+                for j in range(n):
+                    t += W[i, a] * dm[k, i, j] * v[j]
+            D[m + a, k] = s - t
+            D[m + a, n + k] = W[k, a]
+    C = np.empty((2 * m, 2 * m))
+    rhs = np.empty(2 * m)
+    for a in range(2 * m):
+        acc = 0.0
+        for k in range(n):
+            acc += D[a, k] * out[k] + D[a, n + k] * out[n + k]
+        rhs[a] = acc
+        for b in range(2 * m):
+            c = 0.0
+            for k in range(n):
+                c += D[a, k] * D[b, n + k] - D[a, n + k] * D[b, k]
+            C[a, b] = c
+    mu = np.linalg.solve(C, rhs)
+    for b in range(2 * m):
+        for k in range(n):
+            out[k] -= mu[b] * D[b, n + k]
+            out[n + k] += mu[b] * D[b, k]
+
+
+@numba.njit(cache=True)
+def midpoint_run(z, params, n, m, dt, n_steps, tol, max_iter, info):
+    """Implicit midpoint z1 = z0 + dt F((z0 + z1)/2) on the Dirac vector field F;
+    simplified Newton with a finite-difference Jacobian of F at z0 per step."""
+    N = 2 * n
+    f = np.empty(N)
+    fz = np.empty(N)
+    zz = np.empty(N)
+    zm = np.empty(N)
+    z1 = np.empty(N)
+    r = np.empty(N)
+    J = np.empty((N, N))
+    evals = 0.0
+    size = 0.0
+    for step in range(n_steps):
+        dirac_field(z, params, n, m, f)
+        evals += 1.0
+        for j in range(N):
+            zz[:] = z
+            d = 1e-7 * (1.0 + abs(z[j]))
+            zz[j] += d
+            dirac_field(zz, params, n, m, fz)
+            for i in range(N):
+                J[i, j] = -0.5 * dt * (fz[i] - f[i]) / d
+            J[j, j] += 1.0
+        evals += N
+        for i in range(N):
+            z1[i] = z[i] + dt * f[i]
+        converged = False
+        for it in range(max_iter):
+            for i in range(N):
+                zm[i] = 0.5 * (z[i] + z1[i])
+            dirac_field(zm, params, n, m, fz)
+            evals += 1.0
+            for i in range(N):
+                r[i] = z1[i] - z[i] - dt * fz[i]
+            delta = np.linalg.solve(J, r)
+            size = 0.0
+            scale = 1.0
+            for i in range(N):
+                z1[i] -= delta[i]
+                if abs(delta[i]) > size or delta[i] != delta[i]:
+                    size = abs(delta[i]) if delta[i] == delta[i] else np.inf
+                if abs(z1[i]) > scale:
+                    scale = abs(z1[i])
+            if size <= tol * scale:
+                converged = True
+                break
+            if size != size or size == np.inf:
+                break
+        if not converged:
+            info[0] = step
+            info[1] = 1.0
+            info[2] = evals
+            info[3] = size
+            return
+        z[:] = z1
+    info[0] = n_steps
+    info[1] = 0.0
+    info[2] = evals
+    info[3] = size
+'''

@@ -1,0 +1,240 @@
+"""A Lagrangian with holonomic constraints, compiled to numbers for RATTLE and friends.
+
+For ``L = 1/2 q_dot^T M(q) q_dot - V(q)`` with constraints ``chi(q) = 0`` the
+Hamiltonian is ``H = 1/2 p^T M(q)^{-1} p + V(q)`` and the constrained equations are
+(Hairer, Lubich & Wanner, Geometric Numerical Integration, Sect. VII.1)
+
+    q_dot = M^{-1} p,   p_dot = -grad H_q - G(q)^T lambda,   chi(q) = 0,
+
+``G = d chi / dq``; the hidden constraint ``G(q) M^{-1} p = 0`` is the paper's third
+stage (Sect. X). The multipliers ``lambda`` are those of the extended Lagrangian (1).
+
+:class:`MechanicalSystem` extracts ``M(q)``, ``V(q)`` and ``chi(q)`` from a
+:class:`dirac.Lagrangian` (sympy, once), and generates numba functions for them
+(:mod:`dirac.flows.codegen`). Lagrangians that are not of this form (terms linear in the
+velocities, non-quadratic kinetic energy, a singular mass matrix) are refused with an
+:class:`InputError` saying why.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy
+
+from dirac.errors import InputError
+from dirac.lagrangian import Lagrangian
+
+__all__ = ["MechanicalSystem"]
+
+
+@dataclass
+class MechanicalSystem:
+    """Numerical pieces of a natural mechanical system with holonomic constraints.
+
+    Build it with :meth:`from_lagrangian`. Generated numba functions (``f(q, params, out)``,
+    coordinates in :attr:`coordinate_names` order): ``mass`` (n, n), ``grad_potential``
+    (n,), ``potential`` (1,), ``constraints`` (m,), ``constraint_jacobian`` (m, n),
+    ``mass_derivative`` (n, n, n) with ``[k, i, j] = dM_ij/dq_k``.
+
+    Attributes
+    ----------
+    name : str
+    coordinate_names : tuple of str
+    dimension : int
+        Number of coordinates ``n``.
+    n_constraints : int
+        Number of holonomic constraints ``m``.
+    parameter_values : dict
+        Parameter name -> value used.
+    constant_mass : numpy.ndarray or None
+        The mass matrix when it does not depend on ``q`` (fast RATTLE path).
+    """
+
+    name: str
+    coordinate_names: tuple[str, ...]
+    dimension: int
+    n_constraints: int
+    parameter_values: dict[str, float]
+    params: np.ndarray
+    constant_mass: np.ndarray | None
+    module: object
+    symbolic: dict[str, object] = field(repr=False, default_factory=dict)
+
+    # ------------------------------------------------------------------ building
+    @classmethod
+    def from_lagrangian(
+        cls, lagrangian: Lagrangian, parameters: dict[str, float] | None = None, extra_source: str = ""
+    ) -> "MechanicalSystem":
+        """Split ``L`` into ``1/2 q_dot^T M(q) q_dot - V(q)`` and generate its functions.
+
+        Parameters
+        ----------
+        lagrangian
+            The system (parameters without a value must be given in ``parameters``).
+        parameters
+            Overrides of parameter values, by name.
+        extra_source
+            Numba source appended to the generated module (step loops).
+
+        Raises
+        ------
+        InputError
+            Unknown or missing parameter values, velocity-linear terms, a kinetic energy
+            that is not quadratic in the velocities, or a mass matrix that is singular.
+        """
+        values = {name: value for name, value in lagrangian.parameter_values.items()}
+        for key, value in (parameters or {}).items():
+            if key not in values:
+                known = ", ".join(sorted(values)) or "(none)"
+                raise InputError(f"system {lagrangian.name!r} has no parameter {key!r}; its parameters are: {known}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+                raise InputError(f"parameter {key!r} = {value!r} must be a finite number")
+            values[key] = float(value)
+        missing = sorted(k for k, v in values.items() if v is None)
+        if missing:
+            raise InputError(
+                f"system {lagrangian.name!r}: parameters {', '.join(missing)} have no value; give them under "
+                "[system] parameters in the scene"
+            )
+        q = list(lagrangian.coordinates)
+        v = list(lagrangian.velocities)
+        L = sympy.expand(lagrangian.expression)
+        zero_velocity = {s: 0 for s in v}
+        hessian = sympy.hessian(L, v)
+        if any(entry.free_symbols & set(v) for entry in hessian):
+            raise InputError(
+                f"the Lagrangian of {lagrangian.name!r} is not quadratic in the velocities: RATTLE and the "
+                "flows here need L = 1/2 q_dot^T M(q) q_dot - V(q)"
+            )
+        linear = [sympy.simplify(sympy.diff(L, s).subs(zero_velocity)) for s in v]
+        offending = [s.name for s, term in zip(v, linear) if term != 0]
+        if offending:
+            raise InputError(
+                f"the Lagrangian of {lagrangian.name!r} has terms linear in the velocities "
+                f"({', '.join(offending)}, e.g. magnetic or gyroscopic terms): RATTLE needs "
+                "L = 1/2 q_dot^T M(q) q_dot - V(q); use method = \"midpoint\" on the Dirac flow instead"
+            )
+        potential = sympy.expand(-L.subs(zero_velocity))
+        mass = sympy.Matrix(hessian)
+        chis = sympy.Matrix(list(lagrangian.constraints))
+        parameter_symbols = list(lagrangian.parameters)
+        param_array = np.array([float(values[p.name]) for p in parameter_symbols], dtype=float)
+        n, m = len(q), len(lagrangian.constraints)
+        jacobian = chis.jacobian(q) if m else sympy.zeros(0, n)
+        grad_v = sympy.Matrix([sympy.diff(potential, s) for s in q])
+        dmass = [mass.diff(s) for s in q]
+        hessians = [e for chi in chis for e in sympy.hessian(chi, q)]
+        constant = all(not (entry.free_symbols & set(q)) for entry in mass)
+        from dirac.flows.codegen import GeneratedFunction, generate_module
+
+        args = tuple(q)
+        functions = [
+            GeneratedFunction("mass", args, mass, "mass matrix M(q), (n, n)"),
+            GeneratedFunction("potential", args, [potential], "potential V(q), (1,)"),
+            GeneratedFunction("grad_potential", args, grad_v, "dV/dq, (n,)"),
+            GeneratedFunction("constraints", args, list(chis), "holonomic constraints chi(q), (m,)"),
+            GeneratedFunction("constraint_jacobian", args, jacobian, "G = dchi/dq, (m, n)"),
+            GeneratedFunction(
+                "mass_derivative", args, [e for d in dmass for e in d], "dM_ij/dq_k as [k, i, j], (n, n, n)"
+            ),
+            GeneratedFunction("constraint_hessian", args, hessians, "d2 chi_a/dq_k dq_j as [a, k, j], (m, n, n)"),
+        ]
+        from dirac.flows.kernel_sources import SOURCE
+
+        module = generate_module(
+            functions, parameter_symbols, SOURCE + extra_source, title=f"system {lagrangian.name}"
+        )
+        constant_mass = None
+        if constant:
+            constant_mass = np.empty((n, n))
+            module.mass(np.zeros(n), param_array, constant_mass)
+        system = cls(
+            name=lagrangian.name,
+            coordinate_names=tuple(s.name for s in q),
+            dimension=n,
+            n_constraints=m,
+            parameter_values={k: float(v) for k, v in values.items()},
+            params=param_array,
+            constant_mass=constant_mass,
+            module=module,
+            symbolic={"mass": mass, "potential": potential, "constraints": chis, "coordinates": q,
+                      "parameters": parameter_symbols},
+        )
+        return system
+
+    # ------------------------------------------------------------------ numerics (numpy side)
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """``M(q)``, checked to be symmetric positive definite."""
+        if self.constant_mass is not None:
+            matrix = self.constant_mass.copy()
+        else:
+            matrix = np.empty((self.dimension, self.dimension))
+            self.module.mass(np.asarray(q, dtype=float), self.params, matrix)  # type: ignore[attr-defined]
+        eigenvalues = np.linalg.eigvalsh(matrix)
+        if not np.all(np.isfinite(eigenvalues)) or eigenvalues.min() <= 1e-14 * max(1.0, eigenvalues.max()):
+            raise InputError(
+                f"the mass matrix of {self.name!r} is singular or not positive at q = {np.asarray(q).tolist()}: "
+                "RATTLE needs a regular Lagrangian (positive kinetic energy in every velocity)"
+            )
+        return matrix
+
+    def energy(self, q: np.ndarray, p: np.ndarray) -> float:
+        """``H = 1/2 p^T M(q)^{-1} p + V(q)``."""
+        out = np.empty(1)
+        self.module.potential(np.asarray(q, dtype=float), self.params, out)  # type: ignore[attr-defined]
+        return float(0.5 * p @ np.linalg.solve(self.mass_matrix(q), p) + out[0])
+
+    def residuals(self, q: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position residuals ``chi(q)`` and velocity residuals ``G(q) M(q)^{-1} p``."""
+        m = self.n_constraints
+        if m == 0:
+            return np.zeros(0), np.zeros(0)
+        chi = np.empty(m)
+        G = np.empty((m, self.dimension))
+        self.module.constraints(np.asarray(q, dtype=float), self.params, chi)  # type: ignore[attr-defined]
+        self.module.constraint_jacobian(np.asarray(q, dtype=float), self.params, G)  # type: ignore[attr-defined]
+        return chi, G @ np.linalg.solve(self.mass_matrix(q), p)
+
+    def constraint_residual(self, q: np.ndarray, p: np.ndarray) -> float:
+        """``max(|chi(q)|, |G M^{-1} p|)``: distance from the constraint surface."""
+        chi, velocity = self.residuals(q, p)
+        if chi.size == 0:
+            return 0.0
+        return float(max(np.max(np.abs(chi)), np.max(np.abs(velocity))))
+
+    def project(self, q: np.ndarray, p: np.ndarray, tol: float = 1e-14, max_iter: int = 50) -> tuple[np.ndarray, np.ndarray]:
+        """Project ``(q, p)`` onto the constraint surface (closest point in the metric ``M``).
+
+        ``q <- q - M^{-1} G^T (G M^{-1} G^T)^{-1} chi(q)`` (Newton, until ``|chi|`` stops
+        decreasing), then ``p <- p - G^T (G M^{-1} G^T)^{-1} G M^{-1} p``.
+
+        Raises
+        ------
+        InputError
+            When the projection does not converge (q too far from the surface).
+        """
+        q = np.array(q, dtype=float)
+        p = np.array(p, dtype=float)
+        m = self.n_constraints
+        if m == 0:
+            return q, p
+        chi = np.empty(m)
+        G = np.empty((m, self.dimension))
+        for _ in range(max_iter):
+            self.module.constraints(q, self.params, chi)  # type: ignore[attr-defined]
+            if np.max(np.abs(chi)) <= tol * (1.0 + q @ q):
+                break
+            self.module.constraint_jacobian(q, self.params, G)  # type: ignore[attr-defined]
+            A = np.linalg.solve(self.mass_matrix(q), G.T)
+            q = q - A @ np.linalg.solve(G @ A, chi)
+        else:
+            raise InputError(
+                f"could not project the initial q onto the constraints of {self.name!r} "
+                f"(residual {np.max(np.abs(chi)):.3g}): give q closer to the surface"
+            )
+        self.module.constraint_jacobian(q, self.params, G)  # type: ignore[attr-defined]
+        A = np.linalg.solve(self.mass_matrix(q), G.T)
+        p = p - G.T @ np.linalg.solve(G @ A, G @ np.linalg.solve(self.mass_matrix(q), p))
+        return q, p

@@ -1,0 +1,102 @@
+"""Result files (CONTRACTS §7): ``.npz`` with ``t``, the requested outputs and ``meta``.
+
+Files are written atomically: the data go to a temporary file in the destination's
+directory, are flushed to disk, and the temporary file is renamed over the destination
+(:func:`os.replace`). A failed or interrupted write therefore never leaves a half-written
+file and never destroys an existing one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from dirac.errors import InputError
+
+__all__ = ["write_results", "read_results", "versions"]
+
+
+def versions() -> dict[str, str]:
+    """Versions of dirac, Python and the numerical libraries (for ``meta``)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    result = {"python": platform.python_version()}
+    for distribution, key in (("dirac-mechanics", "dirac"), ("numpy", "numpy"), ("scipy", "scipy"),
+                              ("numba", "numba"), ("sympy", "sympy")):
+        try:
+            result[key] = version(distribution)
+        except PackageNotFoundError:
+            result[key] = "unknown"
+    return result
+
+
+def _json_default(value: object) -> object:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return str(value)
+
+
+def write_results(solution, path: str | Path, extra_meta: dict[str, object] | None = None) -> Path:  # noqa: ANN001
+    """Write ``solution`` to ``path`` atomically (CONTRACTS §7).
+
+    Parameters
+    ----------
+    solution : dirac.flows.Solution
+        Complete or partial (``complete = False`` is recorded in ``meta``).
+    path
+        Destination ``.npz`` file; its directory must exist.
+    extra_meta
+        More keys for ``meta`` (e.g. the scene file).
+
+    Returns
+    -------
+    pathlib.Path
+        The destination.
+
+    Raises
+    ------
+    InputError
+        The directory does not exist or is not writable.
+    """
+    destination = Path(path)
+    directory = destination.parent if str(destination.parent) else Path(".")
+    if not directory.is_dir():
+        raise InputError(f"cannot write {str(destination)!r}: directory {str(directory)!r} does not exist")
+    meta = solution.meta()
+    if extra_meta:
+        meta.update(extra_meta)
+    arrays = {"t": np.asarray(solution.t, dtype=float)}
+    arrays.update({name: np.asarray(value) for name, value in solution.outputs.items()})
+    arrays["meta"] = np.array(json.dumps(meta, default=_json_default, allow_nan=True))
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{destination.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise InputError(f"cannot write {str(destination)!r}: {exc.strerror}") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            np.savez(stream, **arrays)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, destination)
+    except BaseException:
+        try:
+            os.unlink(temporary)
+        except OSError:
+            pass
+        raise
+    return destination
+
+
+def read_results(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, object]]:
+    """Read a result file: ``(arrays without meta, meta as a dict)``."""
+    with np.load(path, allow_pickle=False) as data:
+        arrays = {name: data[name] for name in data.files if name != "meta"}
+        meta = json.loads(str(data["meta"]))
+    return arrays, meta

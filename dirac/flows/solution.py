@@ -1,0 +1,88 @@
+"""The result of :func:`dirac.flows.integrate`: sampled outputs, counters and status."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Solution"]
+
+
+@dataclass
+class Solution:
+    """Sampled outputs of one integration.
+
+    Attributes
+    ----------
+    t : numpy.ndarray, shape (samples,)
+        Output times actually reached (fewer than requested when ``complete`` is false).
+    outputs : dict
+        Output name -> array with leading axis ``samples`` (then the batch axis when the
+        problem was batched), e.g. ``M`` (samples, 3), ``R`` (samples, 3, 3).
+    system, method : str
+    order : int
+    dt : float or None
+        Step size used (fixed-step methods; adapted so that it divides the sample spacing).
+    steps : int
+        Steps taken (per initial state).
+    evaluations : int
+        Vector-field or sub-flow evaluations (all states together).
+    cpu_seconds : float
+        CPU time of the integration itself; compilation excluded.
+    complete : bool
+        False when the run stopped early (error or interruption).
+    message : str
+        Why the run stopped early (empty when complete).
+    parameters : dict
+        Numerical parameters of the problem.
+    """
+
+    t: np.ndarray
+    outputs: dict[str, np.ndarray]
+    system: str
+    method: str
+    order: int
+    dt: float | None
+    steps: int
+    evaluations: int
+    cpu_seconds: float
+    complete: bool = True
+    message: str = ""
+    parameters: dict[str, object] = field(default_factory=dict)
+    extra: dict[str, object] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        """The samples of one output (``solution["M"]``)."""
+        if name == "t":
+            return self.t
+        try:
+            return self.outputs[name]
+        except KeyError:
+            raise KeyError(f"output {name!r} was not requested; this solution has {sorted(self.outputs)}") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name == "t" or name in self.outputs
+
+    def meta(self) -> dict[str, object]:
+        """The ``meta`` record of the result file (CONTRACTS §7)."""
+        from dirac.flows.results import versions
+
+        record: dict[str, object] = {
+            "system": self.system,
+            "parameters": self.parameters,
+            "method": self.method,
+            "order": self.order,
+            "dt": self.dt,
+            "steps": self.steps,
+            "evaluations": self.evaluations,
+            "cpu_seconds": self.cpu_seconds,
+            "complete": self.complete,
+            "samples": int(self.t.shape[0]),
+            "outputs": list(self.outputs),
+            "versions": versions(),
+        }
+        if self.message:
+            record["message"] = self.message
+        record.update(self.extra)
+        return record
