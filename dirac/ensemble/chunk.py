@@ -1,0 +1,111 @@
+"""One chunk of an ensemble: draw its members, advance them, reduce, return arrays.
+
+This is the unit of work of both executors (the local loop and a dask task): it depends
+only on the scene and the member range, so a chunk computed anywhere, any number of
+times, gives the same bits.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+from dirac.ensemble.reductions import make_reductions
+from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
+
+__all__ = ["advance_members", "compute_chunk", "KERNEL_LOCK"]
+
+#: Serialises the parallel kernel within one process: numba's default ("workqueue")
+#: threading layer must not be entered by two threads at once (threaded dask workers),
+#: and one call already uses every thread numba is allowed.
+KERNEL_LOCK = threading.Lock()
+
+#: Member-steps below which one kernel call runs single-threaded (a few ms of work).
+PARALLEL_WORK = 100_000
+
+
+def advance_members(
+    M: np.ndarray,
+    R: np.ndarray | None,
+    inv_inertia: np.ndarray,
+    dt: float,
+    n_steps: int,
+    coefficients: tuple[float, ...],
+    with_R: bool,
+) -> None:
+    """Advance a batch in place with the batched Lie-Poisson kernel (250)-(251).
+
+    Delegates to :func:`dirac.rigidbody.batch.advance_batch` (numba, parallel over
+    blocks of bodies), under :data:`KERNEL_LOCK`. A call with less than
+    :data:`PARALLEL_WORK` member-steps runs on one thread: waking the other threads
+    costs more than it saves, and on a loaded machine a parallel launch can wait a
+    whole scheduler time slice for a descheduled thread.
+    """
+    import numba
+
+    from dirac.rigidbody.batch import advance_batch
+
+    with KERNEL_LOCK:
+        threads = numba.get_num_threads()
+        if M.shape[0] * n_steps < PARALLEL_WORK and threads > 1:
+            numba.set_num_threads(1)
+        try:
+            advance_batch(M, R if with_R else None, inv_inertia, dt, n_steps, coefficients, with_R)
+        finally:
+            numba.set_num_threads(threads)
+
+
+def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.ndarray]:
+    """Integrate members ``start .. stop-1`` of ``scene`` and return their arrays.
+
+    The members are drawn (:meth:`MemberSource.members`), advanced over the sample grid
+    ``t_k = k t_end / (samples - 1)`` by ``steps_per_sample`` steps of the scene's
+    splitting method between samples, and at every sample the trajectory outputs are
+    recorded and the reductions updated.
+
+    Parameters
+    ----------
+    scene : EnsembleScene
+    start, stop : int
+        Member range.
+
+    Returns
+    -------
+    dict
+        Array name -> array with ``stop - start`` rows (trajectory outputs have shape
+        ``(n, samples, ...)``, reductions ``(n, ...)``).
+    """
+    M, R, inertia = scene.source.members(start, stop)
+    inv = np.ascontiguousarray(1.0 / inertia)
+    n = stop - start
+    times = scene.times()
+
+    traj = {name: np.empty((n, scene.samples, *TRAJECTORY_OUTPUTS[name])) for name in scene.outputs}
+    reductions = make_reductions(scene.reductions, scene.flip_axis)
+
+    def record(k: int) -> None:
+        for name, array in traj.items():
+            if name == "M":
+                array[:, k] = M
+            elif name == "R":
+                array[:, k] = R
+            elif name == "energy":
+                array[:, k] = 0.5 * np.einsum("ij,ij->i", M * inv, M)
+            elif name == "casimir":
+                array[:, k] = np.einsum("ij,ij->i", M, M)
+            elif name == "lab_momentum":
+                array[:, k] = np.einsum("nij,nj->ni", R, M)
+
+    record(0)
+    for reduction in reductions:
+        reduction.start(M, R, inertia)
+    for k in range(1, scene.samples):
+        advance_members(M, R, inv, scene.dt, scene.steps_per_sample, scene.coefficients, scene.with_R)
+        record(k)
+        for reduction in reductions:
+            reduction.update(times[k - 1], times[k], M, R)
+    results: dict[str, np.ndarray] = dict(traj)
+    for reduction in reductions:
+        results.update(reduction.result())
+    return results
