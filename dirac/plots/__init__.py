@@ -1,1 +1,65 @@
-"""Pictures of the motion (matplotlib, headless): polhodes, body axes, conserved-quantity errors."""
+"""Pictures of the motion (matplotlib, headless): polhodes, body axes, conserved-quantity errors.
+
+Modules, one job each:
+
+- :mod:`dirac.plots.canvas` -- figures on the Agg canvas (no pyplot, no display) and PNG output;
+- :mod:`dirac.plots.geometry` -- spheres, ellipsoids, polhode curves (numpy only);
+- :mod:`dirac.plots.rigid_body` -- the free rigid body: polhode on the energy ellipsoid and
+  the ``|M|`` sphere, body-axis tips on the unit sphere, errors of ``E``, ``|M|^2``,
+  ``m = R M`` and ``R^T R``;
+- :mod:`dirac.plots.constrained` -- a general constrained system: path, coordinates,
+  energy error and constraint residual;
+- :mod:`dirac.plots.results` -- one call that draws a run's result as a PNG
+  (what ``dirac run --plot`` and ``dirac demo --plot`` use).
+
+matplotlib is imported only when a figure is drawn (``pip install 'dirac-mechanics[plot]'``).
+
+Examples
+--------
+>>> import numpy as np
+>>> from dirac.plots import rigid_body_figure, save_png
+>>> t = np.linspace(0.0, 1.0, 3)
+>>> M = np.tile([0.0, 0.0, 1.0], (3, 1))            # steady rotation about axis 3
+>>> fig = rigid_body_figure(t, M, None, [2.0, 1.5, 1.0])
+>>> len(fig.axes)                                  # polhode, M(t), errors (no R given)
+3
+>>> save_png(fig, "steady.png")                     # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+__all__ = [
+    "plot_result",
+    "result_figure",
+    "load_result",
+    "rigid_body_figure",
+    "constrained_figure",
+    "conserved_quantity_errors",
+    "save_png",
+]
+
+_LAZY: dict[str, str] = {
+    "plot_result": "dirac.plots.results",
+    "result_figure": "dirac.plots.results",
+    "load_result": "dirac.plots.results",
+    "rigid_body_figure": "dirac.plots.rigid_body",
+    "conserved_quantity_errors": "dirac.plots.rigid_body",
+    "constrained_figure": "dirac.plots.constrained",
+    "save_png": "dirac.plots.canvas",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'dirac.plots' has no attribute {name!r}")
+    value = getattr(import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

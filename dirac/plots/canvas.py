@@ -1,0 +1,61 @@
+"""Headless figures: matplotlib's object API on the Agg canvas, never pyplot.
+
+No global state is touched (no ``pyplot``, no backend switch), so drawing works on a
+machine without a display and inside programs that use matplotlib themselves.
+matplotlib is imported only when a figure is made: it is an optional dependency
+(``pip install 'dirac-mechanics[plot]'``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from dirac.errors import InputError
+
+__all__ = ["new_figure", "save_png", "check_png_path"]
+
+
+def _require_matplotlib() -> None:
+    try:
+        import matplotlib  # noqa: F401
+    except ModuleNotFoundError as exc:  # pragma: no cover - matplotlib is in the test extra
+        raise InputError(
+            "drawing needs matplotlib, which is not installed: "
+            "pip install 'dirac-mechanics[plot]' (or pip install matplotlib)"
+        ) from exc
+
+
+def new_figure(width: float, height: float) -> Any:
+    """A :class:`matplotlib.figure.Figure` of ``width x height`` inches on an Agg canvas."""
+    _require_matplotlib()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def check_png_path(path: str | Path) -> Path:
+    """Validate the target of a ``--plot FILE.png`` option and return it as a :class:`Path`.
+
+    Raises
+    ------
+    dirac.errors.InputError
+        If the name does not end in ``.png`` or its folder does not exist.
+    """
+    target = Path(path)
+    if target.suffix.lower() != ".png":
+        raise InputError(f"plot file {str(path)!r} must end in .png (for example --plot motion.png)")
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError(f"folder {str(folder)!r} of the plot file {str(path)!r} does not exist: create it first")
+    return target
+
+
+def save_png(fig: Any, path: str | Path, dpi: int = 110) -> Path:
+    """Write ``fig`` as a PNG file and return its path (validated by :func:`check_png_path`)."""
+    target = check_png_path(path)
+    fig.savefig(target, dpi=dpi, format="png")
+    return target

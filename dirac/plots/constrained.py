@@ -1,0 +1,122 @@
+"""Pictures of a general constrained system: path, coordinates, conserved-quantity errors.
+
+For a system with coordinates ``q`` and holonomic constraints ``chi(q) = 0`` (paper (1),
+Sect. X): the path in configuration space (which must stay on the constraint surface),
+the coordinates against time, and the relative energy error together with the
+constraint residual over time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from dirac.errors import InputError
+from dirac.plots.canvas import new_figure
+from dirac.plots.rigid_body import draw_conservation
+
+__all__ = ["draw_configuration", "draw_coordinates", "constrained_errors", "constrained_figure"]
+
+
+def _names(names: Sequence[str] | None, n: int) -> list[str]:
+    if names is not None and len(names) == n:
+        return [str(v) for v in names]
+    return [f"q_{k + 1}" for k in range(n)]
+
+
+def _math(name: str) -> str:
+    """A coordinate name as mathtext (``theta_1`` -> ``$theta_{1}$``)."""
+    base, _, sub = name.partition("_")
+    return f"${base}_{{{sub}}}$" if sub else f"${base}$"
+
+
+def draw_configuration(ax: Any, q: np.ndarray, names: Sequence[str]) -> None:
+    """Draw the path ``q(t)`` in the plane of the first two coordinates (start and end marked)."""
+    ax.plot(q[:, 0], q[:, 1], color="tab:blue", linewidth=1.3, marker="." if q.shape[0] <= 400 else None,
+            markersize=3, label="computed path")
+    ax.plot(q[0, 0], q[0, 1], "o", color="tab:green", markersize=8, markeredgecolor="black", label="$t=0$")
+    ax.plot(q[-1, 0], q[-1, 1], "s", color="tab:red", markersize=7, markeredgecolor="black", label="end")
+    ax.set_xlabel(f"{_math(names[0])} (system units)")
+    ax.set_ylabel(f"{_math(names[1])} (system units)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.set_title("Path in configuration space", fontsize=11)
+    ax.legend(fontsize=8, loc="best")
+
+
+def draw_coordinates(ax: Any, t: np.ndarray, q: np.ndarray, names: Sequence[str]) -> None:
+    """Draw every coordinate ``q_i(t)`` against time."""
+    for k, name in enumerate(names):
+        ax.plot(t, q[:, k], linewidth=1.3, label=_math(name))
+    ax.set_xlabel("time $t$ [s]")
+    ax.set_ylabel("coordinate value (system units)")
+    ax.grid(True, alpha=0.3)
+    ax.set_title("Coordinates over time", fontsize=11)
+    ax.legend(fontsize=8, loc="best", ncol=min(4, len(names)))
+
+
+def constrained_errors(energy: Any | None, constraint_residual: Any | None) -> dict[str, np.ndarray]:
+    """Relative energy error ``|E - E0| / |E0|`` and the constraint residual, by legend label.
+
+    A zero initial energy is measured absolutely (``|E - E0|``) and labelled so.
+    """
+    errors: dict[str, np.ndarray] = {}
+    if energy is not None:
+        E = np.asarray(energy, dtype=float).reshape(-1)
+        scale = abs(E[0])
+        if scale > 0:
+            errors[r"energy $|E-E_0|/|E_0|$"] = np.abs(E - E[0]) / scale
+        else:
+            errors[r"energy $|E-E_0|$ ($E_0=0$)"] = np.abs(E - E[0])
+    if constraint_residual is not None:
+        errors[r"constraint residual $|\chi(q)|$"] = np.abs(np.asarray(constraint_residual, dtype=float).reshape(-1))
+    return errors
+
+
+def constrained_figure(
+    t: Any,
+    q: Any,
+    *,
+    energy: Any | None = None,
+    constraint_residual: Any | None = None,
+    names: Sequence[str] | None = None,
+    title: str | None = None,
+) -> Any:
+    """The three-panel picture of a constrained-system run.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+    q : array_like, shape (n, d)
+        Coordinates at the sample times.
+    energy, constraint_residual : array_like, shape (n,), optional
+        Outputs of the run; drawn as errors over time (:func:`constrained_errors`).
+    names : sequence of str, optional
+        Coordinate names (default ``q_1 … q_d``).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    t = np.asarray(t, dtype=float).reshape(-1)
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 1:
+        q = q[:, None]
+    if q.ndim != 2 or q.shape[0] != t.size or t.size == 0:
+        raise InputError(f"q must have shape ({t.size}, d) to match t; got {q.shape}")
+    labels = _names(names, q.shape[1])
+    errors = constrained_errors(energy, constraint_residual)
+    fig = new_figure(13.0, 9.5)
+    grid = fig.add_gridspec(2, 2)
+    if q.shape[1] >= 2:
+        draw_configuration(fig.add_subplot(grid[0, 0]), q, labels)
+        draw_coordinates(fig.add_subplot(grid[0, 1]), t, q, labels)
+    else:
+        draw_coordinates(fig.add_subplot(grid[0, :]), t, q, labels)
+    if errors:
+        draw_conservation(fig.add_subplot(grid[1, :]), t, errors)
+    fig.suptitle(title or "Constrained system", fontsize=12)
+    return fig
