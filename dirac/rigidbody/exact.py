@@ -44,7 +44,7 @@ from numba import njit
 from dirac.rigidbody.elliptic import (
     agm_sequence,
     carlson_rf,
-    carlson_rj,
+    carlson_rf_rj,
     complete_pi,
     reduced_sncndn,
 )
@@ -58,13 +58,20 @@ def _levi_civita_sign(p1: int, p2: int, p3: int) -> float:
 
 
 def _frame(M: np.ndarray, p3: int) -> np.ndarray:
-    """The rotation ``A(M)`` of the module docstring (rows r1, r2, r3)."""
-    mu = M / np.linalg.norm(M)
-    b = np.zeros(3)
-    b[p3] = 1.0
-    r1 = np.cross(b, mu)
-    r1 /= np.linalg.norm(r1)
-    r2 = np.cross(mu, r1)
+    """The rotation ``A(M)`` of the module docstring (rows ``r1, r2, r3``)."""
+    G = math.sqrt(float(M[0] * M[0] + M[1] * M[1] + M[2] * M[2]))
+    mu = [float(M[0]) / G, float(M[1]) / G, float(M[2]) / G]
+    j, l = (p3 + 1) % 3, (p3 + 2) % 3  # noqa: E741
+    r1 = [0.0, 0.0, 0.0]
+    r1[j] = -mu[l]  # e_p3 x mu for the cyclic triple (p3, j, l)
+    r1[l] = mu[j]
+    rho = math.hypot(r1[j], r1[l])
+    r1 = [x / rho for x in r1]
+    r2 = [
+        mu[1] * r1[2] - mu[2] * r1[1],
+        mu[2] * r1[0] - mu[0] * r1[2],
+        mu[0] * r1[1] - mu[1] * r1[0],
+    ]
     return np.array([r1, r2, mu])
 
 
@@ -267,9 +274,11 @@ def _reduced_jacobi(u, p, em, en):  # noqa: ANN001, ANN202
 @njit(cache=True)
 def _pi_of_reduced(j, sn, cn, dn, n, pi_complete):  # noqa: ANN001, ANN202
     """``Pi(n; am u | m)`` from ``u = 2 j K + w`` and ``sn, cn, dn (w)`` (DLMF 19.25.14)."""
-    value = sn * carlson_rf(cn * cn, dn * dn, 1.0)
-    if n != 0.0:
-        value += n / 3.0 * sn * sn * sn * carlson_rj(cn * cn, dn * dn, 1.0, 1.0 - n * sn * sn)
+    if n == 0.0:
+        value = sn * carlson_rf(cn * cn, dn * dn, 1.0)
+    else:
+        rf, rj = carlson_rf_rj(cn * cn, dn * dn, 1.0, 1.0 - n * sn * sn)
+        value = sn * rf + n / 3.0 * sn * sn * sn * rj
     if j != 0.0:
         value += 2.0 * j * pi_complete
     return value
