@@ -23,7 +23,7 @@ from dirac.ensemble.distributions import Distribution
 __all__ = ["SAMPLING_BLOCK", "STREAMS", "MemberSource", "block_generator", "draw_range", "open_member_file"]
 
 #: Members per sampling block (part of the format: changing it changes every draw).
-SAMPLING_BLOCK = 4096
+SAMPLING_BLOCK = 1024
 
 #: Stream number of each quantity in the spawn key.
 STREAMS = {"M": 0, "R": 1, "inertia": 2}

@@ -1,0 +1,108 @@
+"""The engine: chunkings, local vs dask, retries, resuming, meta."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import zarr
+
+import dirac.ensemble.engine as engine
+from dirac.ensemble.engine import run_ensemble
+from dirac.errors import InputError
+
+
+def _arrays(out) -> dict[str, np.ndarray]:
+    group = zarr.open_group(str(out / "data.zarr"), mode="r")
+    return {name: group[name][:] for name in group.array_keys()}
+
+
+def _assert_identical(a: dict, b: dict) -> None:
+    assert sorted(a) == sorted(b)
+    for name in a:
+        assert a[name].tobytes() == b[name].tobytes(), name  # bit-identical, NaN included
+
+
+def test_two_chunkings_give_bit_identical_results(write_scene, tmp_path):
+    scene = write_scene(count=150)
+    first = run_ensemble(scene, tmp_path / "a", chunk_size=150)
+    second = run_ensemble(scene, tmp_path / "b", chunk_size=31)
+    assert (first.chunks_total, second.chunks_total) == (1, 5)
+    assert first.complete and second.complete
+    a, b = _arrays(tmp_path / "a"), _arrays(tmp_path / "b")
+    _assert_identical(a, b)
+    assert not np.isnan(a["final_M"]).any() and a["M"].shape == (150, 21, 3)
+    meta = json.loads((tmp_path / "b" / "meta.json").read_text())
+    assert meta["complete"] and meta["chunks_complete"] == 5 and meta["chunks_done"] == [[0, 4]]
+    assert meta["count"] == 150 and meta["method"] == "lie-poisson-4" and meta["steps"] == 200
+
+
+def test_dask_local_cluster_gives_the_local_results(write_scene, tmp_path, dask_client):
+    scene = write_scene(count=120)
+    local = run_ensemble(scene, tmp_path / "local", chunk_size=25)
+    remote = run_ensemble(scene, tmp_path / "dask", chunk_size=40, client=dask_client)
+    assert local.complete and remote.complete and remote.chunks_computed == 3
+    _assert_identical(_arrays(tmp_path / "local"), _arrays(tmp_path / "dask"))
+    meta = json.loads((tmp_path / "dask" / "meta.json").read_text())
+    assert meta["runs"][-1]["executor"] == "dask"
+    markers = [json.loads(p.read_text()) for p in sorted((tmp_path / "dask" / "chunks").glob("*.json"))]
+    assert {m["worker"] for m in markers} <= set(dask_client.scheduler_info(n_workers=-1)["workers"])
+
+
+def test_failed_chunk_is_retried_reported_and_recomputed_on_resume(write_scene, tmp_path, monkeypatch):
+    scene = write_scene(count=100)
+    reference = run_ensemble(scene, tmp_path / "ref", chunk_size=20)
+    calls: dict[int, int] = {}
+    real = engine.compute_chunk
+
+    def flaky(scene_, start, stop):
+        calls[start] = calls.get(start, 0) + 1
+        if start == 20 and calls[start] == 1:
+            raise RuntimeError("transient")  # fails once: the retry succeeds
+        if start == 60:
+            raise RuntimeError("always broken")
+        return real(scene_, start, stop)
+
+    monkeypatch.setattr(engine, "compute_chunk", flaky)
+    out = tmp_path / "run"
+    report = run_ensemble(scene, out, chunk_size=20, retries=2)
+    assert calls[20] == 2 and calls[60] == 3
+    assert set(report.failed) == {3} and "always broken" in report.failed[3]
+    assert not report.complete and report.chunks_computed == 4
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["complete"] is False and list(meta["failed_chunks"]) == ["3"]
+    assert meta["chunks_done"] == [[0, 2], [4, 4]]
+    markers = {p.name: p.read_text() for p in (out / "chunks").glob("*.json")}
+
+    monkeypatch.setattr(engine, "compute_chunk", real)
+    again = run_ensemble(scene, out)
+    assert again.complete and again.chunks_computed == 1 and again.chunks_skipped == 4
+    for name, text in markers.items():  # finished chunks were not recomputed
+        assert (out / "chunks" / name).read_text() == text
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["complete"] and meta["failed_chunks"] == {}
+    assert [run["chunks_computed"] for run in meta["runs"]] == [4, 1]
+    _assert_identical(_arrays(tmp_path / "ref"), _arrays(out))
+
+
+def test_resuming_a_different_scene_or_chunk_size_is_refused(write_scene, tmp_path):
+    out = tmp_path / "out"
+    run_ensemble(write_scene(count=30), out, chunk_size=10)
+    with pytest.raises(InputError, match="different scene"):
+        run_ensemble(write_scene("other.toml", count=30, seed=12), out)
+    with pytest.raises(InputError, match="--chunk-size 10"):
+        run_ensemble(write_scene(count=30), out, chunk_size=15)
+    (tmp_path / "busy").mkdir()
+    (tmp_path / "busy" / "notes.txt").write_text("mine")
+    with pytest.raises(InputError, match="not empty"):
+        run_ensemble(write_scene(count=30), tmp_path / "busy")
+
+
+def test_reductions_only_store_no_trajectories(write_scene, tmp_path):
+    scene = write_scene(count=40, outputs="[]", reductions='["flip_time", "max_energy_error"]')
+    report = run_ensemble(scene, tmp_path / "out")
+    assert report.complete
+    arrays = _arrays(tmp_path / "out")
+    assert sorted(arrays) == ["flip_time", "max_energy_error", "t"]
+    assert arrays["max_energy_error"].shape == (40,) and np.all(arrays["max_energy_error"] < 1e-6)
