@@ -107,8 +107,7 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
 
 
 def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, options) -> AutoChoice:  # noqa: ANN001
-    from dirac.flows.lie_poisson import needs_attitude
-    from dirac.rigidbody.exact import ExactRigidBodyFlow
+    from dirac.flows.lie_poisson import exact_flow, needs_attitude
 
     with_R = needs_attitude(outputs)
     exact_cost = samples * (EXACT_SAMPLE_COST if with_R else EXACT_SAMPLE_COST_M)
@@ -120,7 +119,7 @@ def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, 
     numeric = _pilot(name, problem, outputs, span, dt0, options)
     exact_M, exact_R = [], []
     for M0, R0 in zip(problem.M0, problem.R0):
-        M, R = ExactRigidBodyFlow(problem.inertia, M0, R0).state(np.array([span]))
+        M, R = exact_flow(problem.inertia, M0, R0).state(np.array([span]))
         exact_M.append(M[0])
         exact_R.append(R[0].ravel())
     exact_state = np.concatenate(exact_M + (exact_R if with_R else []))

@@ -9,8 +9,8 @@ are eliminated here), the motion is the Dirac-bracket flow (240)
     C_ab = {Phi_a, Phi_b} = grad Phi_a^T J grad Phi_b,
 
 with ``J = [[0, 1], [-1, 0]]``. ``C`` is evaluated and solved numerically at each point
-(never a symbolic inverse); the numba kernel ``dirac_field`` is generated with the system
-(:mod:`dirac.flows.kernel_sources`). Every ``Phi_a`` is an exact invariant of this field
+(never a symbolic inverse); the numba kernel is
+:func:`dirac.flows.constrained_kernels.dirac_field`. Every ``Phi_a`` is an exact invariant of this field
 (``{Phi_a, H}_D = 0`` identically), so quadratic constraints are kept by the implicit
 midpoint rule.
 """
@@ -29,13 +29,16 @@ class ConstrainedField:
         self.mechanics = mechanics
         self.n = mechanics.dimension
         self.m = mechanics.n_constraints
-        self._kernel = mechanics.module.dirac_field
+        from dirac.flows.constrained_kernels import dirac_field
+
+        self._kernel = dirac_field
+        self._functions = mechanics.functions
         self._params = mechanics.params
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """``z_dot`` at ``z = (q, p)`` (shape (2n,))."""
         out = np.empty(2 * self.n)
-        self._kernel(np.ascontiguousarray(z, dtype=float), self._params, self.n, self.m, out)
+        self._kernel(self._functions, np.ascontiguousarray(z, dtype=float), self._params, self.n, self.m, out)
         return out
 
     def scipy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:

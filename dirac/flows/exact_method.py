@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dirac.flows.lie_poisson import needs_attitude, rigid_body_outputs
+from dirac.flows.lie_poisson import exact_flow, needs_attitude, rigid_body_outputs
 from dirac.flows.methods import Method, Stepper, register_method
 
 __all__ = ["ExactStepper"]
@@ -24,12 +24,10 @@ class ExactStepper(Stepper):
 
     def __init__(self, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
         super().__init__()
-        from dirac.rigidbody.exact import ExactRigidBodyFlow
-
         self.problem = problem
         self.outputs = outputs
         self.with_R = needs_attitude(outputs)
-        self.flows = [ExactRigidBodyFlow(problem.inertia, M, R) for M, R in zip(problem.M0, problem.R0)]
+        self.flows = [exact_flow(problem.inertia, M, R) for M, R in zip(problem.M0, problem.R0)]
 
     def warm_up(self) -> None:
         flow = self.flows[0]

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from dirac.flows.lie_poisson import RigidBodyStepper
+from dirac.flows.lie_poisson import RigidBodyStepper, exact_flow
 from dirac.flows.methods import Method, Stepper, register_method
 from dirac.rigidbody.splitting import advance_sequence
 
@@ -97,11 +97,7 @@ class ExactKickStepper(RigidBodyStepper):
         self.w = np.asarray(problem.weight_vector, dtype=float)
 
     def _free(self, b: int, tau: float) -> None:
-        from dirac.rigidbody.exact import ExactRigidBodyFlow
-
-        R = self.R[b]
-        # re-orthonormalise against round-off accumulated by the kicks' callers (none here)
-        flow = ExactRigidBodyFlow(self.inertia, self.M[b].copy(), R.copy())
+        flow = exact_flow(self.inertia, self.M[b].copy(), self.R[b].copy())
         M1, R1 = flow.state(np.array([tau]))
         self.M[b] = M1[0]
         self.R[b] = R1[0]
@@ -111,9 +107,7 @@ class ExactKickStepper(RigidBodyStepper):
         self.M[b] += tau * np.cross(gamma, self.w)
 
     def warm_up(self) -> None:
-        from dirac.rigidbody.exact import ExactRigidBodyFlow
-
-        ExactRigidBodyFlow(self.inertia, self.M[0], self.R[0]).state(np.array([1e-3]))
+        exact_flow(self.inertia, self.M[0], self.R[0]).state(np.array([1e-3]))
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):

@@ -189,6 +189,8 @@ def integrate(
     }
     stepper = method_object.start(problem, chosen_outputs, options)
     stepper.warm_up()
+    if stepper.kind != "exact":
+        stepper.observe()  # compiles what the outputs need before the timed loop
     return _Loop(problem, method_object, stepper, chosen_outputs, t_end, samples, dt, progress, drift_limit, extra).run()
 
 

@@ -15,7 +15,19 @@ import numpy as np
 
 from dirac.flows.methods import Method, Stepper, register_method
 
-__all__ = ["RigidBodyStepper", "LiePoissonStepper", "needs_attitude"]
+__all__ = ["RigidBodyStepper", "LiePoissonStepper", "needs_attitude", "exact_flow"]
+
+
+def exact_flow(inertia, M0, R0):  # noqa: ANN001, ANN201
+    """:class:`ExactRigidBodyFlow` of already validated data (its warnings were shown once)."""
+    import warnings
+
+    from dirac.errors import DiracWarning
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DiracWarning)
+        return ExactRigidBodyFlow(inertia, M0, R0)
 
 
 def needs_attitude(outputs: tuple[str, ...]) -> bool:

@@ -33,10 +33,12 @@ __all__ = ["MechanicalSystem"]
 class MechanicalSystem:
     """Numerical pieces of a natural mechanical system with holonomic constraints.
 
-    Build it with :meth:`from_lagrangian`. Generated numba functions (``f(q, params, out)``,
-    coordinates in :attr:`coordinate_names` order): ``mass`` (n, n), ``grad_potential``
-    (n,), ``potential`` (1,), ``constraints`` (m,), ``constraint_jacobian`` (m, n),
-    ``mass_derivative`` (n, n, n) with ``[k, i, j] = dM_ij/dq_k``.
+    Build it with :meth:`from_lagrangian`. Generated numba functions (``f(q, params, out)``
+    with a flat ``out``, coordinates in :attr:`coordinate_names` order): ``mass`` (n, n),
+    ``grad_potential`` (n,), ``potential`` (1,), ``constraints`` (m,),
+    ``constraint_jacobian`` (m, n), ``mass_derivative`` (n, n, n) with
+    ``[k, i, j] = dM_ij/dq_k``, ``constraint_hessian`` (m, n, n); :attr:`functions` is the
+    tuple handed to the kernels of :mod:`dirac.flows.constrained_kernels`.
 
     Attributes
     ----------
@@ -60,6 +62,7 @@ class MechanicalSystem:
     params: np.ndarray
     constant_mass: np.ndarray | None
     module: object
+    functions: tuple = field(repr=False, default=())
     symbolic: dict[str, object] = field(repr=False, default_factory=dict)
 
     # ------------------------------------------------------------------ building
@@ -141,15 +144,15 @@ class MechanicalSystem:
             ),
             GeneratedFunction("constraint_hessian", args, hessians, "d2 chi_a/dq_k dq_j as [a, k, j], (m, n, n)"),
         ]
-        from dirac.flows.kernel_sources import SOURCE
+        from dirac.flows import constrained_kernels
 
-        module = generate_module(
-            functions, parameter_symbols, SOURCE + extra_source, title=f"system {lagrangian.name}"
-        )
+        module = generate_module(functions, parameter_symbols, extra_source, title=f"system {lagrangian.name}")
+        functions_tuple = tuple(getattr(module, name) for name in constrained_kernels.FUNCTION_NAMES)
         constant_mass = None
         if constant:
-            constant_mass = np.empty((n, n))
-            module.mass(np.zeros(n), param_array, constant_mass)
+            flat = np.empty(n * n)
+            constrained_kernels.evaluate(module.mass, np.zeros(n), param_array, flat)
+            constant_mass = flat.reshape(n, n)
         system = cls(
             name=lagrangian.name,
             coordinate_names=tuple(s.name for s in q),
@@ -159,19 +162,26 @@ class MechanicalSystem:
             params=param_array,
             constant_mass=constant_mass,
             module=module,
+            functions=functions_tuple,
             symbolic={"mass": mass, "potential": potential, "constraints": chis, "coordinates": q,
                       "parameters": parameter_symbols},
         )
         return system
 
     # ------------------------------------------------------------------ numerics (numpy side)
+    def _call(self, name: str, q: np.ndarray, size: int) -> np.ndarray:
+        from dirac.flows.constrained_kernels import evaluate
+
+        out = np.empty(size)
+        evaluate(getattr(self.module, name), np.ascontiguousarray(q, dtype=float), self.params, out)
+        return out
+
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """``M(q)``, checked to be symmetric positive definite."""
         if self.constant_mass is not None:
             matrix = self.constant_mass.copy()
         else:
-            matrix = np.empty((self.dimension, self.dimension))
-            self.module.mass(np.asarray(q, dtype=float), self.params, matrix)  # type: ignore[attr-defined]
+            matrix = self._call("mass", q, self.dimension * self.dimension).reshape(self.dimension, self.dimension)
         eigenvalues = np.linalg.eigvalsh(matrix)
         if not np.all(np.isfinite(eigenvalues)) or eigenvalues.min() <= 1e-14 * max(1.0, eigenvalues.max()):
             raise InputError(
@@ -182,19 +192,16 @@ class MechanicalSystem:
 
     def energy(self, q: np.ndarray, p: np.ndarray) -> float:
         """``H = 1/2 p^T M(q)^{-1} p + V(q)``."""
-        out = np.empty(1)
-        self.module.potential(np.asarray(q, dtype=float), self.params, out)  # type: ignore[attr-defined]
-        return float(0.5 * p @ np.linalg.solve(self.mass_matrix(q), p) + out[0])
+        potential = self._call("potential", q, 1)[0]
+        return float(0.5 * p @ np.linalg.solve(self.mass_matrix(q), p) + potential)
 
     def residuals(self, q: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Position residuals ``chi(q)`` and velocity residuals ``G(q) M(q)^{-1} p``."""
         m = self.n_constraints
         if m == 0:
             return np.zeros(0), np.zeros(0)
-        chi = np.empty(m)
-        G = np.empty((m, self.dimension))
-        self.module.constraints(np.asarray(q, dtype=float), self.params, chi)  # type: ignore[attr-defined]
-        self.module.constraint_jacobian(np.asarray(q, dtype=float), self.params, G)  # type: ignore[attr-defined]
+        chi = self._call("constraints", q, m)
+        G = self._call("constraint_jacobian", q, m * self.dimension).reshape(m, self.dimension)
         return chi, G @ np.linalg.solve(self.mass_matrix(q), p)
 
     def constraint_residual(self, q: np.ndarray, p: np.ndarray) -> float:
@@ -220,13 +227,12 @@ class MechanicalSystem:
         m = self.n_constraints
         if m == 0:
             return q, p
-        chi = np.empty(m)
-        G = np.empty((m, self.dimension))
+        shape = (m, self.dimension)
         for _ in range(max_iter):
-            self.module.constraints(q, self.params, chi)  # type: ignore[attr-defined]
+            chi = self._call("constraints", q, m)
             if np.max(np.abs(chi)) <= tol * (1.0 + q @ q):
                 break
-            self.module.constraint_jacobian(q, self.params, G)  # type: ignore[attr-defined]
+            G = self._call("constraint_jacobian", q, m * self.dimension).reshape(shape)
             A = np.linalg.solve(self.mass_matrix(q), G.T)
             q = q - A @ np.linalg.solve(G @ A, chi)
         else:
@@ -234,7 +240,7 @@ class MechanicalSystem:
                 f"could not project the initial q onto the constraints of {self.name!r} "
                 f"(residual {np.max(np.abs(chi)):.3g}): give q closer to the surface"
             )
-        self.module.constraint_jacobian(q, self.params, G)  # type: ignore[attr-defined]
+        G = self._call("constraint_jacobian", q, m * self.dimension).reshape(shape)
         A = np.linalg.solve(self.mass_matrix(q), G.T)
         p = p - G.T @ np.linalg.solve(G @ A, G @ np.linalg.solve(self.mass_matrix(q), p))
         return q, p

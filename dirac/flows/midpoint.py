@@ -30,6 +30,19 @@ __all__ = ["midpoint_rigid_body"]
 
 
 @njit(cache=True)
+def _solve3(J, r):  # noqa: ANN001, ANN202
+    """Solve the 3 x 3 system J d = r by Cramer's rule."""
+    c00 = J[1, 1] * J[2, 2] - J[1, 2] * J[2, 1]
+    c01 = J[1, 2] * J[2, 0] - J[1, 0] * J[2, 2]
+    c02 = J[1, 0] * J[2, 1] - J[1, 1] * J[2, 0]
+    det = J[0, 0] * c00 + J[0, 1] * c01 + J[0, 2] * c02
+    d0 = (r[0] * c00 + J[0, 1] * (r[2] * J[1, 2] - r[1] * J[2, 2]) + J[0, 2] * (r[1] * J[2, 1] - r[2] * J[1, 1])) / det
+    d1 = (J[0, 0] * (r[1] * J[2, 2] - r[2] * J[1, 2]) + r[0] * c01 + J[0, 2] * (r[2] * J[1, 0] - r[1] * J[2, 0])) / det
+    d2 = (J[0, 0] * (J[1, 1] * r[2] - J[2, 1] * r[1]) + J[0, 1] * (J[2, 0] * r[1] - J[1, 0] * r[2]) + r[0] * c02) / det
+    return d0, d1, d2
+
+
+@njit(cache=True)
 def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, info):  # noqa: ANN001, N803, PLR0913
     """Advance ``(M, R)`` in place by ``n_steps`` implicit-midpoint steps (Euler–Poisson).
 
@@ -72,11 +85,11 @@ def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, i
             J[2, 0] = -hh * (-m1 * a0 + w1)
             J[2, 1] = -hh * (m0 * a1 - w0)
             J[2, 2] = 1.0
-            d = np.linalg.solve(J, r)
-            m0 -= d[0]
-            m1 -= d[1]
-            m2 -= d[2]
-            size = max(abs(d[0]), abs(d[1]), abs(d[2]))
+            d0, d1, d2 = _solve3(J, r)
+            m0 -= d0
+            m1 -= d1
+            m2 -= d2
+            size = max(abs(d0), abs(d1), abs(d2))
             scale = max(1e-300, math.sqrt(m0 * m0 + m1 * m1 + m2 * m2))
             if size <= tol * scale:
                 converged = True
@@ -100,13 +113,26 @@ def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, i
             # (1 - B)^{-1} = (1 + B + b b^T) / (1 + |b|^2)   for skew B = hat(b)
             nb = 1.0 + b0 * b0 + b1 * b1 + b2 * b2
             # Cayley: cay = 1 + 2 (B + B^2) / (1 + |b|^2)
-            B = np.array([[0.0, -b2, b1], [b2, 0.0, -b0], [-b1, b0, 0.0]])
-            B2 = B @ B
-            C = np.eye(3) + 2.0 * (B + B2) / nb
-            Rn = R @ C
+            B = np.zeros((3, 3))
+            B[0, 1] = -b2
+            B[0, 2] = b1
+            B[1, 0] = b2
+            B[1, 2] = -b0
+            B[2, 0] = -b1
+            B[2, 1] = b0
+            C = np.zeros((3, 3))
             for i in range(3):
                 for j in range(3):
-                    R[i, j] = Rn[i, j]
+                    acc = 0.0
+                    for k in range(3):
+                        acc += B[i, k] * B[k, j]
+                    C[i, j] = (1.0 if i == j else 0.0) + 2.0 * (B[i, j] + acc) / nb
+            for i in range(3):
+                r0 = R[i, 0]
+                r1 = R[i, 1]
+                r2 = R[i, 2]
+                for j in range(3):
+                    R[i, j] = r0 * C[0, j] + r1 * C[1, j] + r2 * C[2, j]
     info[0] = n_steps
     info[1] = 0.0
     info[2] = evals
@@ -146,7 +172,9 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         for q in self.q:
             self.mechanics.mass_matrix(q)
         self.z = np.ascontiguousarray(np.concatenate([self.q, self.p], axis=1))
-        self._kernel = self.mechanics.module.midpoint_run
+        from dirac.flows import constrained_kernels
+
+        self._kernel = constrained_kernels.midpoint_run
 
     def _sync(self) -> None:
         n = self.mechanics.dimension
@@ -155,13 +183,13 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
 
     def warm_up(self) -> None:
         n, m = self.mechanics.dimension, self.mechanics.n_constraints
-        self._kernel(self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
+        self._kernel(self.mechanics.functions, self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
         self._sync()
 
     def step(self, n_steps: int, dt: float) -> None:
         n, m = self.mechanics.dimension, self.mechanics.n_constraints
         for b in range(self.z.shape[0]):
-            self._kernel(self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
+            self._kernel(self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
             self._sync()
             self._raise_if_failed("midpoint")

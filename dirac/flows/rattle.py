@@ -9,7 +9,7 @@ Kahan–Li) raise its order to 4, 6, 8 (``rattle-4`` ...), with the coefficients
 
 With a constant mass matrix (Cartesian coordinates) the Newton iteration runs on the
 ``m`` multipliers only; otherwise on ``(p_half, q1, lambda)`` (Jay 1996). Both step loops
-are numba code compiled with the system (:mod:`dirac.flows.kernel_sources`). A step whose
+are numba kernels compiled once (:mod:`dirac.flows.constrained_kernels`). A step whose
 Newton iteration does not converge within ``max_newton_iterations`` stops the run with
 the state of the last completed step.
 """
@@ -63,24 +63,26 @@ class RattleStepper(ConstrainedStepper):
         super().__init__(problem, outputs, options)
         self.name = method.name
         self.fractions = np.asarray(method.data, dtype=float)
-        module = self.mechanics.module
+        from dirac.flows import constrained_kernels as kernels
+
         self.constant = self.mechanics.constant_mass is not None
         if self.constant:
             self.mechanics.mass_matrix(self.q[0])  # checks positivity
             self.minv = np.linalg.inv(self.mechanics.constant_mass)
-            self._kernel = module.rattle_constant_mass
+            self._kernel = kernels.rattle_constant_mass
         else:
             for q in self.q:
                 self.mechanics.mass_matrix(q)
-            self._kernel = module.rattle_general
+            self._kernel = kernels.rattle_general
 
     def _call(self, q: np.ndarray, p: np.ndarray, n_steps: int, dt: float) -> None:
         m = self.mechanics.n_constraints
         params = self.mechanics.params
+        fns = self.mechanics.functions
         if self.constant:
-            self._kernel(q, p, self.minv, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
+            self._kernel(fns, q, p, self.minv, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
         else:
-            self._kernel(q, p, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
+            self._kernel(fns, q, p, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
 
     def warm_up(self) -> None:
         self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6)

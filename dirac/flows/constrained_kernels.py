@@ -1,10 +1,11 @@
-"""numba source of the step loops of general systems, compiled together with the
-generated functions of each system (:mod:`dirac.flows.codegen`).
+"""Step loops of general constrained systems (numba, compiled once per machine).
 
-The loops call the generated functions ``mass``, ``mass_derivative``, ``potential``,
-``grad_potential``, ``constraints``, ``constraint_jacobian`` and ``constraint_hessian``
-by name, so the text below is appended to each system's generated module and the whole
-step loop compiles (and is cached on disk) as one unit: no Python call per step.
+The system-specific pieces -- ``mass``, ``mass_derivative``, ``potential``,
+``grad_potential``, ``constraints``, ``constraint_jacobian``, ``constraint_hessian`` --
+are generated per system by :mod:`dirac.flows.codegen` as ``numba.cfunc`` objects of the
+one signature ``void(float64[::1] x, float64[::1] params, float64[::1] out)`` and handed to
+these kernels as a tuple ``fns`` of first-class functions (indices ``MASS`` ...). The
+kernels therefore compile once and are cached on disk for every system.
 
 Notation: ``n`` coordinates, ``m`` holonomic constraints ``chi(q) = 0`` with Jacobian
 ``G = dchi/dq``; ``H = 1/2 p^T M(q)^{-1} p + V(q)``, ``v = M^{-1} p = dH/dp``,
@@ -14,26 +15,131 @@ Notation: ``n`` coordinates, ``m`` holonomic constraints ``chi(q) = 0`` with Jac
 last_residual]``.
 """
 
-SOURCE = r'''
+import warnings
+
+import numba
+import numpy as np
+
+try:  # first-class function types are flagged experimental by numba; they are what we need
+    from numba.core.errors import NumbaExperimentalFeatureWarning
+
+    warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+except ImportError:  # pragma: no cover
+    pass
+
+MASS = 0
+MASS_DERIVATIVE = 1
+POTENTIAL = 2
+GRAD_POTENTIAL = 3
+CONSTRAINTS = 4
+CONSTRAINT_JACOBIAN = 5
+CONSTRAINT_HESSIAN = 6
+FUNCTION_NAMES = ("mass", "mass_derivative", "potential", "grad_potential", "constraints",
+                  "constraint_jacobian", "constraint_hessian")
+
+
+@numba.njit(cache=True)
+def evaluate(f, x, params, out):
+    """Call a generated function from Python: ``f(x, params, out)``."""
+    f(x, params, out)
+
+
+@numba.njit(cache=True)
+def _mass(fns, q, params, n):
+    out = np.empty(n * n)
+    fns[MASS](q, params, out)
+    return out.reshape((n, n))
+
+
+@numba.njit(cache=True)
+def _mass_derivative(fns, q, params, n):
+    out = np.empty(n * n * n)
+    fns[MASS_DERIVATIVE](q, params, out)
+    return out.reshape((n, n, n))
+
+
+@numba.njit(cache=True)
+def _jacobian(fns, q, params, m, n):
+    out = np.empty(m * n)
+    if m > 0:
+        fns[CONSTRAINT_JACOBIAN](q, params, out)
+    return out.reshape((m, n))
+
+
+@numba.njit(cache=True)
+def _hessian(fns, q, params, m, n):
+    out = np.empty(m * n * n)
+    if m > 0:
+        fns[CONSTRAINT_HESSIAN](q, params, out)
+    return out.reshape((m, n, n))
+
+
 # ---------------------------------------------------------------- shared helpers
 @numba.njit(cache=True)
-def _velocity(q, p, params, v):
+def _solve(A, b):
+    """Solve A x = b (b 1-D or 2-D) by Gaussian elimination with partial pivoting.
+    Small dense systems only; avoids compiling LAPACK bindings into every system module."""
+    n = A.shape[0]
+    M = A.copy()
+    if b.ndim == 1:
+        X = b.copy().reshape((n, 1))
+    else:
+        X = b.copy()
+    k = X.shape[1]
+    for c in range(n):
+        piv = c
+        best = abs(M[c, c])
+        for r in range(c + 1, n):
+            if abs(M[r, c]) > best:
+                best = abs(M[r, c])
+                piv = r
+        if piv != c:
+            for j in range(n):
+                tmp = M[c, j]
+                M[c, j] = M[piv, j]
+                M[piv, j] = tmp
+            for j in range(k):
+                tmp = X[c, j]
+                X[c, j] = X[piv, j]
+                X[piv, j] = tmp
+        d = M[c, c]
+        for r in range(c + 1, n):
+            f = M[r, c] / d
+            if f != 0.0:
+                for j in range(c, n):
+                    M[r, j] -= f * M[c, j]
+                for j in range(k):
+                    X[r, j] -= f * X[c, j]
+    for c in range(n - 1, -1, -1):
+        for j in range(k):
+            acc = X[c, j]
+            for r in range(c + 1, n):
+                acc -= M[c, r] * X[r, j]
+            X[c, j] = acc / M[c, c]
+    return X
+
+
+@numba.njit(cache=True)
+def _solve_vec(A, b):
+    return _solve(A, b.reshape((b.shape[0], 1)))[:, 0].copy()
+
+
+@numba.njit(cache=True)
+def _velocity(fns, q, p, params, v):
     """v = M(q)^{-1} p."""
     n = q.shape[0]
-    mm = np.empty((n, n))
-    mass(q, params, mm)
-    sol = np.linalg.solve(mm, p)
+    mm = _mass(fns, q, params, n)
+    sol = _solve_vec(mm, p)
     for i in range(n):
         v[i] = sol[i]
 
 
 @numba.njit(cache=True)
-def _force(q, v, params, f):
+def _force(fns, q, v, params, f):
     """f = dH/dq = dV/dq - 1/2 v^T dM/dq_k v."""
     n = q.shape[0]
-    grad_potential(q, params, f)
-    dm = np.empty((n, n, n))
-    mass_derivative(q, params, dm)
+    fns[GRAD_POTENTIAL](q, params, f)
+    dm = _mass_derivative(fns, q, params, n)
     for k in range(n):
         s = 0.0
         for i in range(n):
@@ -62,7 +168,7 @@ def _max_abs(x):
 
 # ---------------------------------------------------------------- RATTLE, constant mass
 @numba.njit(cache=True)
-def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max_iter, info):
+def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol, max_iter, info):
     """RATTLE (Andersen 1983; Hairer, Lubich & Wanner VII.1.4) with constant M.
 
     p_half = p - h/2 (grad V(q) + G(q)^T lam),  q1 = q + h M^{-1} p_half,  chi(q1) = 0,
@@ -89,7 +195,7 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
         p_save[:] = p
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
-            grad_potential(q, params, gv)
+            fns[GRAD_POTENTIAL](q, params, gv)
             evals += 1.0
             for i in range(n):
                 ph[i] = p[i] - 0.5 * h * gv[i]
@@ -99,7 +205,7 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
                     acc += minv[i, j] * ph[j]
                 qp[i] = q[i] + h * acc
             if m > 0:
-                constraint_jacobian(q, params, G0)
+                G0[:, :] = _jacobian(fns, q, params, m, n)
                 for i in range(n):
                     for a in range(m):
                         acc = 0.0
@@ -111,7 +217,7 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
                 q1[:] = qp
                 converged = False
                 for it in range(max_iter):
-                    constraints(q1, params, chi)
+                    fns[CONSTRAINTS](q1, params, chi)
                     evals += 1.0
                     residual = _max_abs(chi)
                     if residual <= tol * _scale(q1):
@@ -119,7 +225,7 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
                         break
                     if residual != residual:
                         break
-                    constraint_jacobian(q1, params, G1)
+                    G1[:, :] = _jacobian(fns, q1, params, m, n)
                     J = np.empty((m, m))
                     for a in range(m):
                         for b in range(m):
@@ -127,7 +233,7 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
                             for i in range(n):
                                 acc += G1[a, i] * A[i, b]
                             J[a, b] = -0.5 * h * h * acc
-                    d = np.linalg.solve(J, chi)
+                    d = _solve_vec(J, chi)
                     for a in range(m):
                         lam[a] -= d[a]
                     for i in range(n):
@@ -151,12 +257,12 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
                 q[:] = q1
             else:
                 q[:] = qp
-            grad_potential(q, params, gv)
+            fns[GRAD_POTENTIAL](q, params, gv)
             evals += 1.0
             for i in range(n):
                 p[i] = ph[i] - 0.5 * h * gv[i]
             if m > 0:
-                constraint_jacobian(q, params, G1)
+                G1[:, :] = _jacobian(fns, q, params, m, n)
                 for i in range(n):
                     for a in range(m):
                         acc = 0.0
@@ -175,7 +281,7 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
                     for i in range(n):
                         acc += A[i, a] * p[i]
                     rhs[a] = acc
-                mu = np.linalg.solve(S, rhs)
+                mu = _solve_vec(S, rhs)
                 for i in range(n):
                     acc = 0.0
                     for a in range(m):
@@ -189,34 +295,32 @@ def rattle_constant_mass(q, p, minv, params, m, fractions, dt, n_steps, tol, max
 
 # ---------------------------------------------------------------- RATTLE, general mass
 @numba.njit(cache=True)
-def _rattle_residual(x, q, p, h, params, n, m, r):
-    ph = x[:n]
-    q1 = x[n:2 * n]
+def _rattle_residual(fns, x, q, p, h, params, n, m, r):
+    ph = x[:n].copy()
+    q1 = x[n:2 * n].copy()
     v0 = np.empty(n)
     f0 = np.empty(n)
     v1 = np.empty(n)
-    _velocity(q, ph, params, v0)
-    _force(q, v0, params, f0)
-    G0 = np.zeros((m, n))
-    if m > 0:
-        constraint_jacobian(q, params, G0)
+    _velocity(fns, q, ph, params, v0)
+    _force(fns, q, v0, params, f0)
+    G0 = _jacobian(fns, q, params, m, n)
     for i in range(n):
         acc = 0.0
         for a in range(m):
             acc += G0[a, i] * x[2 * n + a]
         r[i] = ph[i] - p[i] + 0.5 * h * (f0[i] + acc)
-    _velocity(q1, ph, params, v1)
+    _velocity(fns, q1, ph, params, v1)
     for i in range(n):
         r[n + i] = q1[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
     if m > 0:
         chi = np.empty(m)
-        constraints(q1, params, chi)
+        fns[CONSTRAINTS](q1, params, chi)
         for a in range(m):
             r[2 * n + a] = chi[a]
 
 
 @numba.njit(cache=True)
-def rattle_general(q, p, params, m, fractions, dt, n_steps, tol, max_iter, info):
+def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, info):
     """RATTLE for H = 1/2 p^T M(q)^{-1} p + V(q) (Jay 1996; Hairer, Lubich & Wanner
     VII.1.4, eq. (1.26)):
 
@@ -245,28 +349,28 @@ def rattle_general(q, p, params, m, fractions, dt, n_steps, tol, max_iter, info)
         p_save[:] = p
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
-            _velocity(q, p, params, v)
+            _velocity(fns, q, p, params, v)
             for i in range(n):
                 x[i] = p[i]
                 x[n + i] = q[i] + h * v[i]
             for a in range(m):
                 x[2 * n + a] = 0.0
-            _rattle_residual(x, q, p, h, params, n, m, r)
+            _rattle_residual(fns, x, q, p, h, params, n, m, r)
             evals += 1.0
             for j in range(N):
                 xx[:] = x
                 d = 1e-7 * (1.0 + abs(x[j]))
                 xx[j] += d
-                _rattle_residual(xx, q, p, h, params, n, m, rr)
+                _rattle_residual(fns, xx, q, p, h, params, n, m, rr)
                 for i in range(N):
                     J[i, j] = (rr[i] - r[i]) / d
             evals += N
             converged = False
             for it in range(max_iter):
-                delta = np.linalg.solve(J, r)
+                delta = _solve_vec(J, r)
                 for i in range(N):
                     x[i] -= delta[i]
-                _rattle_residual(x, q, p, h, params, n, m, r)
+                _rattle_residual(fns, x, q, p, h, params, n, m, r)
                 evals += 1.0
                 residual = _max_abs(r)
                 if residual <= tol * _scale(x[:2 * n]):
@@ -284,18 +388,16 @@ def rattle_general(q, p, params, m, fractions, dt, n_steps, tol, max_iter, info)
                 return
             ph = x[:n].copy()
             q[:] = x[n:2 * n]
-            _velocity(q, ph, params, v)
-            _force(q, v, params, f)
+            _velocity(fns, q, ph, params, v)
+            _force(fns, q, v, params, f)
             evals += 1.0
             for i in range(n):
                 p[i] = ph[i] - 0.5 * h * f[i]
             if m > 0:
-                G1 = np.empty((m, n))
-                constraint_jacobian(q, params, G1)
-                mm = np.empty((n, n))
-                mass(q, params, mm)
-                W = np.linalg.solve(mm, np.ascontiguousarray(G1.T))
-                u = np.linalg.solve(mm, p)
+                G1 = _jacobian(fns, q, params, m, n)
+                mm = _mass(fns, q, params, n)
+                W = _solve(mm, np.ascontiguousarray(G1.T))
+                u = _solve_vec(mm, p)
                 S = np.empty((m, m))
                 rhs = np.empty(m)
                 for a in range(m):
@@ -308,7 +410,7 @@ def rattle_general(q, p, params, m, fractions, dt, n_steps, tol, max_iter, info)
                         for i in range(n):
                             acc += G1[a, i] * W[i, b]
                         S[a, b] = 0.5 * h * acc
-                mu = np.linalg.solve(S, rhs)
+                mu = _solve_vec(S, rhs)
                 for i in range(n):
                     acc = 0.0
                     for a in range(m):
@@ -322,32 +424,28 @@ def rattle_general(q, p, params, m, fractions, dt, n_steps, tol, max_iter, info)
 
 # ---------------------------------------------------------------- Dirac vector field
 @numba.njit(cache=True)
-def dirac_field(z, params, n, m, out):
+def dirac_field(fns, z, params, n, m, out):
     """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H), C = grad Phi J grad Phi^T,
     on z = (q, p) with the second-class constraints Phi = (chi(q), G(q) M(q)^{-1} p)
     (the paper's second and third stages; Dirac bracket (240)). C is evaluated and
     solved numerically at z.
     """
-    q = z[:n]
-    p = z[n:2 * n]
+    q = z[:n].copy()
+    p = z[n:2 * n].copy()
     v = np.empty(n)
     f = np.empty(n)
-    _velocity(q, p, params, v)
-    _force(q, v, params, f)
+    _velocity(fns, q, p, params, v)
+    _force(fns, q, v, params, f)
     for i in range(n):
         out[i] = v[i]
         out[n + i] = -f[i]
     if m == 0:
         return
-    G = np.empty((m, n))
-    constraint_jacobian(q, params, G)
-    hc = np.empty((m, n, n))
-    constraint_hessian(q, params, hc)
-    mm = np.empty((n, n))
-    mass(q, params, mm)
-    W = np.linalg.solve(mm, np.ascontiguousarray(G.T))  # (n, m) = M^{-1} G^T
-    dm = np.empty((n, n, n))
-    mass_derivative(q, params, dm)
+    G = _jacobian(fns, q, params, m, n)
+    hc = _hessian(fns, q, params, m, n)
+    mm = _mass(fns, q, params, n)
+    W = _solve(mm, np.ascontiguousarray(G.T))  # (n, m) = M^{-1} G^T
+    dm = _mass_derivative(fns, q, params, n)
     D = np.zeros((2 * m, 2 * n))
     for a in range(m):
         for k in range(n):
@@ -373,7 +471,7 @@ def dirac_field(z, params, n, m, out):
             for k in range(n):
                 c += D[a, k] * D[b, n + k] - D[a, n + k] * D[b, k]
             C[a, b] = c
-    mu = np.linalg.solve(C, rhs)
+    mu = _solve_vec(C, rhs)
     for b in range(2 * m):
         for k in range(n):
             out[k] -= mu[b] * D[b, n + k]
@@ -381,7 +479,7 @@ def dirac_field(z, params, n, m, out):
 
 
 @numba.njit(cache=True)
-def midpoint_run(z, params, n, m, dt, n_steps, tol, max_iter, info):
+def midpoint_run(fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
     """Implicit midpoint z1 = z0 + dt F((z0 + z1)/2) on the Dirac vector field F;
     simplified Newton with a finite-difference Jacobian of F at z0 per step."""
     N = 2 * n
@@ -395,13 +493,13 @@ def midpoint_run(z, params, n, m, dt, n_steps, tol, max_iter, info):
     evals = 0.0
     size = 0.0
     for step in range(n_steps):
-        dirac_field(z, params, n, m, f)
+        dirac_field(fns, z, params, n, m, f)
         evals += 1.0
         for j in range(N):
             zz[:] = z
             d = 1e-7 * (1.0 + abs(z[j]))
             zz[j] += d
-            dirac_field(zz, params, n, m, fz)
+            dirac_field(fns, zz, params, n, m, fz)
             for i in range(N):
                 J[i, j] = -0.5 * dt * (fz[i] - f[i]) / d
             J[j, j] += 1.0
@@ -412,11 +510,11 @@ def midpoint_run(z, params, n, m, dt, n_steps, tol, max_iter, info):
         for it in range(max_iter):
             for i in range(N):
                 zm[i] = 0.5 * (z[i] + z1[i])
-            dirac_field(zm, params, n, m, fz)
+            dirac_field(fns, zm, params, n, m, fz)
             evals += 1.0
             for i in range(N):
                 r[i] = z1[i] - z[i] - dt * fz[i]
-            delta = np.linalg.solve(J, r)
+            delta = _solve_vec(J, r)
             size = 0.0
             scale = 1.0
             for i in range(N):
@@ -441,4 +539,3 @@ def midpoint_run(z, params, n, m, dt, n_steps, tol, max_iter, info):
     info[1] = 0.0
     info[2] = evals
     info[3] = size
-'''
