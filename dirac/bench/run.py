@@ -1,0 +1,94 @@
+"""``dirac bench`` end to end: work–precision suite, targets, table, JSON and plot."""
+
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+from collections.abc import Callable
+
+__all__ = ["run_benchmark"]
+
+
+def _progress(enabled: bool) -> Callable[[str], None]:
+    start = time.perf_counter()
+
+    def report(message: str) -> None:
+        if enabled:
+            print(f"[{time.perf_counter() - start:6.1f} s] {message}", file=sys.stderr, flush=True)
+
+    return report
+
+
+def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | None = None,
+                  progress: bool = True, targets: bool = True) -> dict:
+    """Run the benchmark and print its report on stdout; return the JSON document.
+
+    Parameters
+    ----------
+    quick : bool
+        Smaller grid and sizes (under a minute); otherwise the full run (under ten).
+    json_path, plot_path : str, optional
+        Where to write the JSON rows and the work–precision plot.
+    progress : bool
+        Progress lines on stderr.
+    targets : bool
+        Also measure the kernel/batch/start-up targets (the tests switch them off).
+    """
+    from dirac.bench.report import format_rows, format_targets, machine_description, machine_line, write_json
+    from dirac.bench.suite import constrained_cases, rigid_body_cases
+    from dirac.bench.workprecision import run_constrained_case, run_rigid_body_case
+
+    say = _progress(progress)
+    started = time.perf_counter()
+    machine = machine_description()
+    repeats = 3 if quick else 7
+    rows: list[dict] = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # e.g. the standard body's inertia warning, once per run
+        for case in rigid_body_cases(quick):
+            rows += run_rigid_body_case(case, repeats, say)
+        for case in constrained_cases(quick):
+            try:
+                rows += run_constrained_case(case, repeats, say)
+            except Exception as exc:  # a system that cannot be built is reported, not fatal
+                rows.append({"problem": case.name, "method": "-", "parameter": "", "value": None, "t_end": 0.0,
+                             "failed": f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}"})
+    measured, notes = ([], [])
+    if targets:
+        from dirac.bench.targets import measure_targets
+
+        measured, notes = measure_targets(quick, rows, say)
+    else:
+        from dirac.bench.targets import work_precision_targets
+
+        measured = work_precision_targets(rows)
+    elapsed = time.perf_counter() - started
+    command = "dirac bench" + (" --quick" if quick else "")
+    print(f"{command}: work-precision against scipy baselines, every figure measured in this run")
+    print(f"machine: {machine_line(machine)}")
+    print("CPU ms = median over repeats of the integration's CPU time (compiled kernels, warm-up excluded); "
+          "errors at T against independent references")
+    print(format_rows(rows))
+    print(format_targets(measured))
+    for note in notes:
+        print(f"note: {note}")
+    print(f"\ntotal wall time {elapsed:.1f} s")
+    document = {
+        "command": command,
+        "quick": quick,
+        "machine": machine,
+        "elapsed_s": elapsed,
+        "runs": rows,
+        "targets": [t.as_dict() for t in measured],
+        "notes": notes,
+    }
+    if json_path:
+        write_json(json_path, document)
+        print(f"wrote {json_path}")
+    if plot_path:
+        from dirac.bench.report import write_plot
+
+        write_plot(plot_path, rows, f"{command} -- {machine_line(machine)}")
+        print(f"wrote {plot_path}")
+    return document

@@ -1,0 +1,344 @@
+"""Kernel, batch, skipping, memory and start-up measurements, each against its target.
+
+Each function measures one thing in this process (or in a fresh ``dirac`` subprocess for
+start-up), after a warm-up outside the timed region, and returns a :class:`Target`:
+value, target, whether it is met, and the baseline measured in the same run where the
+target is a ratio.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import tracemalloc
+import warnings
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from dirac.bench.timing import median_of, time_call
+
+__all__ = ["Target", "measure_targets", "work_precision_targets"]
+
+_STANDARD_INERTIA = np.array([2.0, 1.0, 2.0 / 3.0])
+_STANDARD_M0 = np.array([math.cos(1.1), 0.0, math.sin(1.1)])
+
+
+@dataclass
+class Target:
+    """One measured figure and its target."""
+
+    name: str
+    value: float | None
+    unit: str
+    target: float
+    sense: str  # "<=" or ">="
+    detail: str = ""
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def met(self) -> bool | None:
+        if self.value is None or not math.isfinite(self.value):
+            return None
+        return self.value <= self.target if self.sense == "<=" else self.value >= self.target
+
+    def as_dict(self) -> dict:
+        data = asdict(self)
+        data["met"] = self.met
+        return data
+
+
+def _quiet() -> warnings.catch_warnings:
+    manager = warnings.catch_warnings()
+    manager.__enter__()
+    warnings.simplefilter("ignore")
+    return manager
+
+
+# --------------------------------------------------------------------------- kernel vs C
+def kernel_against_c(repeats: int, n_steps: int) -> tuple[Target, str]:
+    """ns per lie-poisson-2 step (M and R) of the numba kernel and of the C reference."""
+    from dirac.bench.c_reference import compile_reference
+    from dirac.rigidbody.splitting import advance_sequence, build_sequence
+
+    inv = 1.0 / _STANDARD_INERTIA
+    axes, rates, fractions, casimir_rate = build_sequence(inv, (1.0,), "axes")
+    dt = 0.01
+
+    def state() -> tuple[np.ndarray, np.ndarray]:
+        return _STANDARD_M0.copy(), np.eye(3)
+
+    numba_time = time_call(
+        lambda s: advance_sequence(s[0], s[1], axes, rates, fractions, casimir_rate, dt, n_steps, True),
+        repeats, setup=state,
+    )
+    numba_ns = numba_time.cpu / n_steps * 1e9
+    reference, note = compile_reference()
+    if reference is None:
+        return Target("kernel: lie-poisson-2 step (M, R) / C reference", None, "x", 1.3, "<=",
+                      f"numba {numba_ns:.1f} ns/step; {note}"), note
+    c_time = time_call(lambda s: reference.advance(s[0], s[1], inv, dt, n_steps, True), repeats, setup=state)
+    c_ns = c_time.cpu / n_steps * 1e9
+    # same algorithm: the two must agree (checked here too, not only in the tests)
+    a, b = state()
+    advance_sequence(a, b, axes, rates, fractions, casimir_rate, dt, 1000, True)
+    c, d = state()
+    reference.advance(c, d, inv, dt, 1000, True)
+    agree = max(float(np.max(np.abs(a - c))), float(np.max(np.abs(b - d))))
+    return Target(
+        "kernel: lie-poisson-2 step (M, R) / C reference", numba_ns / c_ns, "x", 1.3, "<=",
+        f"numba {numba_ns:.1f} ns/step, C {c_ns:.1f} ns/step ({n_steps} steps, median of {repeats}); "
+        f"states agree to {agree:.1e}",
+        {"numba_ns_per_step": numba_ns, "c_ns_per_step": c_ns, "c_compile": reference.command},
+    ), note
+
+
+# --------------------------------------------------------------------------- work-precision
+def work_precision_targets(rows: list[dict], threshold: float = 1e-9) -> list[Target]:
+    """Fastest non-exact package method and DOP853 reaching ``threshold`` (standard body)."""
+    standard = [r for r in rows if r.get("problem") == "standard" and "failed" not in r]
+    reached = [r for r in standard if r.get("error", math.inf) <= threshold]
+    ours = [r for r in reached if r["method"] != "exact" and not r["method"].startswith("scipy-")]
+    dop = [r for r in reached if r["method"] == "scipy-DOP853"]
+    best = min(ours, key=lambda r: r["cpu_s"]) if ours else None
+    best_dop = min(dop, key=lambda r: r["cpu_s"]) if dop else None
+    targets = []
+    if best is None:
+        targets.append(Target("work-precision: fastest non-exact method, error <= 1e-9 (ms CPU)", None, "ms",
+                              1.0, "<=", "no package method reached 1e-9 in this run"))
+    else:
+        plain = [r for r in ours if r["method"] in ("lie-poisson-2", "lie-poisson-4", "lie-poisson-6", "lie-poisson-8")]
+        best_plain = min(plain, key=lambda r: r["cpu_s"]) if plain else None
+        also = (f"; best 3-term split: {best_plain['method']} dt = {best_plain['value']}, "
+                f"{best_plain['cpu_s'] * 1e3:.2f} ms" if best_plain is not None and best_plain is not best else "")
+        targets.append(Target(
+            "work-precision: fastest non-exact method, error <= 1e-9 (ms CPU)", best["cpu_s"] * 1e3, "ms", 1.0,
+            "<=", f"{best['method']} dt = {best['value']}: error {best['error']:.2g}, {best['steps']} steps, "
+            f"whole integrate call {best['call_cpu_s'] * 1e3:.2f} ms{also}",
+        ))
+    if best is None or best_dop is None:
+        targets.append(Target("work-precision: DOP853 CPU / fastest (same error)", None, "x", 50.0, ">=",
+                              "DOP853 or the package did not reach 1e-9 in this run"))
+    else:
+        targets.append(Target(
+            "work-precision: DOP853 CPU / fastest (same error)", best_dop["cpu_s"] / best["cpu_s"], "x", 50.0,
+            ">=", f"DOP853 tol {best_dop['value']:g}: {best_dop['cpu_s'] * 1e3:.1f} ms, error "
+            f"{best_dop['error']:.2g}, {best_dop['evaluations']} RHS calls (lean float RHS)",
+        ))
+    return targets
+
+
+# --------------------------------------------------------------------------- exact flow
+def exact_targets(repeats: int, n_times: int) -> list[Target]:
+    """Exact flow: one full state, ``n_times`` states, M-only skipping, t_end independence."""
+    from dirac.flows import RigidBodyProblem, integrate
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    quiet = _quiet()
+    try:
+        flow = ExactRigidBodyFlow(_STANDARD_INERTIA, _STANDARD_M0)
+        one = np.array([37.3])
+        single = time_call(lambda: flow.state(one), max(repeats, 20))
+        setup = time_call(lambda: ExactRigidBodyFlow(_STANDARD_INERTIA, _STANDARD_M0), max(repeats, 20))
+        times = np.linspace(0.0, 100.0, n_times)
+        many = time_call(lambda: flow.state(times), repeats)
+        problem = RigidBodyProblem(_STANDARD_INERTIA, _STANDARD_M0)
+
+        def run(outputs: list[str], t_end: float) -> float:
+            return integrate(problem, "exact", t_end=t_end, samples=n_times, outputs=outputs).cpu_seconds
+
+        run(["M"], 100.0)
+        with_R = median_of([run(["M", "R"], 100.0) for _ in range(repeats)])
+        only_M = median_of([run(["M"], 100.0) for _ in range(repeats)])
+        short = time_call(lambda: flow.state(np.linspace(0.0, 1e2, 1000)), repeats)
+        long = time_call(lambda: flow.state(np.linspace(0.0, 1e6, 1000)), repeats)
+    finally:
+        quiet.__exit__(None, None, None)
+    return [
+        Target("exact: full state (M, R) at one time (us)", single.cpu * 1e6, "us", 20.0, "<=",
+               f"ExactRigidBodyFlow.state at one time; building the flow once costs {setup.cpu * 1e6:.0f} us"),
+        Target(f"exact: {n_times:.0e} output times (s)", many.cpu, "s", 0.1 * n_times / 1e5, "<=",
+               f"ExactRigidBodyFlow.state on {n_times} times" + ("" if n_times == 100_000 else
+                                                                  " (target scaled from 0.1 s per 1e5)")),
+        Target(f"skipping: exact, M only vs M and R at {n_times:.0e} times", with_R / only_M, "x", 1.5, ">=",
+               f"integrate(exact, samples={n_times}): M,R {with_R * 1e3:.1f} ms, M {only_M * 1e3:.1f} ms"),
+        Target("exact: cost at t_end = 1e6 / cost at t_end = 1e2", long.cpu / short.cpu, "x", 1.1, "<=",
+               f"1000 times each: {short.cpu * 1e3:.2f} ms vs {long.cpu * 1e3:.2f} ms"),
+    ]
+
+
+# --------------------------------------------------------------------------- skipping R
+def splitting_skip_target(repeats: int, n_steps: int) -> Target:
+    """integrate(lie-poisson-2) with outputs M only against M and R."""
+    from dirac.flows import RigidBodyProblem, integrate
+
+    quiet = _quiet()
+    try:
+        problem = RigidBodyProblem(_STANDARD_INERTIA, _STANDARD_M0)
+        dt = 0.01
+
+        def run(outputs: list[str]) -> float:
+            return integrate(problem, "lie-poisson-2", t_end=n_steps * dt, dt=dt, samples=1,
+                             outputs=outputs).cpu_seconds
+
+        run(["M"])
+        run(["M", "R"])
+        both = median_of([run(["M", "R"]) for _ in range(repeats)])
+        only = median_of([run(["M"]) for _ in range(repeats)])
+    finally:
+        quiet.__exit__(None, None, None)
+    return Target("skipping: lie-poisson-2, M only vs M and R", both / only, "x", 1.1, ">=",
+                  f"{n_steps} steps: M,R {both * 1e9 / n_steps:.0f} ns/step, M {only * 1e9 / n_steps:.0f} ns/step")
+
+
+# --------------------------------------------------------------------------- memory
+def memory_target(small_steps: int, large_steps: int) -> Target:
+    """Peak traced memory of a final-state-only run: ``small_steps`` against ``large_steps``."""
+    from dirac.flows import RigidBodyProblem, integrate
+
+    quiet = _quiet()
+    try:
+        problem = RigidBodyProblem(_STANDARD_INERTIA, _STANDARD_M0)
+        dt = 0.01
+
+        def peak(n_steps: int) -> int:
+            tracemalloc.start()
+            try:
+                integrate(problem, "lie-poisson-2", t_end=n_steps * dt, dt=dt, samples=1, outputs=["M", "R"])
+                return tracemalloc.get_traced_memory()[1]
+            finally:
+                tracemalloc.stop()
+
+        peak(small_steps)  # imports and compilation outside the measurement
+        small = peak(small_steps)
+        large = peak(large_steps)
+    finally:
+        quiet.__exit__(None, None, None)
+    return Target(f"memory: peak of a final-state run, {large_steps:.0e} / {small_steps:.0e} steps",
+                  large / small, "x", 1.1, "<=",
+                  f"tracemalloc peak {small / 1024:.0f} KiB vs {large / 1024:.0f} KiB (samples = 1)")
+
+
+# --------------------------------------------------------------------------- batch
+def batch_targets(repeats: int, n_bodies: int, n_steps: int, numpy_steps: int) -> list[Target]:
+    """Batched lie-poisson-2 (M and R) per body-step, and against plain numpy."""
+    import numba
+
+    from dirac.rigidbody.batch import advance_batch, advance_batch_numpy
+
+    rng = np.random.default_rng(0)
+    M0 = rng.normal(size=(n_bodies, 3))
+    inv = 1.0 / rng.uniform(0.5, 2.0, size=(n_bodies, 3))
+    dt = 0.01
+
+    def state() -> tuple[np.ndarray, np.ndarray]:
+        return M0.copy(), np.repeat(np.eye(3)[None], n_bodies, axis=0)
+
+    compiled = time_call(lambda s: advance_batch(s[0], s[1], inv, dt, n_steps, (1.0,)), repeats, setup=state)
+    plain = time_call(lambda s: advance_batch_numpy(s[0], s[1], inv, dt, numpy_steps, (1.0,)),
+                      max(1, repeats // 2), setup=state)
+    per = compiled.wall / (n_bodies * n_steps) * 1e9
+    per_numpy = plain.wall / (n_bodies * numpy_steps) * 1e9
+    threads = numba.get_num_threads()
+    return [
+        Target(f"batch: {n_bodies:.0e} bodies x {n_steps} lie-poisson-2 steps (ns per body-step)", per, "ns",
+               20.0, "<=", f"wall time {compiled.wall * 1e3:.1f} ms on {threads} threads "
+               f"(CPU {compiled.cpu / (n_bodies * n_steps) * 1e9:.1f} ns per body-step summed over threads)"),
+        Target("batch: speed-up over plain numpy vectorisation", per_numpy / per, "x", 5.0, ">=",
+               f"numpy {per_numpy:.0f} ns per body-step ({numpy_steps} steps, same bodies)"),
+    ]
+
+
+# --------------------------------------------------------------------------- general systems
+def double_pendulum_target(repeats: int, n_steps: int) -> Target:
+    """``n_steps`` rattle-2 steps of the double pendulum (CPU of the integrate loop)."""
+    from dirac.bench.suite import constrained_cases
+    from dirac.bench.workprecision import _constrained_problem
+    from dirac.flows import integrate
+
+    case = [c for c in constrained_cases(True) if c.system == "double_pendulum"][0]
+    problem, _ = _constrained_problem(case)
+    dt = 1e-3
+
+    def run() -> float:
+        return integrate(problem, "rattle-2", t_end=n_steps * dt, dt=dt, samples=1, outputs=["q"]).cpu_seconds
+
+    run()
+    cpu = median_of([run() for _ in range(repeats)])
+    return Target(f"general: {n_steps:.0e} rattle-2 steps of the double pendulum (s)", cpu * 1e5 / n_steps, "s",
+                  1.0, "<=", f"measured {cpu:.3f} s for {n_steps} steps (dt = 1e-3), scaled to 1e5 steps"
+                  if n_steps != 100_000 else f"dt = 1e-3, CPU of the integrate loop")
+
+
+# --------------------------------------------------------------------------- start-up
+def _dirac_command() -> list[str]:
+    return [sys.executable, "-m", "dirac"]
+
+
+def _wall(command: list[str], env: dict | None = None) -> tuple[float, int]:
+    start = time.perf_counter()
+    completed = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600)
+    return time.perf_counter() - start, completed.returncode
+
+
+def startup_targets(repeats: int, cold: bool) -> list[Target]:
+    """``dirac --help`` and ``dirac demo`` wall time in fresh processes."""
+    help_times = []
+    _wall(_dirac_command() + ["--help"])
+    for _ in range(max(3, repeats)):
+        help_times.append(_wall(_dirac_command() + ["--help"])[0])
+    targets = [Target("start-up: dirac --help (s)", median_of(help_times), "s", 0.3, "<=",
+                      f"wall time of a fresh process, median of {len(help_times)}")]
+    first, status = _wall(_dirac_command() + ["demo"])
+    if status != 0:
+        targets.append(Target("start-up: dirac demo, warm cache (s)", None, "s", 3.0, "<=",
+                              f"'dirac demo' exited with status {status}; not measured"))
+        return targets
+    warm = median_of([_wall(_dirac_command() + ["demo"])[0] for _ in range(max(2, repeats // 2))])
+    detail = "wall time of a fresh process with compiled kernels cached on disk"
+    extra: dict = {}
+    if cold:
+        with tempfile.TemporaryDirectory(prefix="dirac-cold-") as scratch:
+            env = dict(os.environ, NUMBA_CACHE_DIR=os.path.join(scratch, "numba"),
+                       DIRAC_CACHE_DIR=os.path.join(scratch, "dirac"))
+            cold_time, cold_status = _wall(_dirac_command() + ["demo"], env)
+        detail += f"; cold first run (empty numba and dirac caches) {cold_time:.1f} s"
+        extra = {"cold_s": cold_time, "cold_status": cold_status}
+    else:
+        detail += "; cold first run measured by the full run only"
+    targets.append(Target("start-up: dirac demo, warm cache (s)", warm, "s", 3.0, "<=", detail, extra))
+    return targets
+
+
+def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], None]) -> tuple[list[Target], list[str]]:
+    """Every target of issue #5 (smaller sizes in ``quick`` mode, scaled where said)."""
+    notes: list[str] = []
+    targets: list[Target] = []
+    repeats = 5 if quick else 9
+
+    def attempt(label: str, function: Callable[[], object]) -> None:
+        progress(label)
+        try:
+            result = function()
+        except Exception as exc:  # one failed measurement must not hide the others
+            notes.append(f"{label}: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
+            return
+        if isinstance(result, tuple):
+            result, note = result
+            notes.append(note)
+        targets.extend(result if isinstance(result, list) else [result])
+
+    attempt("kernel against the C reference", lambda: kernel_against_c(repeats, 100_000 if quick else 1_000_000))
+    targets.extend(work_precision_targets(rows))
+    attempt("exact flow", lambda: exact_targets(repeats, 100_000))
+    attempt("skipping R with splitting", lambda: splitting_skip_target(repeats, 100_000 if quick else 1_000_000))
+    attempt("peak memory", lambda: memory_target(10_000, 1_000_000 if quick else 10_000_000))
+    attempt("batched bodies", lambda: batch_targets(repeats, 100_000, 100, 5 if quick else 10))
+    attempt("double pendulum", lambda: double_pendulum_target(3 if quick else 5, 20_000 if quick else 100_000))
+    attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
+    return targets, notes

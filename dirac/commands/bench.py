@@ -1,0 +1,61 @@
+"""``dirac bench``: work–precision benchmark against scipy baselines, in one run.
+
+``dirac bench [--quick] [--json FILE] [--plot FILE.png]`` (CONTRACTS §2). The flags
+``--stress`` (issue #6) and ``--ensemble`` (issue #8) hand over to their own benchmark
+modules when those are installed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+
+from dirac.errors import InputError
+
+
+def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "bench",
+        help="work-precision benchmark against scipy baselines",
+        description="Work-precision benchmark: every method at a range of step sizes or tolerances on a suite "
+        "of rigid bodies and constrained systems, CPU time (median of repeats) against the global error from "
+        "independent references, plus kernel, batch, memory and start-up figures against their targets. "
+        "Every ratio is against a baseline measured in the same run.",
+    )
+    parser.add_argument("--quick", action="store_true", help="small grid and sizes (under a minute)")
+    parser.add_argument("--json", metavar="FILE", help="write every run (one row each) and the targets as JSON")
+    parser.add_argument("--plot", metavar="FILE.png", help="draw CPU time against error (log-log)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
+    parser.add_argument("--stress", action="store_true", help="run the stress benchmark instead (issue #6)")
+    parser.add_argument("--ensemble", action="store_true", help="run the ensemble benchmark instead (issue #8)")
+    return parser
+
+
+def _delegate(flag: str, module_name: str, args: argparse.Namespace) -> int:
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        if exc.name is not None and module_name.startswith(exc.name):
+            raise InputError(f"dirac bench --{flag} is not available in this version yet") from None
+        raise
+    return int(module.main(args) or 0)
+
+
+def main(args: argparse.Namespace) -> int:
+    if args.stress and args.ensemble:
+        raise InputError("give either --stress or --ensemble, not both")
+    if args.stress:
+        return _delegate("stress", "dirac.bench.stress", args)
+    if args.ensemble:
+        return _delegate("ensemble", "dirac.ensemble.bench", args)
+    if args.plot and not str(args.plot).lower().endswith(".png"):
+        raise InputError(f"--plot {args.plot!r}: give a file name ending in .png")
+    if args.plot:
+        try:
+            import matplotlib  # noqa: F401
+        except ModuleNotFoundError:
+            raise InputError("--plot needs matplotlib: pip install 'dirac-mechanics[plot]'") from None
+    from dirac.bench.run import run_benchmark
+
+    run_benchmark(quick=bool(args.quick), json_path=args.json, plot_path=args.plot, progress=not args.no_progress)
+    return 0
