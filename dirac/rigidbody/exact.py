@@ -198,6 +198,19 @@ class ExactRigidBodyFlow:
         self._Q = self.R0 @ _frame(M, p3).T
 
     # ------------------------------------------------------------------ public API
+    @property
+    def period(self) -> float:
+        """Period of ``M(t)``: ``4 K(m) / lam`` (``cn``, ``sn`` have period ``4K``).
+
+        ``math.inf`` exactly on the separatrix (``m = 1``); ``0.0`` at a relative
+        equilibrium (``M`` constant).
+        """
+        if self.equilibrium:
+            return 0.0
+        if self.mc == 0.0:
+            return math.inf
+        return 4.0 * self._p[12] / self._p[3]
+
     def M(self, times: object) -> np.ndarray:
         """Body angular momentum ``M(t)`` (Jacobi elliptic solution of (250)).
 
