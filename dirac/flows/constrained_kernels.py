@@ -22,10 +22,18 @@ import numpy as np
 
 try:  # first-class function types are flagged experimental by numba; they are what we need
     from numba.core.errors import NumbaExperimentalFeatureWarning
-
-    warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
 except ImportError:  # pragma: no cover
-    pass
+    NumbaExperimentalFeatureWarning = Warning
+
+
+class quiet(warnings.catch_warnings):
+    """Context that hides numba's 'first-class function type is experimental' warning,
+    which numba issues on every call of a kernel taking the generated functions."""
+
+    def __enter__(self):
+        result = super().__enter__()
+        warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+        return result
 
 MASS = 0
 MASS_DERIVATIVE = 1

@@ -37,8 +37,11 @@ class ConstrainedField:
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """``z_dot`` at ``z = (q, p)`` (shape (2n,))."""
+        from dirac.flows.constrained_kernels import quiet
+
         out = np.empty(2 * self.n)
-        self._kernel(self._functions, np.ascontiguousarray(z, dtype=float), self._params, self.n, self.m, out)
+        with quiet():
+            self._kernel(self._functions, np.ascontiguousarray(z, dtype=float), self._params, self.n, self.m, out)
         return out
 
     def scipy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:

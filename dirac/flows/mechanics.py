@@ -151,7 +151,8 @@ class MechanicalSystem:
         constant_mass = None
         if constant:
             flat = np.empty(n * n)
-            constrained_kernels.evaluate(module.mass, np.zeros(n), param_array, flat)
+            with constrained_kernels.quiet():
+                constrained_kernels.evaluate(module.mass, np.zeros(n), param_array, flat)
             constant_mass = flat.reshape(n, n)
         system = cls(
             name=lagrangian.name,
@@ -170,10 +171,11 @@ class MechanicalSystem:
 
     # ------------------------------------------------------------------ numerics (numpy side)
     def _call(self, name: str, q: np.ndarray, size: int) -> np.ndarray:
-        from dirac.flows.constrained_kernels import evaluate
+        from dirac.flows.constrained_kernels import evaluate, quiet
 
         out = np.empty(size)
-        evaluate(getattr(self.module, name), np.ascontiguousarray(q, dtype=float), self.params, out)
+        with quiet():
+            evaluate(getattr(self.module, name), np.ascontiguousarray(q, dtype=float), self.params, out)
         return out
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:

@@ -182,14 +182,20 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         self.p = self.z[:, n:]
 
     def warm_up(self) -> None:
+        from dirac.flows.constrained_kernels import quiet
+
         n, m = self.mechanics.dimension, self.mechanics.n_constraints
-        self._kernel(self.mechanics.functions, self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
+        with quiet():
+            self._kernel(self.mechanics.functions, self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
         self._sync()
 
     def step(self, n_steps: int, dt: float) -> None:
+        from dirac.flows.constrained_kernels import quiet
+
         n, m = self.mechanics.dimension, self.mechanics.n_constraints
         for b in range(self.z.shape[0]):
-            self._kernel(self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
+            with quiet():
+                self._kernel(self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
             self._sync()
             self._raise_if_failed("midpoint")

@@ -85,11 +85,17 @@ class RattleStepper(ConstrainedStepper):
             self._kernel(fns, q, p, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
 
     def warm_up(self) -> None:
-        self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6)
+        from dirac.flows.constrained_kernels import quiet
+
+        with quiet():
+            self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6)
 
     def step(self, n_steps: int, dt: float) -> None:
+        from dirac.flows.constrained_kernels import quiet
+
         for b in range(self.q.shape[0]):
-            self._call(self.q[b], self.p[b], n_steps, dt)
+            with quiet():
+                self._call(self.q[b], self.p[b], n_steps, dt)
             self.evaluations += int(self.info[2])
             self._raise_if_failed(self.name)
         self.steps += n_steps

@@ -27,7 +27,8 @@ class ScipyStepper(Stepper):
         self.method = method
         self.problem = problem
         self.outputs = outputs
-        self.tolerance = float(options.get("tolerance", 1e-8))
+        # scipy refuses rtol below 100 machine epsilons (it warns and clamps): clamp here
+        self.tolerance = max(float(options.get("tolerance", 1e-8)), 2.3e-14)
         self.t_end = float(options["t_end"])
         self.t = 0.0
         kind = getattr(problem, "system", "")
