@@ -11,7 +11,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from dirac.errors import DiracWarning
-from dirac.rigidbody.closed_forms import principal_axis_rotation, symmetric_top
+from dirac.rigidbody.closed_forms import axis_rotation, principal_axis_rotation, symmetric_top
 from dirac.rigidbody.euler_poisson import energy, lean_rhs_full
 from dirac.rigidbody.exact import ExactRigidBodyFlow
 
@@ -76,6 +76,8 @@ def _cases():
         ("symmetric-prolate", np.array([2.0, 1.0, 1.0]), np.array([0.3, 0.5, 0.2]), np.eye(3)),
         ("symmetric-middle", np.array([1.5, 0.5, 1.5]), np.array([0.1, -0.7, 0.4]), np.eye(3)),
         ("near-axis-1", STANDARD_I, np.array([1.0, 1e-9, -2e-9]), _rotation(rng)),
+        # regression: squares of 1e-200 underflow, 1 - m becomes 0 (separatrix branch)
+        ("underflow-near-saddle", np.array([1.0, 1.5, 2.0]), np.array([1e-200, 0.3, 1e-200]), np.eye(3)),
     ]
     return cases
 
@@ -129,6 +131,11 @@ def test_exact_flow_invariants_and_group_property(name, inertia, M0, R0):
     M_direct, R_direct = flow.state([13.3, 18.0])
     assert np.max(np.abs(M2 - M_direct)) < 1e-12 * G
     assert np.max(np.abs(R2 - R_direct)) < 1e-12
+    # backwards in time and forward again
+    M_back, R_back = flow.state([-7.5])
+    M_again, R_again = _flow(inertia, M_back[0], R_back[0]).state([7.5])
+    assert np.max(np.abs(M_again[0] - M0)) < 1e-12 * G
+    assert np.max(np.abs(R_again[0] - R0)) < 1e-12
 
 
 def test_relative_equilibria_rotate_uniformly_as_in_165():
@@ -182,7 +189,11 @@ def test_symmetric_top_183_sign_of_phi_against_dop853():
     M_ref, R_ref = _dop853(inertia, np.array([0.0, m2, m3]), np.eye(3), times)
     np.testing.assert_allclose(M_cf, M_ref, atol=1e-12)
     np.testing.assert_allclose(R_cf, R_ref, atol=1e-11)
-    M_flip, R_flip = symmetric_top(inertia[[0, 1, 2]], m2, -m3, times)  # phi -> -phi
+    n = np.hypot(m2, m3)
+    phi = (1.3 - 0.7) * m3 / (1.3 * 0.7)
+    R_flip = axis_rotation(np.array([0.0, m2, m3]) / n, n / 1.3 * times) @ axis_rotation(
+        np.array([0.0, 0.0, 1.0]), -phi * times
+    )
     assert np.max(np.abs(R_flip - R_ref)) > 0.1
 
 
