@@ -1,0 +1,135 @@
+"""Text, JSON (CONTRACTS §4) and LaTeX renderings of a :class:`ConstraintAnalysis`."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import sympy
+
+if TYPE_CHECKING:  # pragma: no cover
+    from dirac.symbolic.analysis import ConstraintAnalysis
+
+__all__ = ["to_json", "to_text", "to_latex"]
+
+#: longest expression printed in full in the text report
+TEXT_LIMIT = 400
+
+
+def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
+    text = str(expr)
+    if len(text) <= limit:
+        return text
+    return f"{text[: limit - 40]} ... ({len(text)} characters; full form in --json)"
+
+
+def to_json(analysis: "ConstraintAnalysis") -> dict:
+    """The CONTRACTS §4 object; constraints are ``str()`` of sympy expressions.
+
+    Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
+    ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
+    ``bracket_strategy``, ``notes``.
+    """
+    return {
+        "system": analysis.name,
+        "coordinates": [s.name for s in analysis.coordinates],
+        "phase_space_dimension": len(analysis.phase_space),
+        "stages": [
+            {"stage": k, "constraints": [str(c) for c in stage]} for k, stage in enumerate(analysis.stages, start=1)
+        ],
+        "first_class": [str(c) for c in analysis.first_class],
+        "second_class": [str(c) for c in analysis.second_class],
+        "multipliers": {name: str(value) for name, value in analysis.multipliers.items()},
+        "physical_degrees_of_freedom": analysis.physical_degrees_of_freedom,
+        "phase_space": [s.name for s in analysis.phase_space],
+        "parameters": [p.name for p in analysis.parameters],
+        "canonical_hamiltonian": str(analysis.canonical_hamiltonian),
+        "primary_multipliers": [u.name for u in analysis.primary_multipliers],
+        "undetermined_multipliers": [u.name for u in analysis.undetermined_multipliers],
+        "hessian_rank": analysis.hessian_rank,
+        "bracket_strategy": analysis.bracket_strategy,
+        "notes": list(analysis.notes),
+    }
+
+
+def to_text(analysis: "ConstraintAnalysis") -> str:
+    """Readable report: the chain stage by stage with counts, classes, multipliers."""
+    a = analysis
+    n = len(a.coordinates)
+    lines = [f"Dirac-Bergmann analysis of {a.name!r}"]
+    if a.lagrangian.description:
+        lines.append(f"  {a.lagrangian.description}")
+    lines.append(f"  L = {_short(a.lagrangian.expression)}")
+    for k, chi in enumerate(a.lagrangian.constraints, start=1):
+        lines.append(f"  constraint {k}: {chi} = 0   (multiplier lambda_{k})")
+    lines.append(
+        f"phase space: {2 * n} dimensions ({', '.join(s.name for s in a.coordinates)} and their momenta)"
+    )
+    if a.parameters:
+        lines.append(f"parameters (symbolic): {', '.join(p.name for p in a.parameters)}")
+    lines.append(f"Hessian d2L/dq_dot2: rank {a.hessian_rank} of {len(a.lagrangian.coordinates)}")
+    lines.append(f"canonical Hamiltonian H_c = {_short(a.canonical_hamiltonian)}")
+    lines.append("total Hamiltonian H_T = H_c + " + " + ".join(f"{u}*phi_{k}" for k, u in enumerate(a.primary_multipliers, 1)) if a.primary_multipliers else "total Hamiltonian H_T = H_c")
+    lines.append("")
+    lines.append(f"constraint chain: {len(a.stages)} stage(s), {len(a.constraints)} constraint(s)")
+    for k, stage in enumerate(a.stages, start=1):
+        label = "primary" if k == 1 else f"stage {k}"
+        lines.append(f"  stage {k} ({label if k > 1 else 'primary'}): {len(stage)} constraint(s)")
+        for c in stage:
+            lines.append(f"    {_short(c)} = 0")
+    lines.append("")
+    lines.append("multipliers of the primary constraints:")
+    if not a.primary_multipliers:
+        lines.append("  (none)")
+    for u in a.primary_multipliers:
+        if u.name in a.multipliers:
+            lines.append(f"  {u} = {_short(a.multipliers[u.name])}")
+        else:
+            lines.append(f"  {u}: undetermined (gauge freedom)")
+    lines.append("")
+    lines.append(f"first class: {len(a.first_class)}")
+    for c in a.first_class:
+        lines.append(f"    {_short(c)}")
+    lines.append(f"second class: {len(a.second_class)} (rank of C_ab = {{Phi_a, Phi_b}} on the surface)")
+    if len(a.second_class) <= 12:
+        for c in a.second_class:
+            lines.append(f"    {_short(c)}")
+    else:
+        lines.append("    (all constraints of the chain above)" if len(a.second_class) == len(a.constraints) else "    (see --json)")
+    lines.append(
+        f"physical degrees of freedom: ({2 * n} - 2*{len(a.first_class)} - {len(a.second_class)})/2 = "
+        f"{a.physical_degrees_of_freedom}"
+    )
+    lines.append(f"Dirac bracket: {a.bracket_strategy}")
+    for note in a.notes:
+        lines.append(f"note: {note}")
+    return "\n".join(lines)
+
+
+def to_latex(analysis: "ConstraintAnalysis", display: bool = False) -> str:
+    """LaTeX rendering (``align*`` blocks); ``display=True`` wraps it for Jupyter."""
+    a = analysis
+    lx = sympy.latex
+    out = [rf"\textbf{{Dirac--Bergmann analysis of \texttt{{{a.name.replace('_', r'\_')}}}}}"]
+    out.append(r"\begin{align*}")
+    out.append(rf"L &= {lx(a.lagrangian.expression)} \\")
+    for k, chi in enumerate(a.lagrangian.constraints, start=1):
+        out.append(rf"\chi_{{{k}}} &= {lx(chi)} = 0 \\")
+    out.append(rf"H_c &= {lx(a.canonical_hamiltonian)}")
+    out.append(r"\end{align*}")
+    for k, stage in enumerate(a.stages, start=1):
+        title = "primary constraints" if k == 1 else f"stage {k}"
+        out.append(rf"\textit{{{title} ({len(stage)})}}")
+        out.append(r"\begin{align*}")
+        out.append(" \\\\\n".join(rf"&{lx(c)} = 0" for c in stage))
+        out.append(r"\end{align*}")
+    if a.multipliers:
+        out.append(r"\textit{multipliers}")
+        out.append(r"\begin{align*}")
+        out.append(" \\\\\n".join(rf"{lx(sympy.Symbol(k))} &= {lx(v)}" for k, v in a.multipliers.items()))
+        out.append(r"\end{align*}")
+    out.append(
+        rf"\textit{{first class: {len(a.first_class)}, second class: {len(a.second_class)}, "
+        rf"physical degrees of freedom: {a.physical_degrees_of_freedom}}}"
+    )
+    text = "\n".join(out)
+    return text
