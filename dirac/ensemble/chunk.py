@@ -8,6 +8,7 @@ times, gives the same bits.
 from __future__ import annotations
 
 import threading
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -37,23 +38,32 @@ def advance_members(
     """Advance a batch in place with the batched Lie-Poisson kernel (250)-(251).
 
     Delegates to :func:`dirac.rigidbody.batch.advance_batch` (numba, parallel over
-    blocks of bodies), under :data:`KERNEL_LOCK`. A call with less than
-    :data:`PARALLEL_WORK` member-steps runs on one thread: waking the other threads
-    costs more than it saves, and on a loaded machine a parallel launch can wait a
-    whole scheduler time slice for a descheduled thread.
+    blocks of bodies), under :data:`KERNEL_LOCK`.
     """
-    import numba
-
     from dirac.rigidbody.batch import advance_batch
 
     with KERNEL_LOCK:
-        threads = numba.get_num_threads()
-        if M.shape[0] * n_steps < PARALLEL_WORK and threads > 1:
-            numba.set_num_threads(1)
-        try:
-            advance_batch(M, R if with_R else None, inv_inertia, dt, n_steps, coefficients, with_R)
-        finally:
-            numba.set_num_threads(threads)
+        advance_batch(M, R if with_R else None, inv_inertia, dt, n_steps, coefficients, with_R)
+
+
+@contextmanager
+def _threads_for(work_per_call: int):
+    """One numba thread when a kernel call has less than :data:`PARALLEL_WORK` member-steps.
+
+    Waking the other threads then costs more than it saves, and on a loaded machine a
+    parallel launch can wait a whole scheduler time slice for a descheduled thread.
+    """
+    import numba
+
+    threads = numba.get_num_threads()
+    if work_per_call >= PARALLEL_WORK or threads == 1:
+        yield
+        return
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(threads)
 
 
 def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.ndarray]:
@@ -100,11 +110,12 @@ def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.n
     record(0)
     for reduction in reductions:
         reduction.start(M, R, inertia)
-    for k in range(1, scene.samples):
-        advance_members(M, R, inv, scene.dt, scene.steps_per_sample, scene.coefficients, scene.with_R)
-        record(k)
-        for reduction in reductions:
-            reduction.update(times[k - 1], times[k], M, R)
+    with _threads_for(n * scene.steps_per_sample):
+        for k in range(1, scene.samples):
+            advance_members(M, R, inv, scene.dt, scene.steps_per_sample, scene.coefficients, scene.with_R)
+            record(k)
+            for reduction in reductions:
+                reduction.update(times[k - 1], times[k], M, R)
     results: dict[str, np.ndarray] = dict(traj)
     for reduction in reductions:
         results.update(reduction.result())

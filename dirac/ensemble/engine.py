@@ -87,10 +87,14 @@ class EnsembleReport:
 def default_chunk_size(scene: EnsembleScene) -> int:
     """Members per chunk such that one chunk's arrays take about :data:`CHUNK_BYTES`.
 
-    Counts the stored arrays plus the working state (``M``, ``R``, ``1/I``) of a member.
+    Counts the stored arrays plus the working state (``M``, ``R``, ``1/I``) of a member;
+    at most :data:`MAX_DEFAULT_CHUNK`; the chunks are then made (nearly) equal, which
+    keeps the workers of a cluster evenly loaded.
     """
     per_member = 8 * (21 + sum(int(_size(shape)) for shape in array_layout(scene).values()))
-    return max(1, min(scene.count, MAX_DEFAULT_CHUNK, CHUNK_BYTES // per_member))
+    largest = max(1, min(scene.count, MAX_DEFAULT_CHUNK, CHUNK_BYTES // per_member))
+    chunks = -(-scene.count // largest)
+    return -(-scene.count // chunks)  # equal chunks: no small straggler at the end
 
 
 def _size(shape: tuple[int, ...]) -> int:

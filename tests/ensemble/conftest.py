@@ -61,10 +61,16 @@ def write_scene(tmp_path: Path):
 
 @pytest.fixture(scope="module")
 def dask_client():
-    """A dask LocalCluster of two worker processes on the loopback, closed after the module."""
+    """A dask LocalCluster of two workers (in-process transport, no network), closed after the module.
+
+    The workers are threads of the test process (``processes=False``: no spawn, the
+    kernels are loaded once); worker processes are exercised by the command-line test
+    with ``--cluster local`` and by ``dirac bench --ensemble``.
+    """
     import distributed  # in the test extra
+
     cluster = distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
     )
     client = distributed.Client(cluster)
     try:

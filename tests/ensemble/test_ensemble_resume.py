@@ -23,9 +23,9 @@ def _command(scene, out) -> list[str]:
 
 
 def test_killed_run_resumes_with_identical_results(write_scene, tmp_path):
-    # 20 chunks of 100 members x 4000 steps: each chunk takes a visible fraction of a second
+    # 20 chunks of 100 members x 2000 steps: each chunk takes a visible fraction of a second
     scene = write_scene(
-        count=100 * CHUNKS, t_end=8.0, dt=0.002, samples=11, outputs='["energy"]',
+        count=100 * CHUNKS, t_end=4.0, dt=0.002, samples=11, outputs='["energy"]',
         reductions='["flip_time", "final_state"]', extra="chunk_size = 100",
     )
     out = tmp_path / "killed"

@@ -1,0 +1,120 @@
+"""Plot the flip times of an ensemble: ``python -m dirac.ensemble.plot DIR --out FILE.png``.
+
+Left: the distribution of the members' first flip times (``flip_time`` reduction).
+Right, when the store also holds ``initial_state`` and every member shares one inertia:
+each member's flip time against the separatrix prediction
+
+    t_flip = ln(c / |u_0|) / lambda,     lambda = |M| sqrt(p q),
+    p = 1/I_a - 1/I_b,  q = 1/I_b - 1/I_c,  c = 4 |M| sqrt(q / (p + q))
+
+(``I_a < I_b < I_c``): ``u`` is the unstable coordinate of the Euler equations (250)
+linearised at ``M = |M| e_b`` (:func:`unstable_coordinate`); it grows like
+``e^{lambda t}`` from ``u_0``, and on the separatrix solution ``M_b = -|M| tanh(lambda t)``,
+``M_a, M_c ~ sech(lambda t)`` it behaves as ``c e^{lambda (t - t_flip)}`` for
+``t -> -infinity``, ``t_flip`` being the crossing of ``M_b = 0``. The prediction is
+exact as ``|u_0| / |M| -> 0``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["unstable_coordinate", "predicted_flip_time", "plot_flip_times", "main"]
+
+
+def unstable_coordinate(M: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    """The unstable coordinate ``u`` of ``M`` near ``+|M| e_b`` (``b`` the intermediate axis).
+
+    With ``x = M_a``, ``z = M_c`` (small; ``a, c`` the axes of the smallest and largest
+    moments), (250) linearises to ``x' = -s |M| q z``, ``z' = -s |M| p x`` with ``s = +1``
+    if ``(a, b, c)`` is a cyclic order of the axes, ``-1`` otherwise (``p, q`` of the
+    module docstring); ``u = x - s sqrt(q / p) z`` obeys ``u' = lambda u``.
+    """
+    inertia = np.asarray(inertia, dtype=float)
+    a, b, c = (int(i) for i in np.argsort(inertia, kind="stable"))
+    s = 1.0 if (b - a) % 3 == 1 else -1.0
+    p, q = _rates(inertia)
+    return M[..., a] - s * np.sqrt(q / p) * M[..., c]
+
+
+def _rates(inertia: np.ndarray) -> tuple[float, float]:
+    small, middle, large = np.sort(np.asarray(inertia, dtype=float))
+    return 1 / small - 1 / middle, 1 / middle - 1 / large
+
+
+def predicted_flip_time(M0: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    """``ln(c / |u_0|) / lambda`` (module docstring), exact as ``|u_0| / |M| -> 0``."""
+    norm = np.linalg.norm(M0, axis=-1)
+    p, q = _rates(inertia)
+    lam = norm * np.sqrt(p * q)
+    c = 4 * norm * np.sqrt(q / (p + q))
+    return np.log(c / np.abs(unstable_coordinate(M0, inertia))) / lam
+
+
+def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
+    """Draw the flip-time figure of the ensemble in ``out`` into ``image``.
+
+    Returns
+    -------
+    dict
+        ``members``, ``flipped`` and the median flip time; with initial states also
+        ``max_deviation``, the largest ``|t_flip - prediction|``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import zarr
+
+    group = zarr.open_group(str(Path(out) / "data.zarr"), mode="r")
+    meta = json.loads((Path(out) / "meta.json").read_text())
+    if "flip_time" not in group:
+        raise SystemExit(f"error: {out} has no flip_time array; add \"flip_time\" to [ensemble] reductions")
+    flip = group["flip_time"][:]
+    t_end = float(meta["scene"]["t_end"])
+    summary = {"members": int(flip.size), "flipped": int(np.isfinite(flip).sum()), "median": float(np.nanmedian(flip))}
+    inertia = group["inertia"][:] if "inertia" in group else None
+    shared = inertia is not None and np.all(inertia == inertia[0])
+    panels = 2 if shared else 1
+    fig, axes = plt.subplots(1, panels, figsize=(5.2 * panels, 4.0), squeeze=False)
+    ax = axes[0, 0]
+    ax.hist(flip[np.isfinite(flip)], bins=80, color="tab:blue", alpha=0.85)
+    ax.set_xlabel("time of the first flip of the intermediate axis")
+    ax.set_ylabel("members")
+    ax.set_title(f"{summary['flipped']} of {summary['members']} members flip by t = {t_end:g}")
+    if shared:
+        M0 = group["initial_M"][:]
+        predicted = predicted_flip_time(M0, inertia[0])
+        ok = np.isfinite(flip)
+        summary["max_deviation"] = float(np.max(np.abs(flip[ok] - predicted[ok])))
+        ax = axes[0, 1]
+        ax.plot(predicted[ok], flip[ok], ".", ms=2, alpha=0.4, color="tab:blue", label="members")
+        lo, hi = float(np.min(predicted[ok])), float(np.max(predicted[ok]))
+        ax.plot([lo, hi], [lo, hi], "k-", lw=1, label=r"$t = \ln(c/|u_0|)/\lambda$")
+        ax.set_xlabel(r"separatrix prediction $\ln(c/|u_0|)/\lambda$")
+        ax.set_ylabel("flip time")
+        ax.set_title(f"max deviation {summary['max_deviation']:.2g}")
+        ax.legend(loc="upper left")
+    fig.tight_layout()
+    fig.savefig(image, dpi=120)
+    plt.close(fig)
+    return summary
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m dirac.ensemble.plot", description=__doc__.splitlines()[0])
+    parser.add_argument("out", metavar="DIR", help="the ensemble's output folder")
+    parser.add_argument("--out", dest="image", metavar="FILE.png", required=True, help="image to write")
+    args = parser.parse_args(argv)
+    summary = plot_flip_times(args.out, args.image)
+    print(", ".join(f"{key} = {value:.6g}" for key, value in summary.items()), file=sys.stdout)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,41 @@
+"""'dirac ensemble' on the command line: success summary, resume, bad input (exit 2)."""
+
+from __future__ import annotations
+
+
+def test_cli_runs_and_resumes(write_scene, tmp_path, run_cli):
+    scene = write_scene(count=40, outputs='["M"]', reductions='["final_state"]')
+    out = tmp_path / "out"
+    status, stdout, stderr = run_cli("ensemble", str(scene), "--out", str(out), "--chunk-size", "15", "--no-progress")
+    assert status == 0, stderr
+    assert "40 members in 3 chunks of 15" in stdout and "computed 3 chunks, 0 already complete" in stdout
+    status, stdout, stderr = run_cli("ensemble", str(scene), "--out", str(out), "--no-progress")
+    assert status == 0
+    assert "computed 0 chunks, 3 already complete" in stdout
+    assert "resuming: 3 of 3 chunks already complete" in stderr
+
+
+def test_cli_bad_input_exits_2_with_one_error_line(write_scene, tmp_path, run_cli):
+    cases = [
+        (write_scene("a.toml", method="rattle-2"), "method = 'rattle-2' is not available for ensembles"),
+        (write_scene("b.toml", outputs="[]", reductions="[]"), "the scene asks for nothing"),
+        (write_scene("c.toml", reductions='["flip_count"]'), "reductions: 'flip_count' is unknown"),
+        (write_scene("d.toml", members='[ensemble.M]\ndistribution = "sphere"\n'), "needs 'norm'"),
+        (tmp_path / "missing.toml", "cannot read scene file"),
+    ]
+    for scene, fragment in cases:
+        status, _, stderr = run_cli("ensemble", str(scene), "--out", str(tmp_path / "never"), "--no-progress")
+        lines = [line for line in stderr.splitlines() if line.startswith("error:")]
+        assert status == 2 and len(lines) == 1 and fragment in lines[0], stderr
+    status, _, stderr = run_cli("ensemble", str(cases[0][0]), "--out", str(tmp_path / "x"), "--workers", "2")
+    assert status == 2 and "--workers N needs --cluster local" in stderr
+    assert not (tmp_path / "never").exists()
+
+
+def test_scene_warnings(write_scene, tmp_path, run_cli):
+    scene = write_scene(count=5, dt=0.03, extra="colour = \"red\"", reductions='["final_state"]', outputs="[]")
+    status, _, stderr = run_cli("ensemble", str(scene), "--out", str(tmp_path / "out"), "--no-progress")
+    assert status == 0
+    warnings = [line for line in stderr.splitlines() if line.startswith("warning:")]
+    assert any("[ensemble] key 'colour' is unknown" in line for line in warnings)
+    assert any("dt = 0.03 does not divide the sample spacing 0.1; using dt = 0.025" in line for line in warnings)
