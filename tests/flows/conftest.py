@@ -39,3 +39,12 @@ def standard_problem():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DiracWarning)  # I = (2, 1, 2/3) is not physical: it warns
         return RigidBodyProblem(STANDARD_INERTIA, STANDARD_M0)
+
+
+@pytest.fixture
+def stress_scale() -> float:
+    """The scale of slow stress runs, as :func:`tests/conftest.py::stress_scale` defines it
+    (1.0 with ``DIRAC_FULL_STRESS=1``, else a small fraction)."""
+    import os
+
+    return 1.0 if os.environ.get("DIRAC_FULL_STRESS") == "1" else 0.01
