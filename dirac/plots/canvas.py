@@ -32,7 +32,7 @@ def new_figure(width: float, height: float) -> Any:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(width, height), layout="constrained")
+    fig = Figure(figsize=(width, height))  # fixed margins: the constrained layout is slow with 3-D axes
     FigureCanvasAgg(fig)
     return fig
 

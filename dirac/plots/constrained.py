@@ -110,7 +110,7 @@ def constrained_figure(
     labels = _names(names, q.shape[1])
     errors = constrained_errors(energy, constraint_residual)
     fig = new_figure(13.0, 9.5)
-    grid = fig.add_gridspec(2, 2)
+    grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=0.12, top=0.93, wspace=0.2, hspace=0.3)
     if q.shape[1] >= 2:
         draw_configuration(fig.add_subplot(grid[0, 0]), q, labels)
         draw_coordinates(fig.add_subplot(grid[0, 1]), t, q, labels)

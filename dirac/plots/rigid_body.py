@@ -170,7 +170,15 @@ def draw_polhode(ax: Any, M: Any, inertia: Any, *, family: int = 8) -> None:
     ax.plot([], [], color="0.6", linewidth=0.8, label=r"sphere $|M|=G$ and other polhodes")
     _style_3d(ax, 1.05 * max(G, float(np.sqrt(2.0 * E * inertia.max()))), "M", _MOMENTUM_UNIT)
     ax.set_title("Polhode of $M$: sphere $\\cap$ energy ellipsoid", fontsize=11)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.02), ncol=2, fontsize=7, framealpha=0.8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=2, fontsize=7, framealpha=0.8)
+
+
+def _sparse(points: np.ndarray, max_angle: float = 0.35) -> bool:
+    """True when consecutive unit vectors are typically more than ``max_angle`` rad apart."""
+    if points.shape[0] < 3:
+        return False
+    cosines = np.clip(np.sum(points[1:] * points[:-1], axis=1), -1.0, 1.0)
+    return bool(np.median(np.arccos(cosines)) > max_angle)
 
 
 def draw_body_axes(ax: Any, R: Any, M: Any | None = None) -> None:
@@ -193,8 +201,11 @@ def draw_body_axes(ax: Any, R: Any, M: Any | None = None) -> None:
     ax.plot_wireframe(*sphere_mesh(1.0, 25), color="0.6", linewidth=0.3, alpha=0.35)
     for j in range(3):
         tips = R[:, :, j]
-        _sphere_curve(ax, tips, view, color=AXIS_COLOURS[j], linewidth=1.2,
-                      label=f"tip of body axis {j + 1} (moment $I_{j + 1}$)")
+        label = f"tip of body axis {j + 1} (moment $I_{j + 1}$)"
+        if _sparse(tips):  # samples too far apart for a line to mean anything: dots
+            ax.scatter(*tips.T, s=3, color=AXIS_COLOURS[j], alpha=0.6, depthshade=False, label=label)
+        else:
+            _sphere_curve(ax, tips, view, color=AXIS_COLOURS[j], linewidth=1.2, label=label)
         ax.scatter(*tips[0], color=AXIS_COLOURS[j], s=40, marker="o", edgecolor="black", depthshade=False)
     if M is not None:
         m = np.einsum("ij,j->i", R[0], np.asarray(M, dtype=float)[0])
@@ -210,7 +221,7 @@ def draw_body_axes(ax: Any, R: Any, M: Any | None = None) -> None:
     ax.zaxis.set_rotate_label(False)
     ax.set_zlabel("lab $z$", labelpad=2, rotation=90)
     ax.set_title("Body axes in the lab: columns of $R(t)$", fontsize=11)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.02), ncol=2, fontsize=7, framealpha=0.8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=2, fontsize=7, framealpha=0.8)
 
 
 def draw_conservation(ax: Any, t: Any, errors: dict[str, np.ndarray]) -> None:
@@ -239,18 +250,29 @@ def draw_conservation(ax: Any, t: Any, errors: dict[str, np.ndarray]) -> None:
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, framealpha=0.8)
 
 
-def draw_momentum(ax: Any, t: Any, M: Any) -> None:
-    """Draw the components ``M_i(t)`` of the body angular momentum against time."""
+def draw_momentum(ax: Any, t: Any, M: Any, max_samples: int = 150) -> None:
+    """Draw the components ``M_i(t)`` of the body angular momentum against time.
+
+    Long runs are shown over their first ``max_samples`` samples (named in the title), so
+    that the oscillations stay readable; the error panel covers the whole run.
+    """
     t = np.asarray(t, dtype=float)
     M = np.asarray(M, dtype=float)
+    shown = min(t.size, max_samples)
+    styles = ("-", "--", "-.")
     for j in range(3):
-        ax.plot(t, M[:, j], color=AXIS_COLOURS[j], linewidth=1.3, marker="." if t.size <= 200 else None,
-                markersize=3, label=f"$M_{j + 1}$")
+        ax.plot(t[:shown], M[:shown, j], color=AXIS_COLOURS[j], linestyle=styles[j], linewidth=1.4,
+                marker="." if shown <= 120 else None, markersize=3, label=f"$M_{j + 1}$")
     ax.set_xlabel("time $t$ [s]")
     ax.set_ylabel(f"body angular momentum [{_MOMENTUM_UNIT}]")
-    ax.set_title("Euler equations: $M(t)$ in the body frame", fontsize=11)
+    title = "Euler equations: $M(t)$ in the body frame"
+    if shown < t.size:
+        title += f" (first {t[shown - 1]:.4g} s of {t[-1]:.4g} s)"
+    ax.set_title(title, fontsize=11)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="best", ncol=3)
+    low, high = ax.get_ylim()
+    ax.set_ylim(low, high + 0.18 * (high - low))  # room for the legend above the curves
+    ax.legend(fontsize=8, loc="upper right", ncol=3, framealpha=0.8)
 
 
 def rigid_body_figure(
@@ -278,8 +300,8 @@ def rigid_body_figure(
         On an Agg canvas; save it with :func:`dirac.plots.save_png`.
     """
     t, M, R, inertia = _validate(t, M, R, inertia)
-    fig = new_figure(13.0, 11.0)
-    grid = fig.add_gridspec(2, 2)
+    fig = new_figure(13.0, 12.0)
+    grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=0.10, top=0.92, wspace=0.22, hspace=0.42)
     draw_polhode(fig.add_subplot(grid[0, 0], projection="3d"), M, inertia)
     if R is not None:
         draw_body_axes(fig.add_subplot(grid[0, 1], projection="3d"), R, M)
