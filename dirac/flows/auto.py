@@ -1,12 +1,14 @@
 """``method = "auto"``: pick the cheapest method that meets the tolerance.
 
 * Free rigid body: ``exact`` costs a fixed amount per output sample, whatever ``t_end``;
-  ``lie-poisson-8`` costs per step. A short pilot run of ``lie-poisson-8`` against the
-  exact flow measures its error constant; assuming the error grows linearly in time
-  (phase error of an integrable system) gives the step that meets ``tolerance`` at
-  ``t_end`` and so the number of steps. The cheaper of the two is chosen with the cost
-  ratio :data:`EXACT_SAMPLE_COST` (in units of one Strang sub-step). Dense, long outputs
-  (many samples per period) favour the splitting; sparse or very long ones the exact flow.
+  a splitting ``lie-poisson-p`` costs per step plus the sampling overhead of the loop.
+  For each ``p`` a short pilot run against the exact flow measures the error constant;
+  assuming linear growth in time (phase error of an integrable system) gives the step
+  that meets ``tolerance`` at ``t_end``. The cheapest wins, with the measured unit costs
+  below. With these costs the exact flow (about 0.2-0.5 us per sample) is cheaper than
+  sampling any stepping run (about 15 us per sample), so ``auto`` picks ``exact`` for the
+  free body at every sampling density; the splittings would win only if sampling were
+  moved into the compiled loop.
 * Heavy top and general systems: no exact reference, so each candidate of order ``p``
   (``lie-poisson-4/8`` resp. ``rattle-2/4``) is run over a pilot span with steps ``h`` and
   ``h/2``; Richardson's estimate ``|y_h - y_{h/2}| / (1 - 2^-p)`` with linear growth in
@@ -24,14 +26,16 @@ import numpy as np
 
 from dirac.flows.methods import get_method
 
-__all__ = ["AutoChoice", "choose_method", "EXACT_SAMPLE_COST"]
+__all__ = ["AutoChoice", "choose_method"]
 
-#: Cost of one exact sample (M and R) in units of one Strang sub-step of the splitting
-#: kernel (one rotation of M and R). Measured on this project's reference machine:
-#: exact state ~ 1.1 us per sample, one rotation sub-step ~ 0.011 us.
-EXACT_SAMPLE_COST = 100.0
-#: The same for an exact sample of M alone.
-EXACT_SAMPLE_COST_M = 40.0
+#: Measured costs (microseconds; ``python /tmp/cost*.py`` style timings on the reference
+#: machine, 2 cores): one exact sample of ``(M, R)`` / of ``M`` alone (vectorised
+#: elliptic functions), one rotation sub-step of the splitting kernel, and the sampling
+#: overhead of the fixed-step loop per output time (kernel call, guard rails, copy).
+EXACT_SAMPLE_US = 0.5
+EXACT_SAMPLE_M_US = 0.2
+SUBSTEP_US = 0.11
+LOOP_SAMPLE_US = 15.0
 
 
 @dataclass(frozen=True)
@@ -94,7 +98,7 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
             factor = (tolerance / (error * growth)) ** (1.0 / method.order)
         else:
             factor = 8.0
-        step = dt0 * min(8.0, 0.8 * factor)
+        step = dt0 * min(8.0, 0.5 * factor)
         stages = len(method.data) if isinstance(method.data, tuple) else len(method.data.coefficients)  # type: ignore[union-attr]
         cost = (t_end / step) * stages
         if cost < best_cost:
@@ -110,31 +114,34 @@ def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, 
     from dirac.flows.lie_poisson import exact_flow, needs_attitude
 
     with_R = needs_attitude(outputs)
-    exact_cost = samples * (EXACT_SAMPLE_COST if with_R else EXACT_SAMPLE_COST_M)
+    batch = problem.M0.shape[0]
+    exact_cost = batch * samples * (EXACT_SAMPLE_US if with_R else EXACT_SAMPLE_M_US)
+    floor = batch * samples * LOOP_SAMPLE_US  # no fixed-step run can cost less than its sampling
+    if floor >= exact_cost:
+        return AutoChoice("exact", None, f"the exact flow ({samples} samples, ~{exact_cost * 1e-6:.2g} s) costs less "
+                          "than sampling any time-stepping run", 0.0)
     omega = _frequency(problem)
     dt0 = 0.2 / omega
     span = min(t_end, 200 * dt0)
-    name = "lie-poisson-8"
-    method = get_method(name)
-    numeric = _pilot(name, problem, outputs, span, dt0, options)
     exact_M, exact_R = [], []
     for M0, R0 in zip(problem.M0, problem.R0):
         M, R = exact_flow(problem.inertia, M0, R0).state(np.array([span]))
         exact_M.append(M[0])
         exact_R.append(R[0].ravel())
     exact_state = np.concatenate(exact_M + (exact_R if with_R else []))
-    error = float(np.max(np.abs(numeric - exact_state)))
-    growth = t_end / span
-    floor = 1e-16 * math.sqrt(max(1.0, t_end / dt0)) * 10
-    if tolerance <= floor:
-        return AutoChoice("exact", None, f"tolerance {tolerance:g} is below the round-off floor of time stepping", 0.0)
-    factor = (tolerance / max(error * growth, 1e-300)) ** (1.0 / method.order)
-    step = dt0 * min(4.0, 0.8 * factor)
-    spacing = t_end / max(1, samples - 1)
-    steps = max(samples - 1, math.ceil(t_end / step))
-    sequence_length = 4 * len(method.data.coefficients) + 1  # type: ignore[union-attr]
-    split_cost = steps * sequence_length
-    if split_cost < exact_cost:
-        predicted = error * growth * (min(step, spacing) / dt0) ** method.order
-        return AutoChoice(name, step, f"dense output: {steps} steps of {name} cost less than {samples} exact samples", predicted)
-    return AutoChoice("exact", None, f"the exact flow ({samples} samples) costs less than {steps} steps of {name}", 0.0)
+    best = AutoChoice("exact", None, "the exact flow is the cheapest", 0.0)
+    best_cost = exact_cost
+    for name in ("lie-poisson-2", "lie-poisson-4", "lie-poisson-6", "lie-poisson-8"):
+        method = get_method(name)
+        error = float(np.max(np.abs(_pilot(name, problem, outputs, span, dt0, options) - exact_state)))
+        growth = t_end / span
+        factor = (tolerance / max(error * growth, 1e-300)) ** (1.0 / method.order)
+        step = dt0 * min(4.0, 0.5 * factor)
+        steps = max(samples - 1, math.ceil(t_end / step))
+        substeps = 4 * len(method.data.coefficients)  # type: ignore[union-attr]
+        cost = floor + batch * steps * substeps * SUBSTEP_US
+        if cost < best_cost:
+            best_cost = cost
+            best = AutoChoice(name, step, f"{steps} steps of {name} cost less than {samples} exact samples",
+                              error * growth * (step / dt0) ** method.order)
+    return best
