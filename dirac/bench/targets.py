@@ -188,8 +188,11 @@ def splitting_skip_target(repeats: int, n_steps: int) -> Target:
 
         run(["M"])
         run(["M", "R"])
-        both = median_of([run(["M", "R"]) for _ in range(repeats)])
-        only = median_of([run(["M"]) for _ in range(repeats)])
+        both, only = [], []
+        for _ in range(repeats):  # interleaved, so slow drifts of the machine hit both alike
+            both.append(run(["M", "R"]))
+            only.append(run(["M"]))
+        both, only = median_of(both), median_of(only)
     finally:
         quiet.__exit__(None, None, None)
     return Target("skipping: lie-poisson-2, M only vs M and R", both / only, "x", 1.1, ">=",
@@ -240,6 +243,8 @@ def batch_targets(repeats: int, n_bodies: int, n_steps: int, numpy_steps: int) -
         return M0.copy(), np.repeat(np.eye(3)[None], n_bodies, axis=0)
 
     compiled = time_call(lambda s: advance_batch(s[0], s[1], inv, dt, n_steps, (1.0,)), repeats, setup=state)
+    only_M = time_call(lambda s: advance_batch(s[0], s[1], inv, dt, n_steps, (1.0,), with_R=False), repeats,
+                       setup=state)
     plain = time_call(lambda s: advance_batch_numpy(s[0], s[1], inv, dt, numpy_steps, (1.0,)),
                       max(1, repeats // 2), setup=state)
     per = compiled.wall / (n_bodies * n_steps) * 1e9
@@ -251,7 +256,36 @@ def batch_targets(repeats: int, n_bodies: int, n_steps: int, numpy_steps: int) -
                f"(CPU {compiled.cpu / (n_bodies * n_steps) * 1e9:.1f} ns per body-step summed over threads)"),
         Target("batch: speed-up over plain numpy vectorisation", per_numpy / per, "x", 5.0, ">=",
                f"numpy {per_numpy:.0f} ns per body-step ({numpy_steps} steps, same bodies)"),
+        Target("skipping: batched lie-poisson-2, M only vs M and R", compiled.cpu / only_M.cpu, "x", 1.1, ">=",
+               f"CPU per body-step {compiled.cpu / (n_bodies * n_steps) * 1e9:.1f} ns (M, R) vs "
+               f"{only_M.cpu / (n_bodies * n_steps) * 1e9:.1f} ns (M)"),
     ]
+
+
+def batch_integrate_target(n_bodies: int, n_steps: int) -> Target:
+    """The same batch through :func:`dirac.flows.integrate` (the user-facing path)."""
+    from dirac.flows import RigidBodyProblem, integrate
+
+    rng = np.random.default_rng(0)
+    M0 = rng.normal(size=(n_bodies, 3))
+    quiet = _quiet()
+    try:
+        problem = RigidBodyProblem(_STANDARD_INERTIA, M0)
+        dt = 0.01
+
+        def run() -> tuple[float, float]:
+            w0 = time.perf_counter()
+            solution = integrate(problem, "lie-poisson-2", t_end=n_steps * dt, dt=dt, samples=1, outputs=["M", "R"])
+            return time.perf_counter() - w0, solution.cpu_seconds
+
+        run()
+        wall, cpu = run()
+    finally:
+        quiet.__exit__(None, None, None)
+    per = wall / (n_bodies * n_steps) * 1e9
+    return Target(f"batch via integrate: {n_bodies:.0e} bodies x {n_steps} lie-poisson-2 steps (ns per body-step)",
+                  per, "ns", 20.0, "<=", f"whole integrate call, wall {wall * 1e3:.0f} ms (loop CPU {cpu * 1e3:.0f} ms); "
+                  "the path a batched RigidBodyProblem takes today")
 
 
 # --------------------------------------------------------------------------- general systems
@@ -280,34 +314,48 @@ def _dirac_command() -> list[str]:
     return [sys.executable, "-m", "dirac"]
 
 
+_CHILD_CPU: list[float] = []
+
+
 def _wall(command: list[str], env: dict | None = None) -> tuple[float, int]:
+    """Wall time and exit status of a fresh process; its CPU time goes to ``_CHILD_CPU``."""
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     completed = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600)
-    return time.perf_counter() - start, completed.returncode
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    _CHILD_CPU.append((after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime))
+    return wall, completed.returncode
 
 
 def startup_targets(repeats: int, cold: bool) -> list[Target]:
     """``dirac --help`` and ``dirac demo`` wall time in fresh processes."""
     help_times = []
     _wall(_dirac_command() + ["--help"])
+    _CHILD_CPU.clear()
     for _ in range(max(3, repeats)):
         help_times.append(_wall(_dirac_command() + ["--help"])[0])
     targets = [Target("start-up: dirac --help (s)", median_of(help_times), "s", 0.3, "<=",
-                      f"wall time of a fresh process, median of {len(help_times)}")]
+                      f"wall time of a fresh process, median of {len(help_times)} "
+                      f"(its CPU time: {median_of(_CHILD_CPU):.3f} s)")]
     first, status = _wall(_dirac_command() + ["demo"])
     if status != 0:
         targets.append(Target("start-up: dirac demo, warm cache (s)", None, "s", 3.0, "<=",
                               f"'dirac demo' exited with status {status}; not measured"))
         return targets
+    _CHILD_CPU.clear()
     warm = median_of([_wall(_dirac_command() + ["demo"])[0] for _ in range(max(2, repeats // 2))])
-    detail = "wall time of a fresh process with compiled kernels cached on disk"
+    detail = f"wall time of a fresh process with compiled kernels cached on disk (CPU {median_of(_CHILD_CPU):.2f} s)"
     extra: dict = {}
     if cold:
         with tempfile.TemporaryDirectory(prefix="dirac-cold-") as scratch:
             env = dict(os.environ, NUMBA_CACHE_DIR=os.path.join(scratch, "numba"),
                        DIRAC_CACHE_DIR=os.path.join(scratch, "dirac"))
             cold_time, cold_status = _wall(_dirac_command() + ["demo"], env)
-        detail += f"; cold first run (empty numba and dirac caches) {cold_time:.1f} s"
+        detail += (f"; cold first run (empty numba and dirac caches) {cold_time:.1f} s wall, "
+                   f"{_CHILD_CPU[-1]:.1f} s CPU")
         extra = {"cold_s": cold_time, "cold_status": cold_status}
     else:
         detail += "; cold first run measured by the full run only"
@@ -339,6 +387,7 @@ def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], Non
     attempt("skipping R with splitting", lambda: splitting_skip_target(repeats, 100_000 if quick else 1_000_000))
     attempt("peak memory", lambda: memory_target(10_000, 1_000_000 if quick else 10_000_000))
     attempt("batched bodies", lambda: batch_targets(repeats, 100_000, 100, 5 if quick else 10))
+    attempt("batch through integrate", lambda: batch_integrate_target(1_000, 100))
     attempt("double pendulum", lambda: double_pendulum_target(3 if quick else 5, 20_000 if quick else 100_000))
     attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
     return targets, notes

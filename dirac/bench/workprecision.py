@@ -32,14 +32,16 @@ TIME_BUDGET = 0.6
 
 
 def _median_runs(run: Callable[[], dict], repeats: int) -> dict:
-    """One untimed warm-up run, then up to ``repeats`` runs; medians of their timings.
+    """One untimed warm-up run, then up to ``repeats`` timed runs; medians of their timings.
 
-    A run slower than ``TIME_BUDGET / repeats`` is repeated fewer times (at least once).
+    The number of timed runs is cut so that they take about ``TIME_BUDGET`` of CPU in
+    all (at least one), judged from the first timed run.
     """
-    first = run()
-    slow = max(first.get("call_cpu_s") or 0.0, first.get("cpu_s") or 0.0)
+    run()
+    results = [run()]
+    slow = max(results[0].get("call_cpu_s") or 0.0, results[0].get("cpu_s") or 0.0)
     repeats = max(1, min(int(repeats), int(TIME_BUDGET / max(slow, 1e-9))))
-    results = [run() for _ in range(repeats)]
+    results += [run() for _ in range(repeats - 1)]
     row = dict(results[-1])
     for key in ("cpu_s", "call_cpu_s", "wall_s"):
         values = [r[key] for r in results if r.get(key) is not None]
@@ -206,6 +208,8 @@ def run_constrained_case(case: ConstrainedCase, repeats: int, progress: Progress
                     dt=value if grid.parameter == "dt" else None,
                     tolerance=value if grid.parameter == "tolerance" else 1e-8,
                     samples=1, outputs=["q", "p", "constraint_residual"],
+                    # the baselines drift off the constraints: report it, do not stop them
+                    drift_limit=1e3 if grid.method.startswith("scipy-") else 1e-6,
                 )
                 call = time.process_time() - c0
                 q = solution.outputs["q"][-1]
