@@ -177,3 +177,49 @@ def write_plot(path: str | Path, rows: list[dict], title: str) -> None:
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
+
+
+def format_markdown(document: dict, problems: list[str] | None = None) -> str:
+    """Markdown tables (work–precision per problem, then the targets) of a bench JSON document."""
+    rows = document["runs"]
+    lines: list[str] = []
+    wanted = problems or list(dict.fromkeys(r["problem"] for r in rows))
+    for problem in wanted:
+        subset = [r for r in rows if r["problem"] == problem]
+        if not subset:
+            continue
+        rigid = any("error_M" in r for r in subset)
+        lines.append(f"\n#### {problem} (T = {subset[0]['t_end']:.6g})\n")
+        if rigid:
+            lines.append("| method | dt / tol | CPU ms | steps | f-evals | err M | err R | energy | \\|M\\|² | \\|RᵀR−1\\| |")
+            lines.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+            keys = ("error_M", "error_R", "energy_error", "casimir_error", "orthogonality_error")
+        else:
+            lines.append("| method | dt / tol | CPU ms | steps | f-evals | err q | err p | energy | constraint |")
+            lines.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+            keys = ("error_q", "error_p", "energy_error", "constraint_residual")
+        for r in subset:
+            value = "–" if r["value"] is None else f"{r['value']:g}"
+            if "failed" in r:
+                lines.append(f"| {r['method']} | {value} | failed: {r['failed']} |" + " |" * (len(keys) + 2))
+                continue
+            cells = [r["method"], value, f"{r['cpu_s'] * 1e3:.3f}", str(r["steps"]), str(r["evaluations"])]
+            cells += [_number(r.get(k), ".1e") for k in keys]
+            lines.append("| " + " | ".join(cells) + " |")
+    lines.append("\n### Targets\n")
+    lines.append("| figure | measured | target | status |")
+    lines.append("|---|---:|---:|---|")
+    for t in document["targets"]:
+        value = "–" if t["value"] is None else f"{t['value']:.3g} {t['unit']}"
+        if t["met"] is None:
+            status = "not measured"
+        elif t["met"]:
+            status = "met"
+        elif t["sense"] == "<=":
+            status = f"**missed** ({t['value'] / t['target']:.2f}× over)"
+        else:
+            status = f"**missed** ({t['target'] / t['value']:.2f}× short)"
+        lines.append(f"| {t['name']} | {value} | {t['sense']} {t['target']:g} {t['unit']} | {status} |")
+        if t.get("detail"):
+            lines.append(f"| ↳ {t['detail']} | | | |")
+    return "\n".join(lines)
