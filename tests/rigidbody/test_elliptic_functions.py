@@ -1,5 +1,5 @@
 """Jacobi functions and Carlson integrals (dirac.rigidbody.elliptic) against mpmath at
-40 digits, including the near-separatrix regime m -> 1 where scipy's ellipj degrades."""
+30 digits, including the near-separatrix regime m -> 1 where scipy's ellipj degrades."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from dirac.rigidbody.elliptic import (
     jacobi_sncndn,
 )
 
-mp.mp.dps = 40
+mp.mp.dps = 30
 
 
 @pytest.mark.parametrize("mc", [1.0, 0.7, 0.3, 1e-3, 1e-8, 1e-12, 1e-15, 0.0])
