@@ -7,9 +7,12 @@ Modules, one job each:
   (250)–(251), plus lean scipy right-hand sides for baselines;
 - :mod:`dirac.rigidbody.splitting` -- Lie–Poisson splitting methods (numba kernels,
   composition schemes as data);
+- :mod:`dirac.rigidbody.elliptic` -- Jacobi functions (accurate as ``m -> 1``) and Carlson's
+  symmetric integrals, as numba kernels;
 - :mod:`dirac.rigidbody.exact` -- the exact flow in Jacobi elliptic functions and an
   elliptic integral of the third kind;
-- :mod:`dirac.rigidbody.closed_forms` -- the paper's elementary solutions (165), (183).
+- :mod:`dirac.rigidbody.closed_forms` -- the paper's elementary solutions (165), (183);
+- :mod:`dirac.rigidbody.batch` -- many bodies at once with the 3-term splitting.
 
 Heavy modules (numba, scipy) are imported only when used; importing this package is cheap.
 """

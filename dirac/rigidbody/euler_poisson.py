@@ -7,7 +7,8 @@ and the Casimir ``|M|^2``. A flat state is ``y = concatenate([M, R.ravel()])``
 (12 floats, ``R`` row-major).
 
 The ``lean_rhs_*`` functions are written in plain float arithmetic for scipy's
-``solve_ivp`` baselines (about 3.5 times cheaper per call than ``np.cross`` versions).
+``solve_ivp`` baselines: about 5 µs per call against about 45 µs for the numpy version
+:func:`euler_poisson_rhs` (``np.cross``, ``concatenate``), measured on the 2-core machine.
 """
 
 from __future__ import annotations
