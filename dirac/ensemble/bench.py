@@ -110,7 +110,6 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
         )
         client = Client(cluster)
         try:
-            run_ensemble(warm, root / "warm-dask", chunk_size=1, client=client)  # one chunk per worker
             best = min(run_ensemble(scene, root / f"dask-{i}", client=client).seconds for i in range(repeats))
         finally:
             client.close()

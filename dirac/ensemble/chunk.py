@@ -15,7 +15,7 @@ import numpy as np
 from dirac.ensemble.reductions import make_reductions
 from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
 
-__all__ = ["advance_members", "compute_chunk", "KERNEL_LOCK"]
+__all__ = ["advance_members", "compute_chunk", "warm_up", "KERNEL_LOCK"]
 
 #: Serialises the parallel kernel within one process: numba's default ("workqueue")
 #: threading layer must not be entered by two threads at once (threaded dask workers),
@@ -23,7 +23,7 @@ __all__ = ["advance_members", "compute_chunk", "KERNEL_LOCK"]
 KERNEL_LOCK = threading.Lock()
 
 #: Member-steps below which one kernel call runs single-threaded (a few ms of work).
-PARALLEL_WORK = 100_000
+PARALLEL_WORK = 20_000
 
 
 def advance_members(
@@ -66,7 +66,12 @@ def _threads_for(work_per_call: int):
         numba.set_num_threads(threads)
 
 
-def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.ndarray]:
+def compute_chunk(
+    scene: EnsembleScene,
+    start: int,
+    stop: int,
+    members: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> dict[str, np.ndarray]:
     """Integrate members ``start .. stop-1`` of ``scene`` and return their arrays.
 
     The members are drawn (:meth:`MemberSource.members`), advanced over the sample grid
@@ -79,6 +84,8 @@ def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.n
     scene : EnsembleScene
     start, stop : int
         Member range.
+    members : tuple of numpy.ndarray, optional
+        ``scene.source.members(start, stop)`` if already drawn (e.g. prefetched).
 
     Returns
     -------
@@ -86,7 +93,7 @@ def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.n
         Array name -> array with ``stop - start`` rows (trajectory outputs have shape
         ``(n, samples, ...)``, reductions ``(n, ...)``).
     """
-    M, R, inertia = scene.source.members(start, stop)
+    M, R, inertia = scene.source.members(start, stop) if members is None else members
     inv = np.ascontiguousarray(1.0 / inertia)
     n = stop - start
     times = scene.times()
@@ -120,3 +127,11 @@ def compute_chunk(scene: EnsembleScene, start: int, stop: int) -> dict[str, np.n
     for reduction in reductions:
         results.update(reduction.result())
     return results
+
+
+def warm_up() -> None:
+    """Load the compiled kernels in this process (a tiny advance; e.g. on dask workers)."""
+    from dirac.rigidbody.splitting import SCHEMES
+
+    M = np.array([[0.0, 1.0, 0.1]])
+    advance_members(M, np.eye(3)[None].copy(), np.ones((1, 3)), 0.1, 1, SCHEMES["lie-poisson-2"].coefficients, True)

@@ -29,7 +29,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from dirac.ensemble.chunk import compute_chunk
+from dirac.ensemble.chunk import compute_chunk, warm_up
 from dirac.ensemble.scene import EnsembleScene, load_ensemble_scene
 from dirac.ensemble.store import FORMAT, EnsembleStore, array_layout
 from dirac.errors import InputError
@@ -380,14 +380,23 @@ def _run_local(scene, store, missing, chunk_size, run_id, retries, record) -> No
             record(marker, index, None)
 
     pending = None
-    with ThreadPoolExecutor(max_workers=1) as writer:
-        for index in missing:
-            start, stop = chunk_bounds(scene.count, chunk_size, index)
+    bounds = [chunk_bounds(scene.count, chunk_size, index) for index in missing]
+    with ThreadPoolExecutor(max_workers=1) as writer, ThreadPoolExecutor(max_workers=1) as drawer:
+        # draw the next chunk's members while this one is integrated (numpy's generators
+        # and array operations release the GIL)
+        upcoming = drawer.submit(scene.source.members, *bounds[0]) if bounds else None
+        for position, index in enumerate(missing):
+            start, stop = bounds[position]
+            try:
+                members = upcoming.result()
+            except Exception:  # noqa: BLE001 -- drawn again below, where errors are counted
+                members = None
+            upcoming = drawer.submit(scene.source.members, *bounds[position + 1]) if position + 1 < len(bounds) else None
             error = None
             for attempt in range(retries + 1):
                 try:
                     wall, cpu = time.perf_counter(), time.process_time()
-                    arrays = compute_chunk(scene, start, stop)
+                    arrays = compute_chunk(scene, start, stop, members if attempt == 0 else None)
                     timing = {"seconds": time.perf_counter() - wall, "cpu_seconds": time.process_time() - cpu}
                     break
                 except Exception as exc:  # noqa: BLE001 -- retried, then reported
@@ -426,6 +435,7 @@ def _run_dask(scene, store, missing, chunk_size, run_id, retries, record, *, sch
                     host="127.0.0.1", dashboard_address=":0",
                 )
                 client = own_client = Client(own_cluster)
+        client.run(warm_up)  # load the kernels in every worker before the clock starts
         dashboard = _dashboard(client)
         if dashboard:
             say(f"dask dashboard: {dashboard}")

@@ -56,13 +56,13 @@ def test_failed_chunk_is_retried_reported_and_recomputed_on_resume(write_scene, 
     calls: dict[int, int] = {}
     real = engine.compute_chunk
 
-    def flaky(scene_, start, stop):
+    def flaky(scene_, start, stop, members=None):
         calls[start] = calls.get(start, 0) + 1
         if start == 20 and calls[start] == 1:
             raise RuntimeError("transient")  # fails once: the retry succeeds
         if start == 60:
             raise RuntimeError("always broken")
-        return real(scene_, start, stop)
+        return real(scene_, start, stop, members)
 
     monkeypatch.setattr(engine, "compute_chunk", flaky)
     out = tmp_path / "run"
