@@ -19,6 +19,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
 
+import numpy as np
 import sympy
 
 from dirac.errors import InputError
@@ -33,6 +34,8 @@ __all__ = [
     "constraint_index_pairs",
     "inertia_symbols",
     "ValidatedLagrangian",
+    "surface_point",
+    "multipliers_221",
 ]
 
 #: default principal moments: an admissible (physical) asymmetric body, g = (5/2, 3/2, 1/2)
@@ -199,3 +202,50 @@ def system() -> Lagrangian:
         "free rigid body, rotation-matrix Lagrangian (78)",
         validator=_validate_fixed_inertia,
     )
+
+
+def _hat(w: np.ndarray) -> np.ndarray:
+    """``hat(w) v = w x v`` (PHYSICS.md §2)."""
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def multipliers_221(angular_velocity: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    """The multipliers on the constraint surface, (221):
+    ``lambda_ij = 2 g_i g_j/(g_i + g_j) [|Omega|^2 delta_ij - Omega_i Omega_j]``.
+
+    Returns the symmetric 3x3 matrix ``lambda``.
+    """
+    omega = np.asarray(angular_velocity, dtype=float)
+    g = np.array(check_inertia(*(float(v) for v in inertia)))
+    weight = 2 * np.outer(g, g) / np.add.outer(g, g)
+    return weight * (omega @ omega * np.eye(3) - np.outer(omega, omega))
+
+
+def surface_point(rotation: np.ndarray, angular_velocity: np.ndarray, inertia: np.ndarray) -> dict[str, float]:
+    """The point of the constraint surface (217) of (78) with attitude ``R`` and body
+    angular velocity ``Omega``, written by hand from the paper.
+
+    ``p = R_dot g`` (205) with ``R_dot = R hat(Omega)`` (225), the multipliers from
+    (221), ``pi = 0`` (206); the moments ``I_1, I_2, I_3`` are included.
+
+    Parameters
+    ----------
+    rotation
+        A rotation matrix (``R^T R = 1``).
+    angular_velocity
+        ``Omega`` in the body.
+    inertia
+        ``(I_1, I_2, I_3)`` satisfying the triangle inequality strictly.
+    """
+    R = np.asarray(rotation, dtype=float)
+    omega = np.asarray(angular_velocity, dtype=float)
+    g = np.array(check_inertia(*(float(v) for v in inertia)))
+    p = R @ _hat(omega) @ np.diag(g)
+    lam = multipliers_221(omega, inertia)
+    point = {f"R_{i + 1}{j + 1}": R[i, j] for i in range(3) for j in range(3)}
+    point.update({f"p_R_{i + 1}{j + 1}": p[i, j] for i in range(3) for j in range(3)})
+    for k, (i, j) in enumerate(_PAIRS, start=1):
+        point[f"lambda_{k}"] = lam[i - 1, j - 1]
+        point[f"p_lambda_{k}"] = 0.0
+    point.update({f"I_{k + 1}": float(inertia[k]) for k in range(3)})
+    return {name: float(value) for name, value in point.items()}

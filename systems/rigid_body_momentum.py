@@ -15,20 +15,23 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import numpy as np
 import sympy
 
 from dirac.errors import InputError, warn
 from dirac.lagrangian import Lagrangian
 from dirac_systems.rigid_body_matrix import (
+    _PAIRS,
     DEFAULT_INERTIA,
     ValidatedLagrangian,
+    _hat,
     inertia_symbols,
     mass_matrix_from_inertia,
     orthogonality_constraints,
     rotation_symbols,
 )
 
-__all__ = ["system", "body_angular_momentum"]
+__all__ = ["system", "body_angular_momentum", "surface_point", "multipliers_on_surface"]
 
 
 def body_angular_momentum(R: sympy.Matrix, R_dot: sympy.Matrix, inertia) -> sympy.Matrix:  # noqa: ANN001, N803
@@ -101,3 +104,41 @@ def system() -> Lagrangian:
         "free rigid body, angular-momentum Lagrangian (228)",
         validator=_validate_fixed_inertia,
     )
+
+
+def multipliers_on_surface(angular_momentum: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    """The multipliers of (228) on its constraint surface (derived by hand, Sect. XI).
+
+    ``dP_ab/dt = {P_ab, H} = 0`` with ``v = 0`` (fixed by ``d(R^T R)/dt = 0``) and the
+    brackets (237), ``{P_ab, R_ki R_kj} = -2 (delta_ia delta_jb + delta_ib delta_ja)`` on
+    ``R^T R = 1``, give
+
+        lambda_ab = (M . Omega) delta_ab - (Omega_a M_b + Omega_b M_a)/2,  Omega = I^{-1} M.
+
+    (They differ from (221) of the Lagrangian (78); Appendix 2 relates the two.)
+    """
+    M = np.asarray(angular_momentum, dtype=float)
+    omega = M / np.asarray(inertia, dtype=float)
+    return (M @ omega) * np.eye(3) - (np.outer(omega, M) + np.outer(M, omega)) / 2
+
+
+def surface_point(rotation: np.ndarray, angular_velocity: np.ndarray, inertia: np.ndarray) -> dict[str, float]:
+    """The point of the constraint surface of (228) with attitude ``R`` and body angular
+    velocity ``Omega``, written by hand from the paper.
+
+    ``M = I Omega``, ``p = -1/2 R eps·M = 1/2 R hat(M)`` (229), so ``P = 0`` (230) and
+    ``M = -eps (R^T p)`` (233); multipliers from :func:`multipliers_on_surface`;
+    ``pi = 0``. The moments ``I_1, I_2, I_3`` are included.
+    """
+    R = np.asarray(rotation, dtype=float)
+    inertia = np.asarray(inertia, dtype=float)
+    M = inertia * np.asarray(angular_velocity, dtype=float)
+    p = 0.5 * R @ _hat(M)
+    lam = multipliers_on_surface(M, inertia)
+    point = {f"R_{i + 1}{j + 1}": R[i, j] for i in range(3) for j in range(3)}
+    point.update({f"p_R_{i + 1}{j + 1}": p[i, j] for i in range(3) for j in range(3)})
+    for k, (i, j) in enumerate(_PAIRS, start=1):
+        point[f"lambda_{k}"] = lam[i - 1, j - 1]
+        point[f"p_lambda_{k}"] = 0.0
+    point.update({f"I_{k + 1}": float(inertia[k]) for k in range(3)})
+    return {name: float(value) for name, value in point.items()}
