@@ -90,6 +90,10 @@ def test_case_list_covers_both_polhode_families_and_orderings():
     assert families >= {-1, 1}
     orders = {tuple(np.argsort(I)) for _, I, _, _ in CASES}
     assert len(orders) == 6
+    # both choices of the Euler-angle axis b (p3 or p1) of ExactRigidBodyFlow occur
+    flows = [_flow(I, M0) for _, I, M0, _ in CASES]
+    axes_b = {("p3" if f._perm[3] == f._perm[2] else "p1") for f in flows if not f.equilibrium}
+    assert axes_b == {"p1", "p3"}
 
 
 def test_standard_case_reference_values():
