@@ -130,7 +130,10 @@ def compute_chunk(
 
 
 def warm_up() -> None:
-    """Load the compiled kernels in this process (a tiny advance; e.g. on dask workers)."""
+    """Load the compiled kernels and the store's modules in this process (a tiny advance;
+    e.g. on dask workers, before timing)."""
+    import zarr  # noqa: F401 -- imported by the first chunk write otherwise
+
     from dirac.rigidbody.splitting import SCHEMES
 
     M = np.array([[0.0, 1.0, 0.1]])
