@@ -117,6 +117,7 @@ def constrained_figure(
     else:
         draw_coordinates(fig.add_subplot(grid[0, :]), t, q, labels)
     if errors:
-        draw_conservation(fig.add_subplot(grid[1, :]), t, errors)
+        draw_conservation(fig.add_subplot(grid[1, :]), t, errors,
+                          ylabel="largest error so far (energy: relative; residual: system units)")
     fig.suptitle(title or "Constrained system", fontsize=12)
     return fig

@@ -9,7 +9,7 @@ constrained-system picture (:func:`dirac.plots.constrained.constrained_figure`).
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -79,7 +79,7 @@ def _title(meta: Mapping[str, Any], default: str) -> str:
     return ",  ".join(parts)
 
 
-def result_figure(result: Any) -> Any:
+def result_figure(result: Any, coordinates: Sequence[str] | None = None) -> Any:
     """The picture of one run (see the module docstring); returns a matplotlib Figure.
 
     Parameters
@@ -88,6 +88,8 @@ def result_figure(result: Any) -> Any:
         Anything with the outputs of CONTRACTS §7 by name (``t`` and ``M``/``R`` or
         ``q``/``energy``/``constraint_residual``) and a ``meta`` record (dict, JSON
         string, or a ``meta()`` method). A batched result is drawn for its first state.
+    coordinates : sequence of str, optional
+        Names of the coordinates ``q`` (default: ``meta["coordinates"]``, else ``q_1 …``).
 
     Raises
     ------
@@ -115,18 +117,18 @@ def result_figure(result: Any) -> Any:
         residual = (
             _first_body(_get(result, "constraint_residual"), 1) if _has(result, "constraint_residual") else None
         )
-        names = meta.get("coordinates")
+        names = list(coordinates) if coordinates is not None else meta.get("coordinates")
         return constrained_figure(t, q, energy=energy, constraint_residual=residual, names=names,
                                   title=_title(meta, "constrained system"))
     raise InputError("the result has neither 'M' (rigid body) nor 'q' (constrained system) among its outputs: "
                      "add \"M\" or \"q\" to outputs in the scene's [run] table to draw it")
 
 
-def plot_result(result: Any, path: str | Path) -> Path:
+def plot_result(result: Any, path: str | Path, coordinates: Sequence[str] | None = None) -> Path:
     """Draw ``result`` (see :func:`result_figure`) and write it to the PNG file ``path``.
 
     ``path`` is checked before any drawing, so a bad name fails fast.
     """
     target = check_png_path(path)
-    fig = result_figure(result)
+    fig = result_figure(result, coordinates)
     return save_png(fig, target)

@@ -224,7 +224,9 @@ def draw_body_axes(ax: Any, R: Any, M: Any | None = None) -> None:
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=2, fontsize=7, framealpha=0.8)
 
 
-def draw_conservation(ax: Any, t: Any, errors: dict[str, np.ndarray]) -> None:
+def draw_conservation(
+    ax: Any, t: Any, errors: dict[str, np.ndarray], ylabel: str = "largest relative error so far (dimensionless)"
+) -> None:
     """Draw the errors of conserved quantities against time on a logarithmic axis.
 
     Each curve is the running maximum ``max_{s <= t} err(s)`` (the largest error so far),
@@ -242,7 +244,7 @@ def draw_conservation(ax: Any, t: Any, errors: dict[str, np.ndarray]) -> None:
     ax.annotate("double-precision round-off $2.2\\times10^{-16}$", (1.0, eps), xycoords=("axes fraction", "data"),
                 xytext=(-4, 3), textcoords="offset points", ha="right", fontsize=7, color="0.35")
     ax.set_xlabel("time $t$ [s]")
-    ax.set_ylabel("largest relative error so far (dimensionless)")
+    ax.set_ylabel(ylabel)
     ax.set_title("Conserved quantities: error over time", fontsize=11)
     low, high = ax.get_ylim()
     ax.set_ylim(min(low, 1e-17), max(high, 1e-14))
