@@ -49,7 +49,8 @@ __all__ = [
 #: Fixed-point scale of the Taylor integrator: numbers are integers times 2**-FRACTION_BITS.
 FRACTION_BITS = 124
 _ONE = 1 << FRACTION_BITS
-_REFERENCE_VERSION = 1
+_FLOOR = 2.0 ** (8 - FRACTION_BITS)  # coefficient sizes below this are not resolved
+_REFERENCE_VERSION = 2
 
 
 def cache_directory() -> Path:
@@ -144,10 +145,14 @@ def taylor_rigid_body(
         target = Fraction(float(target))
         while t < target:
             coeffs = _taylor_step(y, a, order)
-            size = [max(abs(v) for v in coeffs[k]) / _ONE for k in (order - 1, order)]
+            # the last two terms set h; coefficients that fall below the fixed-point grid
+            # are floored (else h would be unbounded), and h stays below 2 / |Omega|
+            size = [max(max(abs(v) for v in coeffs[k]) / _ONE, _FLOOR) for k in (order - 1, order)]
+            omega = max(abs(y[i] * a[i]) for i in range(3)) / _ONE / _ONE * math.sqrt(3.0)
             h_float = min(
-                (tol / max(size[0], 1e-300)) ** (1.0 / (order - 1)),
-                (tol / max(size[1], 1e-300)) ** (1.0 / order),
+                (tol / size[0]) ** (1.0 / (order - 1)),
+                (tol / size[1]) ** (1.0 / order),
+                2.0 / max(omega, 1e-300),
             )
             h = Fraction(h_float).limit_denominator(1 << 40)
             if t + h >= target:

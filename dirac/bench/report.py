@@ -140,6 +140,9 @@ _STYLE = {
     "exact": ("black", "*"),
     "scipy-RK45": ("tab:gray", "x"),
     "scipy-DOP853": ("tab:brown", "+"),
+    "lie-poisson-sym-4": ("tab:olive", "s"),
+    "lie-poisson-sym-6": ("tab:cyan", "^"),
+    "lie-poisson-sym-8": ("tab:pink", "D"),
     "rattle-2": ("tab:blue", "o"),
     "rattle-4": ("tab:orange", "s"),
 }
@@ -163,8 +166,9 @@ def write_plot(path: str | Path, rows: list[dict], title: str) -> None:
             points = sorted(((max(r["error"], 1e-17), r["cpu_s"]) for r in subset if r["method"] == method),
                             key=lambda p: p[1])
             colour, marker = _STYLE.get(method, (None, "o"))
+            style = "--" if "-sym-" in method else ("-." if method.startswith("scipy-") else "-")
             axis.loglog([p[0] for p in points], [max(p[1], 1e-7) for p in points], marker=marker, color=colour,
-                        label=method, linewidth=1.2, markersize=5)
+                        label=method, linewidth=1.2, markersize=5, linestyle=style)
         axis.axvline(1e-9, color="0.7", linewidth=0.8, linestyle="--")
         axis.set_xlabel("global error at T (max over M, R / q, p)")
         axis.set_ylabel("CPU time [s]")

@@ -102,3 +102,14 @@ def test_double_pendulum_angle_equations_follow_from_the_lagrangian():
         got = _double_pendulum_angles_rhs(0.0, point, m1, m2, l1, l2, g)
         np.testing.assert_allclose(got[:2], point[2:], rtol=0, atol=0)
         np.testing.assert_allclose(got[2:], expected, rtol=1e-12)
+
+
+def test_taylor_reference_stays_accurate_when_the_series_underflows():
+    # Regression (bench separatrix case): for a steady rotation about the middle axis the
+    # high Taylor coefficients fall below the fixed-point grid; the step size must stay
+    # bounded. M = (0, 1, 0), I = (1, 2, 3): Omega = (0, 1/2, 0), R(t) = rotation about y
+    # by t/2 (paper (133)-(165) with the axes relabelled).
+    M, R = taylor_rigid_body([1.0, 2.0, 3.0], [0.0, 1.0, 0.0], np.eye(3), [100.0])
+    c, s = math.cos(50.0), math.sin(50.0)
+    np.testing.assert_allclose(R[0], [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]], atol=1e-15)
+    np.testing.assert_allclose(M[0], [0.0, 1.0, 0.0], atol=1e-30)
