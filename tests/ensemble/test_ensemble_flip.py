@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from dirac.ensemble.chunk import compute_chunk
 from dirac.ensemble.engine import run_ensemble
