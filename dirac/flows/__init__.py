@@ -3,7 +3,8 @@ result files.
 
 Public names (imported on first use, so ``import dirac.flows`` stays cheap):
 :func:`integrate`, :class:`Solution`, :class:`RigidBodyProblem`, :class:`HeavyTopProblem`,
-:class:`ConstrainedProblem`, :class:`MechanicalSystem`, :func:`load_scene`,
+:class:`ConstrainedProblem`, :class:`MechanicalSystem`, :class:`AnalysedSystem`,
+:class:`AnalysedProblem`, :func:`load_scene`, :func:`scene_from_dict`,
 :func:`write_results`, :func:`read_results`, :func:`get_method`, :func:`method_names`.
 """
 
@@ -20,6 +21,8 @@ _LAZY = {
     "HeavyTopProblem": "dirac.flows.problem",
     "ConstrainedProblem": "dirac.flows.problem",
     "MechanicalSystem": "dirac.flows.mechanics",
+    "AnalysedSystem": "dirac.flows.analysed",
+    "AnalysedProblem": "dirac.flows.analysed",
     "load_scene": "dirac.flows.scene",
     "scene_from_dict": "dirac.flows.scene",
     "write_results": "dirac.flows.results",

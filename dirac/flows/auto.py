@@ -9,8 +9,8 @@
   sampling any stepping run (about 15 us per sample), so ``auto`` picks ``exact`` for the
   free body at every sampling density; the splittings would win only if sampling were
   moved into the compiled loop.
-* Heavy top and general systems: no exact reference, so each candidate of order ``p``
-  (``lie-poisson-4/8`` resp. ``rattle-2/4``) is run over a pilot span with steps ``h`` and
+* Heavy top, general and analysed systems: no exact reference, so each candidate of
+  order ``p`` (``lie-poisson-4/8``, ``rattle-2/4``, resp. ``midpoint``) is run over a pilot span with steps ``h`` and
   ``h/2``; Richardson's estimate ``|y_h - y_{h/2}| / (1 - 2^-p)`` with linear growth in
   time gives the step for ``tolerance``; the cheaper candidate wins.
 
@@ -49,6 +49,8 @@ class AutoChoice:
 
 
 def _state(stepper) -> np.ndarray:  # noqa: ANN001
+    if hasattr(stepper, "analysed"):
+        return stepper.z.ravel().copy()
     if hasattr(stepper, "q"):
         return np.concatenate([stepper.q.ravel(), stepper.p.ravel()])
     parts = [stepper.M.ravel()]
@@ -82,6 +84,9 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
         if weight > 0:
             scale = min(scale, 1.0 / math.sqrt(weight / float(np.min(problem.inertia))))
         dt0 = dt if dt is not None else 0.05 * scale
+    elif kind == "analysed":
+        candidates = ("midpoint",)
+        dt0 = dt if dt is not None else t_end / 1000.0
     else:
         candidates = ("rattle-2", "rattle-4")
         dt0 = dt if dt is not None else t_end / 1000.0
@@ -99,7 +104,10 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
         else:
             factor = 8.0
         step = dt0 * min(8.0, 0.5 * factor)
-        stages = len(method.data) if isinstance(method.data, tuple) else len(method.data.coefficients)  # type: ignore[union-attr]
+        if method.data is None:
+            stages = 1
+        else:
+            stages = len(method.data) if isinstance(method.data, tuple) else len(method.data.coefficients)  # type: ignore[union-attr]
         cost = (t_end / step) * stages
         if cost < best_cost:
             best_cost = cost

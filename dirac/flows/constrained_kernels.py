@@ -42,6 +42,10 @@ GRAD_POTENTIAL = 3
 CONSTRAINTS = 4
 CONSTRAINT_JACOBIAN = 5
 CONSTRAINT_HESSIAN = 6
+#: the same tuple layout for an analysed system (padded to 7 with the gradient)
+ANALYSED_GRADIENT = 0
+ANALYSED_CONSTRAINTS = 1
+ANALYSED_JACOBIAN = 2
 FUNCTION_NAMES = ("mass", "mass_derivative", "potential", "grad_potential", "constraints",
                   "constraint_jacobian", "constraint_hessian")
 
@@ -467,29 +471,105 @@ def dirac_field(fns, z, params, n, m, out):
                     t += W[i, a] * dm[k, i, j] * v[j]
             D[m + a, k] = s - t
             D[m + a, n + k] = W[k, a]
-    C = np.empty((2 * m, 2 * m))
-    rhs = np.empty(2 * m)
-    for a in range(2 * m):
-        acc = 0.0
-        for k in range(n):
-            acc += D[a, k] * out[k] + D[a, n + k] * out[n + k]
-        rhs[a] = acc
-        for b in range(2 * m):
-            c = 0.0
-            for k in range(n):
-                c += D[a, k] * D[b, n + k] - D[a, n + k] * D[b, k]
-            C[a, b] = c
-    mu = _solve_vec(C, rhs)
-    for b in range(2 * m):
-        for k in range(n):
-            out[k] -= mu[b] * D[b, n + k]
-            out[n + k] += mu[b] * D[b, k]
+    _dirac_projection(D, n, 2 * m, out)
 
 
 @numba.njit(cache=True)
-def midpoint_run(fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
-    """Implicit midpoint z1 = z0 + dt F((z0 + z1)/2) on the Dirac vector field F;
-    simplified Newton with a finite-difference Jacobian of F at z0 per step."""
+def _dirac_projection(D, n, k, out):
+    """out <- out - J D^T C^{-1} (D out), C = D J D^T: the Dirac correction (240) of the
+    Hamiltonian vector field ``out = J grad H`` over k second-class constraints whose
+    gradients are the rows of D (columns: n coordinates, then n momenta)."""
+    C = np.empty((k, k))
+    rhs = np.empty(k)
+    for a in range(k):
+        acc = 0.0
+        for j in range(n):
+            acc += D[a, j] * out[j] + D[a, n + j] * out[n + j]
+        rhs[a] = acc
+        for b in range(k):
+            c = 0.0
+            for j in range(n):
+                c += D[a, j] * D[b, n + j] - D[a, n + j] * D[b, j]
+            C[a, b] = c
+    mu = _solve_vec(C, rhs)
+    for b in range(k):
+        for j in range(n):
+            out[j] -= mu[b] * D[b, n + j]
+            out[n + j] += mu[b] * D[b, j]
+
+
+@numba.njit(cache=True)
+def analysed_field(fns, z, params, n, k, out):
+    """z_dot = {z, H}_D on the full phase space of a Dirac–Bergmann analysis
+    (coordinates and multipliers, then their momenta; 2n variables): J grad H corrected
+    over the k second-class constraints (240); C is evaluated and solved at z.
+    ``fns[ANALYSED_GRADIENT]`` gives grad H (2n,), ``fns[ANALYSED_CONSTRAINTS]`` the
+    constraints (k,), ``fns[ANALYSED_JACOBIAN]`` their gradients (k, 2n)."""
+    N = 2 * n
+    g = np.empty(N)
+    fns[ANALYSED_GRADIENT](z, params, g)
+    for i in range(n):
+        out[i] = g[n + i]
+        out[n + i] = -g[i]
+    if k == 0:
+        return
+    flat = np.empty(k * N)
+    fns[ANALYSED_JACOBIAN](z, params, flat)
+    _dirac_projection(flat.reshape((k, N)), n, k, out)
+
+
+@numba.njit(cache=True)
+def _project_analysed(fns, z, params, N, k, tol):
+    """Orthogonal projection of z onto Phi = 0 (Gauss-Newton, a few iterations):
+    z <- z - D^T (D D^T)^{-1} Phi(z). Used after each midpoint step of an analysed system,
+    whose later-stage constraints are not quadratic and so not kept by the midpoint rule."""
+    if k == 0:
+        return
+    phi = np.empty(k)
+    flat = np.empty(k * N)
+    for it in range(5):
+        fns[ANALYSED_CONSTRAINTS](z, params, phi)
+        size = 0.0
+        scale = 1.0
+        for a in range(k):
+            size = max(size, abs(phi[a]))
+        for i in range(N):
+            scale = max(scale, abs(z[i]))
+        if size <= tol * scale:
+            return
+        fns[ANALYSED_JACOBIAN](z, params, flat)
+        D = flat.reshape((k, N))
+        A = np.empty((k, k))
+        for a in range(k):
+            for b in range(k):
+                acc = 0.0
+                for i in range(N):
+                    acc += D[a, i] * D[b, i]
+                A[a, b] = acc
+        y = _solve_vec(A, phi)
+        for i in range(N):
+            acc = 0.0
+            for a in range(k):
+                acc += D[a, i] * y[a]
+            z[i] -= acc
+
+
+@numba.njit(cache=True)
+def _field(kind, fns, z, params, n, m, out):
+    if kind == 0:
+        dirac_field(fns, z, params, n, m, out)
+    else:
+        analysed_field(fns, z, params, n, m, out)
+
+
+@numba.njit(cache=True)
+def midpoint_run(kind, fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
+    """Implicit midpoint z1 = z0 + dt F((z0 + z1)/2) on a Dirac vector field F
+    (kind 0: :func:`dirac_field` of a mechanical system, n coordinates and m holonomic
+    constraints; kind 1: :func:`analysed_field`, 2n phase-space variables and m
+    second-class constraints, projected back onto Phi = 0 after each step since the
+    later-stage constraints are not quadratic); simplified Newton with a
+    finite-difference Jacobian of F at z0 per step."""
     N = 2 * n
     f = np.empty(N)
     fz = np.empty(N)
@@ -501,13 +581,13 @@ def midpoint_run(fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
     evals = 0.0
     size = 0.0
     for step in range(n_steps):
-        dirac_field(fns, z, params, n, m, f)
+        _field(kind, fns, z, params, n, m, f)
         evals += 1.0
         for j in range(N):
             zz[:] = z
             d = 1e-7 * (1.0 + abs(z[j]))
             zz[j] += d
-            dirac_field(fns, zz, params, n, m, fz)
+            _field(kind, fns, zz, params, n, m, fz)
             for i in range(N):
                 J[i, j] = -0.5 * dt * (fz[i] - f[i]) / d
             J[j, j] += 1.0
@@ -518,7 +598,7 @@ def midpoint_run(fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
         for it in range(max_iter):
             for i in range(N):
                 zm[i] = 0.5 * (z[i] + z1[i])
-            dirac_field(fns, zm, params, n, m, fz)
+            _field(kind, fns, zm, params, n, m, fz)
             evals += 1.0
             for i in range(N):
                 r[i] = z1[i] - z[i] - dt * fz[i]
@@ -543,6 +623,8 @@ def midpoint_run(fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
             info[3] = size
             return
         z[:] = z1
+        if kind == 1:
+            _project_analysed(fns, z, params, N, m, tol)
     info[0] = n_steps
     info[1] = 0.0
     info[2] = evals

@@ -43,6 +43,7 @@ DEFAULT_OUTPUTS = {
     "rigid_body": ("M", "R", "energy"),
     "heavy_top": ("M", "R", "energy"),
     "constrained": ("q", "p", "energy", "constraint_residual"),
+    "analysed": ("z", "energy", "constraint_residual"),
 }
 
 
@@ -51,7 +52,7 @@ class IntegrationInterrupted(IntegrationError):
 
 
 def problem_kind(problem: object) -> str:
-    """``"rigid_body"``, ``"heavy_top"`` or ``"constrained"``."""
+    """``"rigid_body"``, ``"heavy_top"``, ``"constrained"`` or ``"analysed"``."""
     from dirac.flows.problem import ConstrainedProblem, HeavyTopProblem, RigidBodyProblem
 
     if isinstance(problem, HeavyTopProblem):
@@ -60,7 +61,14 @@ def problem_kind(problem: object) -> str:
         return "rigid_body"
     if isinstance(problem, ConstrainedProblem):
         return "constrained"
-    raise InputError(f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem or ConstrainedProblem")
+    from dirac.flows.analysed import AnalysedProblem
+
+    if isinstance(problem, AnalysedProblem):
+        return "analysed"
+    raise InputError(
+        f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem, ConstrainedProblem "
+        "or AnalysedProblem"
+    )
 
 
 def sample_times(t_end: float, samples: int) -> np.ndarray:

@@ -25,7 +25,11 @@ angular velocity, ``M = I omega``) or ``m`` (lab angular momentum, ``M = R^T m``
 heavy top adds ``mass_gravity`` (``m g``) and ``center_of_mass`` (body frame) under
 ``[system]``. A general system gives ``q = { x = ..., ... }`` and ``q_dot = {...}`` or
 ``p = {...}`` (omitted velocities mean rest); initial data off the constraint surface
-are refused unless ``project = true`` in ``[initial]``. Parameters of a Lagrangian are
+are refused unless ``project = true`` in ``[initial]``. A Lagrangian that is not of the
+form ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the velocities, singular) is
+integrated on the full phase space of its Dirac–Bergmann analysis (``midpoint`` or the
+scipy baselines; the multipliers are completed on the constraint surface, outputs ``z``,
+``q``, ``p``, ``energy``, ``constraint_residual``). Parameters of a Lagrangian are
 overridden under ``[system] parameters``. Optional ``[run]`` keys: ``drift_limit``,
 ``newton_tolerance``, ``max_newton_iterations``. Unknown keys are warned about and ignored.
 """
@@ -242,7 +246,12 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path):  # n
     overrides = system.get("parameters", {})
     if not isinstance(overrides, dict):
         raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ l = 2.0 }}")
-    mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides)
+    try:
+        mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides)
+    except InputError as exc:
+        if "velocities" not in str(exc):
+            raise
+        return _analysed_problem(lagrangian, overrides, initial, source)
     names = mechanics.coordinate_names
     if "q" not in initial:
         raise InputError(f"{source}: [initial] lacks q (the coordinates {', '.join(names)})")
@@ -261,6 +270,28 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path):  # n
         q, p = mechanics.project(q, p)
     try:
         return ConstrainedProblem(mechanics, q, p)
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def _analysed_problem(lagrangian, overrides: dict, initial: dict, source: str):  # noqa: ANN001, ANN202
+    """A Lagrangian that is not of the form 1/2 q_dot^T M q_dot - V (velocity-linear or
+    singular): integrate the Dirac vector field of its analysis (``midpoint``, scipy)."""
+    from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
+
+    analysed = AnalysedSystem.from_lagrangian(lagrangian, overrides)
+    names = tuple(s.name for s in lagrangian.coordinates)
+    if "q" not in initial:
+        raise InputError(f"{source}: [initial] lacks q (the coordinates {', '.join(names)})")
+    q = dict(zip(names, _coordinates(initial["q"], "q", names, source, required=True).tolist()))
+    if "p" in initial:
+        p = dict(zip(names, _coordinates(initial["p"], "p", names, source, required=False).tolist()))
+        z0 = analysed.initial_state(q, p=p)
+    else:
+        velocity = dict(zip(names, _coordinates(initial.get("q_dot", {}), "q_dot", names, source, required=False).tolist()))
+        z0 = analysed.initial_state(q, q_dot=velocity)
+    try:
+        return AnalysedProblem(analysed, z0)
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
 

@@ -38,6 +38,10 @@ class ScipyStepper(Stepper):
             self.with_R = needs_attitude(outputs) or kind == "heavy_top"
             self._fun, self._args = _rigid_body_rhs(problem, self.with_R)
             states = [np.concatenate([M, R.ravel()]) if self.with_R else M.copy() for M, R in zip(problem.M0, problem.R0)]
+        elif hasattr(problem, "analysed"):
+            self.analysed = problem.analysed
+            self._fun, self._args = (lambda t, y: self.analysed.field(y)), ()
+            states = [z.copy() for z in problem.z0]
         else:
             from dirac.flows.dirac_field import ConstrainedField
 
@@ -85,6 +89,10 @@ class ScipyStepper(Stepper):
         return bool(np.all(np.isfinite(self.y)))
 
     def observe(self) -> dict[str, np.ndarray]:
+        if hasattr(self, "analysed"):
+            from dirac.flows.analysed import analysed_outputs
+
+            return analysed_outputs(self.analysed, self.outputs, self.y)
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
             return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:])
@@ -95,6 +103,8 @@ class ScipyStepper(Stepper):
         return rigid_body_outputs(self.outputs, M, R, np.asarray(self.problem.inertia), self.problem)
 
     def drift(self) -> float:
+        if hasattr(self, "analysed"):
+            return max(self.analysed.constraint_residual(y) for y in self.y)
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
             return max(self.problem.mechanics.constraint_residual(y[:n], y[n:]) for y in self.y)
@@ -133,7 +143,7 @@ for _name, _order, _ref in (
             name=_name,
             order=_order,
             kind="adaptive",
-            problems=("rigid_body", "heavy_top", "constrained"),
+            problems=("rigid_body", "heavy_top", "constrained", "analysed"),
             symplectic=False,
             preserves_casimirs=False,
             description=f"baseline: scipy {_name[6:]} with rtol = atol = tolerance (adaptive steps)",

@@ -1,0 +1,205 @@
+"""Flows on the full phase space of a Dirac–Bergmann analysis (any analysed system).
+
+From a :class:`dirac.symbolic.analysis.ConstraintAnalysis` (phase space ``z``: the
+coordinates and multipliers, then their momenta), the numerical Hamiltonian vector field
+
+    z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H),
+    C_ab = {Phi_a, Phi_b}  (240),
+
+over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
+``grad Phi`` are generated from sympy (:mod:`dirac.flows.codegen`), ``C`` is evaluated and
+solved numerically at each point (:func:`dirac.flows.constrained_kernels.analysed_field`).
+``H`` is the canonical Hamiltonian; with first-class constraints the gauge ``u = 0`` is
+taken (their multipliers stay arbitrary in ``H_T``). This path takes every Lagrangian the
+engine can analyse, also those that :class:`MechanicalSystem` refuses (terms linear in the
+velocities, singular Lagrangians such as the rigid body's (228)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy
+
+from dirac.errors import InputError
+from dirac.lagrangian import Lagrangian
+
+__all__ = ["AnalysedSystem", "AnalysedProblem"]
+
+
+@dataclass
+class AnalysedSystem:
+    """Compiled Dirac vector field of an analysed Lagrangian (build with :meth:`from_lagrangian`)."""
+
+    name: str
+    variable_names: tuple[str, ...]
+    dimension: int
+    n_constraints: int
+    parameter_values: dict[str, float]
+    params: np.ndarray
+    module: object
+    functions: tuple
+    analysis: object = field(repr=False)
+    momenta: object = field(repr=False, default=None)
+
+    @classmethod
+    def from_lagrangian(cls, lagrangian: Lagrangian, parameters: dict[str, float] | None = None) -> "AnalysedSystem":
+        """Fix the parameters (defaults, overridden by ``parameters``), analyse, compile.
+
+        Raises
+        ------
+        InputError
+            Unknown parameters or parameters without a value.
+        """
+        from dirac.flows.codegen import GeneratedFunction, generate_module
+        from dirac.symbolic.analysis import analyze
+
+        values = dict(lagrangian.parameter_values)
+        for key, value in (parameters or {}).items():
+            if key not in values:
+                raise InputError(f"system {lagrangian.name!r} has no parameter {key!r}")
+            values[key] = value
+        missing = sorted(k for k, v in values.items() if v is None)
+        if missing:
+            raise InputError(f"system {lagrangian.name!r}: parameters {', '.join(missing)} have no value; give them")
+        fixed = lagrangian.fix(**{k: float(v) for k, v in values.items()})  # type: ignore[arg-type]
+        analysis = analyze(fixed)
+        z = tuple(analysis.phase_space)
+        H = analysis.canonical_hamiltonian
+        constraints = list(analysis.second_class)
+        gradient = [sympy.diff(H, s) for s in z]
+        jacobian = [sympy.diff(c, s) for c in constraints for s in z]
+        generated = [
+            GeneratedFunction("hamiltonian_gradient", z, gradient, "grad H over the phase space"),
+            GeneratedFunction("second_class", z, constraints, "second-class constraints Phi"),
+            GeneratedFunction("second_class_jacobian", z, jacobian, "grad Phi, (k, N)"),
+            GeneratedFunction("hamiltonian", z, [H], "canonical Hamiltonian H_c"),
+        ]
+        module = generate_module(generated, (), title=f"analysed system {lagrangian.name}")
+        g = module.hamiltonian_gradient
+        functions = (g, module.second_class, module.second_class_jacobian, module.hamiltonian, g, g, g)
+        velocities = list(fixed.velocities)
+        momenta = sympy.lambdify([list(fixed.coordinates), velocities],
+                                 [sympy.diff(fixed.expression, v) for v in velocities], modules="numpy")
+        return cls(
+            name=lagrangian.name,
+            variable_names=tuple(s.name for s in z),
+            dimension=len(z),
+            n_constraints=len(constraints),
+            parameter_values={k: float(v) for k, v in values.items()},  # type: ignore[arg-type]
+            params=np.zeros(0),
+            module=module,
+            functions=functions,
+            analysis=analysis,
+            momenta=momenta,
+        )
+
+    def _call(self, name: str, z: np.ndarray, size: int) -> np.ndarray:
+        from dirac.flows.constrained_kernels import evaluate, quiet
+
+        out = np.empty(size)
+        with quiet():
+            evaluate(getattr(self.module, name), np.ascontiguousarray(z, dtype=float), self.params, out)
+        return out
+
+    def energy(self, z: np.ndarray) -> float:
+        """``H_c(z)``."""
+        return float(self._call("hamiltonian", z, 1)[0])
+
+    def constraint_residual(self, z: np.ndarray) -> float:
+        """``max |Phi(z)|`` over the second-class constraints."""
+        if self.n_constraints == 0:
+            return 0.0
+        return float(np.max(np.abs(self._call("second_class", z, self.n_constraints))))
+
+    def field(self, z: np.ndarray) -> np.ndarray:
+        """``z_dot`` at ``z``."""
+        from dirac.flows.constrained_kernels import analysed_field, quiet
+
+        out = np.empty(self.dimension)
+        with quiet():
+            analysed_field(self.functions, np.ascontiguousarray(z, dtype=float), self.params, self.dimension // 2,
+                           self.n_constraints, out)
+        return out
+
+    def initial_state(self, q: dict[str, float], q_dot: dict[str, float] | None = None,
+                      p: dict[str, float] | None = None) -> np.ndarray:
+        """A point of the constraint surface with the given coordinates and velocities
+        (``p = dL/dq_dot``) or momenta; the multipliers and the rest are completed by
+        :meth:`ConstraintAnalysis.surface_point`.
+
+        Raises
+        ------
+        InputError
+            If no point of the surface has these values.
+        """
+        lagrangian = self.analysis.lagrangian  # type: ignore[attr-defined]
+        names = [s.name for s in lagrangian.coordinates]
+        values = {k: float(v) for k, v in q.items()}
+        if q_dot is not None:
+            qv = [values.get(n, 0.0) for n in names]
+            vv = [float(q_dot.get(n, 0.0)) for n in names]
+            momenta = np.broadcast_to(np.asarray(self.momenta(qv, vv), dtype=float), (len(names),))
+            values.update({f"p_{n}": float(m) for n, m in zip(names, momenta)})
+        elif p is not None:
+            values.update({f"p_{n}": float(v) for n, v in p.items()})
+        point = self.analysis.surface_point(values)  # type: ignore[attr-defined]
+        return np.array([point[n] for n in self.variable_names])
+
+
+@dataclass
+class AnalysedProblem:
+    """An analysed system with initial states ``z0`` (shape (N,) or (B, N)) on its surface."""
+
+    analysed: AnalysedSystem
+    z0: np.ndarray
+    surface_tolerance: float = 1e-8
+    batched: bool = field(init=False, default=False)
+
+    outputs = ("z", "q", "p", "energy", "constraint_residual")
+
+    def __post_init__(self) -> None:
+        z0 = np.asarray(self.z0, dtype=float)
+        self.batched = z0.ndim == 2
+        z0 = np.atleast_2d(z0).copy()
+        if z0.shape[1] != self.analysed.dimension:
+            raise InputError(f"initial state has {z0.shape[1]} entries; the phase space has {self.analysed.dimension}: "
+                             f"{', '.join(self.analysed.variable_names)}")
+        for z in z0:
+            residual = self.analysed.constraint_residual(z)
+            if not residual <= self.surface_tolerance * (1.0 + float(z @ z)):
+                raise InputError(f"initial state is off the constraint surface (residual {residual:.3g}); "
+                                 "complete it with AnalysedSystem.initial_state")
+        self.z0 = z0
+
+    @property
+    def system(self) -> str:
+        return self.analysed.name
+
+    @property
+    def batch(self) -> int:
+        return int(self.z0.shape[0])
+
+    def parameters(self) -> dict[str, object]:
+        return dict(self.analysed.parameter_values)
+
+
+def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.ndarray) -> dict[str, np.ndarray]:
+    """Outputs of an analysed system from batched ``z`` (B, N): the state ``z``, its
+    coordinate half ``q`` (coordinates and multipliers), momentum half ``p``, ``energy``
+    (``H_c``) and ``constraint_residual`` (``max |Phi|``)."""
+    half = analysed.dimension // 2
+    result: dict[str, np.ndarray] = {}
+    for name in names:
+        if name == "z":
+            result[name] = z.copy()
+        elif name == "q":
+            result[name] = z[:, :half].copy()
+        elif name == "p":
+            result[name] = z[:, half:].copy()
+        elif name == "energy":
+            result[name] = np.array([analysed.energy(x) for x in z])
+        elif name == "constraint_residual":
+            result[name] = np.array([analysed.constraint_residual(x) for x in z])
+    return result
