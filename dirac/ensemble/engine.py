@@ -453,6 +453,8 @@ def _run_dask(scene, store, missing, chunk_size, run_id, retries, record, *, sch
             index = futures[future.key][1]
             if future.status == "finished":
                 record(future.result(), index, None)
+            elif future.status == "cancelled":
+                record(None, index, "the task was cancelled by the cluster (e.g. its scheduler restarted)")
             else:
                 exc = future.exception()
                 record(None, index, f"{type(exc).__name__}: {exc} (after {retries + 1} attempts)")

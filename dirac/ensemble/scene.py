@@ -176,8 +176,14 @@ class EnsembleScene:
         }
 
     def fingerprint(self) -> str:
-        """SHA-256 of :meth:`describe` (a resumed run must match it)."""
-        text = json.dumps(self.describe(), sort_keys=True)
+        """SHA-256 of :meth:`describe` (a resumed run must match it).
+
+        A member file enters by its content digest, not its path, so a moved folder
+        still resumes.
+        """
+        described = self.describe()
+        described.pop("file")
+        text = json.dumps(described, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()
 
 
