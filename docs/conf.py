@@ -54,3 +54,30 @@ html_theme_options = {
     "description": "Dirac brackets and structure-preserving flows; flagship: the free rigid body",
     "fixed_sidebar": True,
 }
+
+
+def _markdown_fences_to_rst(app, what, name, obj, options, lines):  # noqa: ANN001, ARG001
+    """Let docstrings use Markdown code fences: turn them into ``code-block`` directives."""
+    import re
+
+    out: list[str] = []
+    i = 0
+    while i < len(lines):
+        opening = re.match(r"^(\s*)```+\s*([\w+-]*)\s*$", lines[i])
+        if not opening:
+            out.append(lines[i])
+            i += 1
+            continue
+        indent, language = opening.group(1), opening.group(2) or "text"
+        body = []
+        i += 1
+        while i < len(lines) and not re.match(r"^\s*```+\s*$", lines[i]):
+            body.append(lines[i][len(indent):] if lines[i].startswith(indent) else lines[i].lstrip())
+            i += 1
+        i += 1  # the closing fence
+        out += [f"{indent}.. code-block:: {language}", ""] + [f"{indent}   {line}" if line else "" for line in body] + [""]
+    lines[:] = out
+
+
+def setup(app):  # noqa: ANN001, ANN201
+    app.connect("autodoc-process-docstring", _markdown_fences_to_rst)
