@@ -296,14 +296,18 @@ def double_pendulum_target(repeats: int, n_steps: int) -> Target:
     from dirac.flows import integrate
 
     case = [c for c in constrained_cases(True) if c.system == "double_pendulum"][0]
-    problem, _ = _constrained_problem(case)
-    dt = 1e-3
+    quiet = _quiet()
+    try:
+        problem, _ = _constrained_problem(case)
+        dt = 1e-3
 
-    def run() -> float:
-        return integrate(problem, "rattle-2", t_end=n_steps * dt, dt=dt, samples=1, outputs=["q"]).cpu_seconds
+        def run() -> float:
+            return integrate(problem, "rattle-2", t_end=n_steps * dt, dt=dt, samples=1, outputs=["q"]).cpu_seconds
 
-    run()
-    cpu = median_of([run() for _ in range(repeats)])
+        run()
+        cpu = median_of([run() for _ in range(repeats)])
+    finally:
+        quiet.__exit__(None, None, None)
     return Target(f"general: {n_steps:.0e} rattle-2 steps of the double pendulum (s)", cpu * 1e5 / n_steps, "s",
                   1.0, "<=", f"measured {cpu:.3f} s for {n_steps} steps (dt = 1e-3), scaled to 1e5 steps"
                   if n_steps != 100_000 else f"dt = 1e-3, CPU of the integrate loop")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+from pathlib import Path
 
 from dirac.errors import InputError
 
@@ -48,6 +49,9 @@ def main(args: argparse.Namespace) -> int:
         return _delegate("stress", "dirac.bench.stress", args)
     if args.ensemble:
         return _delegate("ensemble", "dirac.ensemble.bench", args)
+    for flag, path in (("--json", args.json), ("--plot", args.plot)):
+        if path and not Path(path).resolve().parent.is_dir():
+            raise InputError(f"{flag} {path!r}: the folder {str(Path(path).resolve().parent)!r} does not exist; create it first")
     if args.plot and not str(args.plot).lower().endswith(".png"):
         raise InputError(f"--plot {args.plot!r}: give a file name ending in .png")
     if args.plot:

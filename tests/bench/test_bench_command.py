@@ -125,3 +125,8 @@ def test_stress_and_ensemble_flags_say_when_unavailable(run_cli, monkeypatch, fl
 def test_bad_plot_name_is_an_input_error(run_cli):
     status, _, err = run_cli("bench", "--quick", "--plot", "figure.pdf")
     assert status == 2 and err.startswith("error:") and ".png" in err
+
+
+def test_output_into_a_missing_folder_is_an_input_error(run_cli, tmp_path):
+    status, _, err = run_cli("bench", "--quick", "--json", str(tmp_path / "no" / "such" / "bench.json"))
+    assert status == 2 and err.startswith("error:") and "does not exist" in err
