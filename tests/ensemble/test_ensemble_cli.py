@@ -39,3 +39,26 @@ def test_scene_warnings(write_scene, tmp_path, run_cli):
     warnings = [line for line in stderr.splitlines() if line.startswith("warning:")]
     assert any("[ensemble] key 'colour' is unknown" in line for line in warnings)
     assert any("dt = 0.03 does not divide the sample spacing 0.1; using dt = 0.025" in line for line in warnings)
+
+
+def test_cli_on_a_local_cluster_of_worker_processes(write_scene, tmp_path, run_cli):
+    import json
+
+    import zarr
+
+    scene = write_scene(count=60, outputs='["M"]', reductions='["flip_time", "final_state"]')
+    status, stdout, stderr = run_cli(
+        "ensemble", str(scene), "--out", str(tmp_path / "dask"), "--cluster", "local", "--workers", "2",
+        "--chunk-size", "20", "--no-progress",
+    )
+    assert status == 0, stderr
+    assert "dask dashboard: http://127.0.0.1:" in stderr
+    assert "computed 3 chunks" in stdout
+    status, _, stderr = run_cli("ensemble", str(scene), "--out", str(tmp_path / "local"), "--chunk-size", "30", "--no-progress")
+    assert status == 0, stderr
+    a = zarr.open_group(str(tmp_path / "dask" / "data.zarr"), mode="r")
+    b = zarr.open_group(str(tmp_path / "local" / "data.zarr"), mode="r")
+    for name in ("M", "flip_time", "final_M", "final_R"):
+        assert a[name][:].tobytes() == b[name][:].tobytes(), name
+    markers = [json.loads(p.read_text()) for p in (tmp_path / "dask" / "chunks").glob("*.json")]
+    assert all(m["worker"].startswith("tcp://127.0.0.1:") for m in markers)  # loopback only

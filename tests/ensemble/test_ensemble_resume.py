@@ -23,10 +23,10 @@ def _command(scene, out) -> list[str]:
 
 
 def test_killed_run_resumes_with_identical_results(write_scene, tmp_path):
-    # 20 chunks of 100 members x 2000 steps: each chunk takes a visible fraction of a second
+    # 20 chunks of 50 members x 2000 steps: each chunk takes a visible fraction of a second
     scene = write_scene(
-        count=100 * CHUNKS, t_end=4.0, dt=0.002, samples=11, outputs='["energy"]',
-        reductions='["flip_time", "final_state"]', extra="chunk_size = 100",
+        count=50 * CHUNKS, t_end=4.0, dt=0.002, samples=11, outputs='["energy"]',
+        reductions='["flip_time", "final_state"]', extra="chunk_size = 50",
     )
     out = tmp_path / "killed"
     process = subprocess.Popen(_command(scene, out), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
