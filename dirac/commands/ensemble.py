@@ -12,6 +12,7 @@ import sys
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare ``dirac ensemble`` and its options."""
     parser = subparsers.add_parser(
         "ensemble",
         help="run an ensemble scene (many bodies, chunked, resumable)",
@@ -33,6 +34,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def main(args: argparse.Namespace) -> int:
+    """Run or resume the ensemble; 0 when complete, 1 when chunks failed (listed on stderr)."""
     from dirac.ensemble.engine import run_ensemble
     from dirac.errors import InputError
 

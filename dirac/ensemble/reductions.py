@@ -41,13 +41,15 @@ class Reduction:
     """A streaming summary: :meth:`start` at ``t = 0``, :meth:`update` at each later sample,
     :meth:`result` at the end (arrays with the chunk's members along axis 0)."""
 
-    def start(self, M: np.ndarray, R: np.ndarray | None, inertia: np.ndarray) -> None:
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
+        """Called with the chunk's initial state (``t = 0``)."""
         raise NotImplementedError  # pragma: no cover - abstract
 
     def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
         """Called after the members were advanced from ``t_prev`` to ``t``."""
 
     def result(self) -> dict[str, np.ndarray]:
+        """The arrays of :func:`reduction_arrays` for the chunk's members."""
         raise NotImplementedError  # pragma: no cover - abstract
 
 
@@ -57,7 +59,7 @@ class FlipTime(Reduction):
     def __init__(self, axis: int | None) -> None:
         self.axis = axis
 
-    def start(self, M, R, inertia):  # noqa: ANN001, ANN201, N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
         n = M.shape[0]
         self.rows = np.arange(n)
         if self.axis is None:
@@ -68,7 +70,7 @@ class FlipTime(Reduction):
         self.prev = self.a0.copy()
         self.time = np.full(n, np.nan)
 
-    def update(self, t_prev, t, M, R):  # noqa: ANN001, ANN201, N803
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:  # noqa: N803
         a = M[self.rows, self.cols]
         new = np.isnan(self.time) & (a * self.a0 < 0.0)
         if np.any(new):
@@ -76,7 +78,7 @@ class FlipTime(Reduction):
             self.time[new] = t_prev + (t - t_prev) * (p / (p - a[new]))
         self.prev = a
 
-    def result(self):  # noqa: ANN201
+    def result(self) -> dict[str, np.ndarray]:
         return {"flip_time": self.time}
 
 
@@ -86,44 +88,44 @@ class MaxRelativeError(Reduction):
     def __init__(self, name: str) -> None:
         self.name = name
 
-    def _value(self, M):  # noqa: ANN001, ANN202, N803
+    def _value(self, M: np.ndarray) -> np.ndarray:  # noqa: N803
         if self.name == "max_energy_error":
             return 0.5 * np.einsum("ij,ij->i", M * self.inv, M)
         return np.einsum("ij,ij->i", M, M)
 
-    def start(self, M, R, inertia):  # noqa: ANN001, ANN201, N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
         self.inv = 1.0 / inertia
         self.f0 = self._value(M)
         self.scale = np.where(self.f0 != 0.0, np.abs(self.f0), 1.0)
         self.error = np.zeros(M.shape[0])
 
-    def update(self, t_prev, t, M, R):  # noqa: ANN001, ANN201, N803
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:  # noqa: N803
         np.maximum(self.error, np.abs(self._value(M) - self.f0) / self.scale, out=self.error)
 
-    def result(self):  # noqa: ANN201
+    def result(self) -> dict[str, np.ndarray]:
         return {self.name: self.error}
 
 
 class FinalState(Reduction):
     """``M`` and ``R`` at the last sample."""
 
-    def start(self, M, R, inertia):  # noqa: ANN001, ANN201, N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
         self.M, self.R = M, R
 
-    def update(self, t_prev, t, M, R):  # noqa: ANN001, ANN201, N803
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:  # noqa: N803
         self.M, self.R = M, R
 
-    def result(self):  # noqa: ANN201
+    def result(self) -> dict[str, np.ndarray]:
         return {"final_M": self.M.copy(), "final_R": self.R.copy()}
 
 
 class InitialState(Reduction):
     """The member's initial data."""
 
-    def start(self, M, R, inertia):  # noqa: ANN001, ANN201, N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
         self.data = {"initial_M": M.copy(), "initial_R": R.copy(), "inertia": inertia.copy()}
 
-    def result(self):  # noqa: ANN201
+    def result(self) -> dict[str, np.ndarray]:
         return self.data
 
 
