@@ -106,3 +106,23 @@ def test_reductions_only_store_no_trajectories(write_scene, tmp_path):
     arrays = _arrays(tmp_path / "out")
     assert sorted(arrays) == ["flip_time", "max_energy_error", "t"]
     assert arrays["max_energy_error"].shape == (40,) and np.all(arrays["max_energy_error"] < 1e-6)
+
+
+def test_dask_failed_chunk_is_retried_then_reported(write_scene, tmp_path, dask_client, monkeypatch):
+    # the cluster's workers are threads of this process, so they see the patched function
+    scene = write_scene(count=60, outputs="[]", reductions='["final_state"]')
+    calls: dict[int, int] = {}
+    real = engine.compute_chunk
+
+    def broken(scene_, start, stop, members=None):
+        calls[start] = calls.get(start, 0) + 1
+        if start == 20:
+            raise RuntimeError("broken chunk")
+        return real(scene_, start, stop, members)
+
+    monkeypatch.setattr(engine, "compute_chunk", broken)
+    report = run_ensemble(scene, tmp_path / "out", chunk_size=20, client=dask_client, retries=1)
+    assert calls[20] == 2 and calls[0] == 1 and calls[40] == 1
+    assert list(report.failed) == [1] and "broken chunk" in report.failed[1] and not report.complete
+    meta = json.loads((tmp_path / "out" / "meta.json").read_text())
+    assert meta["failed_chunks"].keys() == {"1"} and meta["chunks_done"] == [[0, 0], [2, 2]]
