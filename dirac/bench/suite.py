@@ -122,15 +122,15 @@ def rigid_body_cases(quick: bool) -> list[RigidBodyCase]:
 def constrained_cases(quick: bool) -> list[ConstrainedCase]:
     """The pendulum (10 periods) and the double pendulum (``T = 10``)."""
     if quick:
+        # no scipy baseline here: its first use compiles the Dirac vector field of each
+        # system, too slow for a first --quick run on a fresh install (the full run has it)
         pendulum_grids = (
             MethodGrid("rattle-2", (0.01, 0.001), "dt"),
-            MethodGrid("rattle-4", (0.02,), "dt"),
-            MethodGrid("scipy-DOP853", (1e-9,), "tolerance"),
+            MethodGrid("rattle-4", (0.02, 0.005), "dt"),
         )
         double_grids = (
             MethodGrid("rattle-2", (0.001,), "dt"),
             MethodGrid("rattle-4", (0.01,), "dt"),
-            MethodGrid("scipy-DOP853", (1e-9,), "tolerance"),
         )
     else:
         pendulum_grids = (
