@@ -43,7 +43,8 @@ def check_png_path(path: str | Path) -> Path:
     Raises
     ------
     dirac.errors.InputError
-        If the name does not end in ``.png`` or its folder does not exist.
+        If the name does not end in ``.png``, its folder does not exist, or matplotlib is
+        not installed (so that a run with ``--plot`` fails before it starts, not after).
     """
     target = Path(path)
     if target.suffix.lower() != ".png":
@@ -51,6 +52,7 @@ def check_png_path(path: str | Path) -> Path:
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise InputError(f"folder {str(folder)!r} of the plot file {str(path)!r} does not exist: create it first")
+    _require_matplotlib()
     return target
 
 
