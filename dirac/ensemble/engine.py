@@ -265,7 +265,7 @@ def run_ensemble(
             )
         stored = int(meta["chunk_size"])
         asked = chunk_size or scene.chunk_size
-        if asked is not None and asked != stored:
+        if asked is not None and min(asked, scene.count) != stored:
             raise InputError(
                 f"--out {store.root} was started with chunk size {stored}; resume with --chunk-size {stored} "
                 "(or without the option)"

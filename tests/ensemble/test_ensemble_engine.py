@@ -93,6 +93,9 @@ def test_resuming_a_different_scene_or_chunk_size_is_refused(write_scene, tmp_pa
         run_ensemble(write_scene("other.toml", count=30, seed=12), out)
     with pytest.raises(InputError, match="--chunk-size 10"):
         run_ensemble(write_scene(count=30), out, chunk_size=15)
+    # a chunk size above the count was stored as the count: resuming with it is fine
+    assert run_ensemble(write_scene(count=30), tmp_path / "big", chunk_size=100).chunk_size == 30
+    assert run_ensemble(write_scene(count=30), tmp_path / "big", chunk_size=100).chunks_skipped == 1
     (tmp_path / "busy").mkdir()
     (tmp_path / "busy" / "notes.txt").write_text("mine")
     with pytest.raises(InputError, match="not empty"):
