@@ -473,15 +473,19 @@ def local_cluster(n_workers: int, dashboard_address: str | None = None):  # noqa
     One thread per worker (each task's kernel gets the host's cores divided by the
     workers), and the workers' statistical profiler is off: it samples the task
     thread's stack every 10 ms, which costs a noticeable share of a compute-bound
-    task's CPU time.
+    task's CPU time. Log messages below CRITICAL are silenced (a worker still
+    heartbeating while the cluster shuts down logs a traceback); task failures reach
+    the engine through their futures and are reported there.
     """
+    import logging
+
     import dask
     from distributed import LocalCluster
 
     with dask.config.set({"distributed.worker.profile.enabled": False}):
         return LocalCluster(
             n_workers=n_workers, threads_per_worker=1, processes=True,
-            host="127.0.0.1", dashboard_address=dashboard_address,
+            host="127.0.0.1", dashboard_address=dashboard_address, silence_logs=logging.CRITICAL,
         )
 
 
