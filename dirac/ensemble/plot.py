@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from dirac.errors import DiracError, InputError, install_warning_printer, warn
+
 __all__ = ["unstable_coordinate", "predicted_flip_time", "plot_flip_times", "main"]
 
 
@@ -71,10 +73,15 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
     import matplotlib.pyplot as plt
     import zarr
 
-    group = zarr.open_group(str(Path(out) / "data.zarr"), mode="r")
-    meta = json.loads((Path(out) / "meta.json").read_text())
+    try:
+        meta = json.loads((Path(out) / "meta.json").read_text())
+        group = zarr.open_group(str(Path(out) / "data.zarr"), mode="r")
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{out} holds no ensemble results ({exc}); run 'dirac ensemble SCENE --out {out}' first") from None
+    if not meta.get("complete"):
+        warn(f"{out}: the ensemble is not complete ({meta.get('chunks_complete')} of {meta.get('chunks_total')} chunks); plotting the finished members")
     if "flip_time" not in group:
-        raise SystemExit(f"error: {out} has no flip_time array; add \"flip_time\" to [ensemble] reductions")
+        raise InputError(f"{out} has no flip_time array; add \"flip_time\" to [ensemble] reductions and rerun")
     flip = group["flip_time"][:]
     t_end = float(meta["scene"]["t_end"])
     summary = {"members": int(flip.size), "flipped": int(np.isfinite(flip).sum()), "median": float(np.nanmedian(flip))}
@@ -83,6 +90,8 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
     panels = 2 if shared else 1
     fig, axes = plt.subplots(1, panels, figsize=(5.2 * panels, 4.0), squeeze=False)
     ax = axes[0, 0]
+    if not np.isfinite(flip).any():
+        raise InputError(f"{out}: no member flipped by t_end = {t_end:g}; nothing to plot (raise t_end)")
     ax.hist(flip[np.isfinite(flip)], bins=80, color="tab:blue", alpha=0.85)
     ax.set_xlabel("time of the first flip of the intermediate axis")
     ax.set_ylabel("members")
@@ -107,11 +116,20 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``python -m dirac.ensemble.plot DIR --out FILE.png``; prints a one-line summary.
+
+    Returns 0, or 2 with one ``error:`` line on stderr for bad input.
+    """
+    install_warning_printer()
     parser = argparse.ArgumentParser(prog="python -m dirac.ensemble.plot", description=__doc__.splitlines()[0])
     parser.add_argument("out", metavar="DIR", help="the ensemble's output folder")
     parser.add_argument("--out", dest="image", metavar="FILE.png", required=True, help="image to write")
     args = parser.parse_args(argv)
-    summary = plot_flip_times(args.out, args.image)
+    try:
+        summary = plot_flip_times(args.out, args.image)
+    except DiracError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     print(", ".join(f"{key} = {value:.6g}" for key, value in summary.items()), file=sys.stdout)
     return 0
 

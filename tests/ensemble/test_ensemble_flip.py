@@ -81,3 +81,9 @@ norm = 1.0
     assert 0 < flipped < 100  # t_end = 20 lies inside the distribution of flip times
     out = capsys.readouterr().out
     assert f"members = 100, flipped = {flipped}," in out and "max_deviation" in out
+
+
+def test_plot_command_bad_input_exits_2(tmp_path, capsys):
+    assert plot_main([str(tmp_path / "nothing"), "--out", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "holds no ensemble results" in err and len(err.splitlines()) == 1
