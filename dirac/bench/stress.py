@@ -483,15 +483,15 @@ def _e(value: float | None) -> str:
 
 def format_table(document: dict) -> str:
     """The three parts as fixed-width text tables (also valid Markdown)."""
-    lines = ["Long runs, standard body I = (2, 1, 2/3) (limits: |M|^2 and R^T R - 1 <= 2e-12; energy bounded)", ""]
-    lines.append("| method | steps | dt | max dev. |M|^2 | max |R^T R - 1| | energy err. first 1/10 | energy err. last 1/10 | CPU s | pass |")
+    lines = ["Long runs, standard body I = (2, 1, 2/3) (limits: deviations of M.M and R^T R <= 2e-12; energy bounded)", ""]
+    lines.append("| method | steps | dt | max dev. of M.M | max dev. of R^T R from 1 | energy err. first 1/10 | energy err. last 1/10 | CPU s | pass |")
     lines.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
     for r in document["long_runs"]:
         lines.append(f"| {r['method']} | {r['steps']:.0e} | {r['dt']:g} | {_e(r['casimir_error'])} | "
                      f"{_e(r['orthogonality_error'])} | {_e(r['energy_error_first_tenth'])} | "
                      f"{_e(r['energy_error_last_tenth'])} | {r['cpu_seconds']:.1f} | {'yes' if r['passed'] else 'NO'} |")
     lines += ["", "Hard bodies: max error over the samples against the 50-digit Taylor reference "
-              "(M relative to |M|; exact must stay below its bound; no silent NaN)", ""]
+              "(M relative to the norm of M(0); exact must stay below its bound; no silent NaN)", ""]
     lines.append("| body | method | error M | error R | status | pass |")
     lines.append("| --- | --- | ---: | ---: | --- | --- |")
     for r in document["hard_bodies"]:
@@ -500,9 +500,9 @@ def format_table(document: dict) -> str:
             status += f" (bound {r['bound']:.1e})"
         lines.append(f"| {r['case']} | {r['method']} | {_e(r['error_M'])} | {_e(r['error_R'])} | {status} | "
                      f"{'yes' if r['passed'] else 'NO'} |")
-    lines += ["", "Constrained long runs (limits: |chi| <= tol (1 + |q|^2), tol = 1e-12; velocity residual at "
+    lines += ["", "Constrained long runs (limits: abs chi <= tol (1 + q.q), tol = 1e-12; velocity residual at "
               "round-off; energy bounded)", ""]
-    lines.append("| system | method | steps | dt | max |chi(q)| | max |G M^-1 p| | energy err. first 1/10 | "
+    lines.append("| system | method | steps | dt | max abs chi(q) | max abs G M^-1 p | energy err. first 1/10 | "
                  "energy err. last 1/10 | CPU s | pass |")
     lines.append("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
     for r in document["constrained"]:
