@@ -62,3 +62,10 @@ def test_cli_on_a_local_cluster_of_worker_processes(write_scene, tmp_path, run_c
         assert a[name][:].tobytes() == b[name][:].tobytes(), name
     markers = [json.loads(p.read_text()) for p in (tmp_path / "dask" / "chunks").glob("*.json")]
     assert all(m["worker"].startswith("tcp://127.0.0.1:") for m in markers)  # loopback only
+
+
+def test_cli_progress_bar_counts_members(write_scene, tmp_path, run_cli):
+    scene = write_scene(count=30, outputs="[]", reductions='["final_state"]')
+    status, _, stderr = run_cli("ensemble", str(scene), "--out", str(tmp_path / "out"), "--chunk-size", "10")
+    assert status == 0, stderr
+    assert "ensemble: 100%" in stderr and "30.0/30.0" in stderr and "member/s" in stderr
