@@ -34,7 +34,7 @@ def _math(name: str) -> str:
 
 def draw_configuration(ax: Any, q: np.ndarray, names: Sequence[str]) -> None:
     """Draw the path ``q(t)`` in the plane of the first two coordinates (start and end marked)."""
-    ax.plot(q[:, 0], q[:, 1], color="tab:blue", linewidth=1.3, marker="." if q.shape[0] <= 400 else None,
+    ax.plot(q[:, 0], q[:, 1], color="tab:blue", linewidth=1.3, marker="." if q.shape[0] <= 100 else None,
             markersize=3, label="computed path")
     ax.plot(q[0, 0], q[0, 1], "o", color="tab:green", markersize=8, markeredgecolor="black", label="$t=0$")
     ax.plot(q[-1, 0], q[-1, 1], "s", color="tab:red", markersize=7, markeredgecolor="black", label="end")
@@ -118,6 +118,6 @@ def constrained_figure(
         draw_coordinates(fig.add_subplot(grid[0, :]), t, q, labels)
     if errors:
         draw_conservation(fig.add_subplot(grid[1, :]), t, errors,
-                          ylabel="largest error so far (energy: relative; residual: system units)")
+                          ylabel="largest error so far (see legend)")
     fig.suptitle(title or "Constrained system", fontsize=12)
     return fig

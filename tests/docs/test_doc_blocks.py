@@ -99,3 +99,13 @@ def test_a_placeholder_output_is_reported(tmp_path: Path, monkeypatch) -> None:
     assert len(problems) == 1 and "only '...'" in problems[0]
     problems, _ = run_page(_write(tmp_path, PAGE.replace("dirac ...\n", "...\n")), "page.md")
     assert len(problems) == 1 and "only '...'" in problems[0]
+
+
+def test_round_off_figures_match_each_other_but_larger_numbers_must_agree() -> None:
+    from doc_blocks import matches
+
+    assert matches("error 4.441e-16, E = 0.647", "error 6.661e-16, E = 0.647")
+    assert matches("drift 1.2e-14", "drift 3e-15")
+    assert not matches("drift 1.2e-13", "drift 3.0e-13")  # 1e-13 and up must agree
+    assert not matches("error 4.4e-16, E = 0.647", "error 4.4e-16, E = 0.648")
+    assert not matches("error 4.4e-16", "error 4.4e-06")
