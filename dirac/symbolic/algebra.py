@@ -62,64 +62,81 @@ def _evaluate(expr: sympy.Expr, gens: dict, domain, allow_division: bool):
     return walk(expr)
 
 
-def _coefficient(c, params: Sequence[sympy.Symbol]) -> sympy.Expr:
-    """A coefficient in ``QQ(params)`` as a sympy expression with factored denominator."""
-    if hasattr(c, "numer") and hasattr(c, "denom"):
-        num = c.numer.as_expr()
-        den = c.denom.as_expr()
-        if den == 1:
-            return sympy.factor_terms(num)
-        return sympy.factor_terms(num) / sympy.factor(den)
-    return sympy.sympify(c.as_expr() if hasattr(c, "as_expr") else c)
+def _split_denominators(expr: sympy.Expr, variables: set) -> tuple[sympy.Expr, dict, list]:
+    """Replace powers ``base**(-k)`` of variable-free bases by ``d_i**k`` (new symbols).
+
+    Returns the new expression, ``{d_i: 1/base}`` and the list of ``d_i``.
+    """
+    replacements: dict = {}
+    back: dict = {}
+    for node in sympy.preorder_traversal(expr):
+        if node.is_Pow and node.exp.is_Integer and node.exp < 0 and not (node.base.free_symbols & variables):
+            base = node.base
+            if base not in back.values():
+                d = sympy.Dummy(f"d{len(back)}")
+                back[d] = base
+            d = next(k for k, v in back.items() if v == base)
+            replacements[node] = d ** int(-node.exp)
+    if not replacements:
+        return expr, {}, []
+    return expr.xreplace(replacements), {d: 1 / b for d, b in back.items()}, list(back)
 
 
-def _poly_to_expr(p, variables: Sequence[sympy.Symbol], params: Sequence[sympy.Symbol]) -> sympy.Expr:
-    terms = []
+def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.Symbol], back: dict) -> sympy.Expr:
+    """Ring element in ``variables + others`` -> sympy, terms grouped by variable monomial."""
+    nv = len(variables)
+    groups: dict = {}
     for monom, c in p.terms():
-        coeff = _coefficient(c, params) if params else sympy.Rational(int(c.numerator), int(c.denominator))
+        coeff = sympy.Rational(int(c.numerator), int(c.denominator)) * sympy.Mul(*[s**k for s, k in zip(others, monom[nv:])])
+        groups.setdefault(monom[:nv], []).append(coeff)
+    terms = []
+    for monom, coeffs in groups.items():
+        coeff = sympy.Add(*coeffs).xreplace(back) if back else sympy.Add(*coeffs)
+        if back and len(coeffs) > 1:
+            coeff = sympy.factor_terms(sympy.together(coeff))
         terms.append(coeff * sympy.Mul(*[v**k for v, k in zip(variables, monom)]))
     return sympy.Add(*terms)
 
 
-def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = ()) -> sympy.Expr:
+def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = False) -> sympy.Expr:
     """Readable exact form: expanded in the phase-space ``variables`` over one denominator.
 
-    A polynomial in ``variables`` is expanded with coefficients rational functions of the
-    parameters (denominators factored); a rational function becomes
-    ``numerator / factored denominator``. Anything else (``sin``, ``sqrt`` …) is returned
-    cancelled. The overall sign is chosen so that the first term is positive.
+    A polynomial in ``variables`` is expanded with coefficients functions of the
+    parameters; a rational function becomes ``numerator / factored denominator``.
+    Anything else (``sin``, ``sqrt`` …) is returned cancelled. With ``sign=True`` (for
+    constraints, whose sign is free) the overall sign is chosen so that the leading term
+    is positive; otherwise the value is unchanged. Expansion runs in the sparse polynomial ring
+    over ``QQ`` (parameter denominators become extra generators, so no gcd is needed).
     """
     expr = sympy.sympify(expr)
     present = expr.free_symbols
     variables = [v for v in variables if v in present]
     if not variables:
         out = sympy.cancel(expr) if expr.free_symbols else expr
-        return -out if out.could_extract_minus_sign() else out
+        return -out if sign and out.could_extract_minus_sign() else out
+    work, back, ds = _split_denominators(expr, set(variables))
     params = sorted(present - set(variables), key=lambda s: s.name)
-    K = sympy.QQ.frac_field(*params) if params else sympy.QQ
-    ring = PolyRing(variables, K)
-    gens = dict(zip(variables, ring.gens))
-    if params:
-        for s in params:
-            gens[s] = ring(K.from_sympy(s))
+    others = [*params, *ds]
+    gens_all = [*variables, *others]
+    ring = PolyRing(gens_all, sympy.QQ)
+    gens = dict(zip(gens_all, ring.gens))
     try:
-        value = _evaluate(expr, gens, ring, allow_division=False)
-        out = _poly_to_expr(value, variables, params)
+        value = _evaluate(work, gens, ring, allow_division=False)
+        out = _poly_to_expr(value, variables, others, back)
     except (_NotRational, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
-        field = FracField(variables, K)
-        fgens = dict(zip(variables, field.gens))
-        for s in params:
-            fgens[s] = field(K.from_sympy(s))
+        field = FracField(gens_all, sympy.QQ)
+        fgens = dict(zip(gens_all, field.gens))
         try:
-            value = _evaluate(expr, fgens, field, allow_division=True)
+            value = _evaluate(work, fgens, field, allow_division=True)
         except (_NotRational, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
             out = sympy.cancel(expr)
-            return -out if out.could_extract_minus_sign() else out
-        num = _poly_to_expr(value.numer, variables, params)
-        den = _poly_to_expr(value.denom, variables, params)
+            return -out if sign and out.could_extract_minus_sign() else out
+        ring = PolyRing(gens_all, sympy.QQ)
+        num = _poly_to_expr(ring(value.numer.as_expr()) if False else value.numer, variables, others, back)
+        den = _poly_to_expr(value.denom, variables, others, back)
         if den.could_extract_minus_sign():
             num, den = -num, -den
         out = num / sympy.factor(den) if den != 1 else num
-    if out.could_extract_minus_sign():
+    if sign and out.could_extract_minus_sign():
         out = -out
     return out

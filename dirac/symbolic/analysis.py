@@ -185,7 +185,10 @@ class ConstraintAnalysis:
         missing = [p.name for p, v in self.lagrangian.parameters.items() if v is None]
         if missing:
             raise InputError(f"parameters {', '.join(missing)} have no default value: fix them (Lagrangian.fix) first")
-        numerics = Numerics(self._space, dict(self.lagrangian.parameters), seed=seed if seed is not None else 1)
+        if self._defaults_numerics is None:
+            self._defaults_numerics = Numerics(self._space, dict(self.lagrangian.parameters))
+        numerics = self._defaults_numerics
+        numerics.rng = np.random.default_rng(seed)
         index = {s.name: i for i, s in enumerate(self.phase_space)}
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:

@@ -18,6 +18,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import InputError
+from dirac.symbolic.codegen import compile_expressions
 from dirac.symbolic.linear_solve import weak_solve
 from dirac.symbolic.numeric import Numerics
 from dirac.symbolic.phase_space import PhaseSpace
@@ -119,13 +120,13 @@ class DiracBracket:
             pb = self.space.poisson_bracket
             exprs = [pb(f, g)] + [pb(f, c) for c in self.constraints] + [pb(c, g) for c in self.constraints]
             needed = set().union(*[e.free_symbols for e in exprs]) if exprs else set()
-            fn = sympy.lambdify(self._args, exprs, modules="numpy", cse=True)
+            fn = compile_expressions(self._args, exprs)
             entry = (fn, needed)
             self._compiled[key] = entry
         fn, needed = entry
         if "C" not in self._compiled:
             self._compiled["C"] = (
-                sympy.lambdify(self._args, self.C, modules="numpy", cse=True),
+                compile_expressions(self._args, list(self.C)),
                 set().union(*[e.free_symbols for e in self.C]) if self.C.shape[0] else set(),
             )
         c_fn, c_needed = self._compiled["C"]

@@ -218,6 +218,9 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
             H_c = (p_S.T * W_inv * p_S)[0, 0] / 2 + potential
             velocity = None
             method = f"singular Hessian of rank {rank}: null space from an invertible {rank}x{rank} block of W"
+    from dirac.symbolic.algebra import tidy
+
+    H_c = tidy(H_c, space.variables)
     full_rank = rank
     return LegendreTransform(
         phase_space=space,

@@ -19,6 +19,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import AnalysisError
+from dirac.symbolic.codegen import compile_expressions
 from dirac.symbolic.phase_space import PhaseSpace
 
 __all__ = ["Numerics", "numeric_rank", "independent_rows"]
@@ -114,7 +115,10 @@ class Numerics:
         missing = list(dict.fromkeys(e for e in exprs if not e.is_number and e not in self._index))
         if not missing:
             return
-        raw = sympy.lambdify(self._args, missing, modules="numpy", cse=len(missing) > 1)
+        try:
+            raw = compile_expressions(self._args, missing)
+        except TypeError:  # an unusual function: fall back to sympy's printer
+            raw = sympy.lambdify(self._args, missing, modules="numpy", cse=True)
         batch = len(self._batches)
         self._batches.append(raw)
         for i, e in enumerate(missing):
@@ -122,7 +126,7 @@ class Numerics:
 
     def _call(self, batch: int, z: np.ndarray) -> list[float]:
         with np.errstate(all="ignore"):
-            out = self._batches[batch](*z, *self.parameter_vector)
+            out = self._batches[batch](*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
         return [complex(v).real if isinstance(v, complex) else float(v) for v in out]
 
     def evaluate(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:

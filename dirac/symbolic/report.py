@@ -106,30 +106,31 @@ def to_text(analysis: "ConstraintAnalysis") -> str:
 
 
 def to_latex(analysis: "ConstraintAnalysis", display: bool = False) -> str:
-    """LaTeX rendering (``align*`` blocks); ``display=True`` wraps it for Jupyter."""
+    """LaTeX rendering: one ``align*`` environment (``display=True``: ``$$ aligned $$`` for Jupyter)."""
     a = analysis
     lx = sympy.latex
-    out = [rf"\textbf{{Dirac--Bergmann analysis of \texttt{{{a.name.replace('_', r'\_')}}}}}"]
-    out.append(r"\begin{align*}")
-    out.append(rf"L &= {lx(a.lagrangian.expression)} \\")
+    name = a.name.replace("_", r"\_")
+    rows = [rf"&\text{{Dirac--Bergmann analysis of {name}}}"]
+    rows.append(rf"L &= {lx(a.lagrangian.expression)}")
     for k, chi in enumerate(a.lagrangian.constraints, start=1):
-        out.append(rf"\chi_{{{k}}} &= {lx(chi)} = 0 \\")
-    out.append(rf"H_c &= {lx(a.canonical_hamiltonian)}")
-    out.append(r"\end{align*}")
+        rows.append(rf"\chi_{{{k}}} &= {lx(chi)} = 0")
+    rows.append(rf"H_c &= {lx(a.canonical_hamiltonian)}")
     for k, stage in enumerate(a.stages, start=1):
         title = "primary constraints" if k == 1 else f"stage {k}"
-        out.append(rf"\textit{{{title} ({len(stage)})}}")
-        out.append(r"\begin{align*}")
-        out.append(" \\\\\n".join(rf"&{lx(c)} = 0" for c in stage))
-        out.append(r"\end{align*}")
-    if a.multipliers:
-        out.append(r"\textit{multipliers}")
-        out.append(r"\begin{align*}")
-        out.append(" \\\\\n".join(rf"{lx(sympy.Symbol(k))} &= {lx(v)}" for k, v in a.multipliers.items()))
-        out.append(r"\end{align*}")
-    out.append(
-        rf"\textit{{first class: {len(a.first_class)}, second class: {len(a.second_class)}, "
+        rows.append(rf"&\text{{{title} ({len(stage)})}}")
+        rows.extend(rf"&{lx(c)} = 0" for c in stage)
+    if a.primary_multipliers:
+        rows.append(r"&\text{multipliers}")
+        for u in a.primary_multipliers:
+            if u.name in a.multipliers:
+                rows.append(rf"{lx(u)} &= {lx(a.multipliers[u.name])}")
+            else:
+                rows.append(rf"{lx(u)} &\;\text{{undetermined (gauge)}}")
+    rows.append(
+        rf"&\text{{first class: {len(a.first_class)}, second class: {len(a.second_class)}, "
         rf"physical degrees of freedom: {a.physical_degrees_of_freedom}}}"
     )
-    text = "\n".join(out)
-    return text
+    body = " \\\\\n".join(rows)
+    if display:
+        return "$$\\begin{aligned}\n" + body + "\n\\end{aligned}$$"
+    return "\\begin{align*}\n" + body + "\n\\end{align*}"
