@@ -79,10 +79,8 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
         figures stay meaningful on a machine shared with other jobs, where wall times
         are not.
     """
-    from distributed import Client
-
     from dirac.ensemble.chunk import advance_members, warm_up
-    from dirac.ensemble.engine import default_chunk_size, local_cluster, run_ensemble
+    from dirac.ensemble.engine import dask_client, default_chunk_size, local_cluster, run_ensemble
 
     dt = 0.01
     scene = _scene(members, steps, dt)
@@ -119,7 +117,7 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
         results["local"] = _best(local_runs)
 
         cluster = local_cluster(workers)
-        client = Client(cluster)
+        client = dask_client(cluster)
         try:
             client.run(warm_up)
             dask_runs = []
