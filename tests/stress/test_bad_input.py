@@ -370,3 +370,26 @@ def test_load_system_refuses_unknown_names_and_bad_parameters(name, value):
     if not (isinstance(value, float) and math.isfinite(value)):
         with pytest.raises(InputError):
             dirac.load_system("pendulum", l=value)
+
+
+# ----------------------------------------------------------------------------- constraint surface
+@settings(max_examples=10, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(angle=st.floats(-3.0, 3.0), radius=st.one_of(st.floats(0.5, 0.999), st.floats(1.001, 2.0)),
+       radial_speed=st.one_of(st.floats(-2.0, -1e-3), st.floats(1e-3, 2.0)), which=st.booleans())
+def test_initial_data_off_the_constraint_surface_is_refused(angle, radius, radial_speed, which, cli, tmp_path):
+    """Pendulum (l = 1): q off the circle, or q on it with a radial velocity."""
+    x, y = math.sin(angle), -math.cos(angle)
+    if which:
+        initial = {"q": {"x": radius * x, "y": radius * y}}
+        phrase = "off the constraint surface"
+    else:
+        initial = {"q": {"x": x, "y": y}, "q_dot": {"x": radial_speed * x, "y": radial_speed * y}}
+        phrase = "not tangent"
+    scene = {"system": {"name": "pendulum"}, "initial": initial,
+             "run": {"t_end": 0.1, "method": "rattle-2", "dt": 0.01, "samples": 2}}
+    path = tmp_path / "scene.toml"
+    path.write_text(toml_document(scene))
+    out = tmp_path / "out.npz"
+    status, _, err = cli("run", str(path), "--out", str(out), "--no-progress")
+    assert phrase in assert_one_error_line(status, err)
+    assert not out.exists()
