@@ -41,10 +41,17 @@ def standard_problem():
         return RigidBodyProblem(STANDARD_INERTIA, STANDARD_M0)
 
 
-@pytest.fixture
 def stress_scale() -> float:
-    """The scale of slow stress runs, as :func:`tests/conftest.py::stress_scale` defines it
-    (1.0 with ``DIRAC_FULL_STRESS=1``, else a small fraction)."""
+    """Same as ``tests/conftest.py::stress_scale`` (1.0 with ``DIRAC_FULL_STRESS=1``, else a
+    small fraction). Conftest modules of test folders without ``__init__.py`` share the
+    module name ``conftest``; defining it here too keeps ``from conftest import
+    stress_scale`` working in other folders whichever conftest pytest imported last."""
     import os
 
     return 1.0 if os.environ.get("DIRAC_FULL_STRESS") == "1" else 0.01
+
+
+@pytest.fixture
+def stress() -> float:
+    """:func:`stress_scale` as a fixture."""
+    return stress_scale()
