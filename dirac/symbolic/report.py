@@ -68,12 +68,16 @@ def to_text(analysis: "ConstraintAnalysis") -> str:
         lines.append(f"parameters (symbolic): {', '.join(p.name for p in a.parameters)}")
     lines.append(f"Hessian d2L/dq_dot2: rank {a.hessian_rank} of {len(a.lagrangian.coordinates)}")
     lines.append(f"canonical Hamiltonian H_c = {_short(a.canonical_hamiltonian)}")
-    lines.append("total Hamiltonian H_T = H_c + " + " + ".join(f"{u}*phi_{k}" for k, u in enumerate(a.primary_multipliers, 1)) if a.primary_multipliers else "total Hamiltonian H_T = H_c")
+    if a.primary_multipliers:
+        terms = " + ".join(f"{u}*({_short(phi, 80)})" for u, phi in zip(a.primary_multipliers, a.primary_constraints))
+        lines.append(f"total Hamiltonian H_T = H_c + {terms}")
+    else:
+        lines.append("total Hamiltonian H_T = H_c")
     lines.append("")
     lines.append(f"constraint chain: {len(a.stages)} stage(s), {len(a.constraints)} constraint(s)")
     for k, stage in enumerate(a.stages, start=1):
-        label = "primary" if k == 1 else f"stage {k}"
-        lines.append(f"  stage {k} ({label if k > 1 else 'primary'}): {len(stage)} constraint(s)")
+        label = " (primary)" if k == 1 else ""
+        lines.append(f"  stage {k}{label}: {len(stage)} constraint(s)")
         for c in stage:
             lines.append(f"    {_short(c)} = 0")
     lines.append("")
