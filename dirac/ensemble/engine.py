@@ -339,7 +339,9 @@ def run_ensemble(
 
     bar = _Progress(progress, scene.count, sum(m["stop"] - m["start"] for m in done.values()))
     try:
-        if run["executor"] == "local":
+        if not missing:  # nothing to do: no cluster is started
+            start_time = time.perf_counter()
+        elif run["executor"] == "local":
             start_time = time.perf_counter()
             _run_local(scene, store, missing, chunk_size, run["run_id"], retries, record)
         else:
