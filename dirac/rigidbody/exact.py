@@ -123,7 +123,8 @@ class ExactRigidBodyFlow:
         a = 1.0 / self.inertia
         M = self.M0
         self.casimir = float(M @ M)
-        self.energy = 0.5 * float(np.sum(a * M * M))
+        with np.errstate(over="ignore"):
+            self.energy = 0.5 * float(np.sum(a * M * M))
         nonzero = M != 0.0
         self.equilibrium = (not np.any(nonzero)) or float(np.ptp(a[nonzero])) == 0.0
         self._p = np.zeros(15)
@@ -131,12 +132,22 @@ class ExactRigidBodyFlow:
         self._em = np.zeros(0)
         self._en = np.zeros(0)
         self._Q = np.array(self.R0)
+        self._size = 1.0
+        self._rate = 1.0
         if self.equilibrium:
             self.m = 0.0
             self.mc = 1.0
             self.omega = a * M
             return
-        self._setup(a, M)
+        # Homogeneity of (250)-(251): with G = |M(0)| and alpha = max 1/I_i,
+        # M(t) = G Mu(G alpha t) and R(t) = Ru(G alpha t), where (Mu, Ru) is the flow of the
+        # moments I alpha with |Mu(0)| = 1. The set-up works in these units, so no product
+        # M_i^2 (a_i - a_j) under- or overflows however small |M| or I_i are.
+        largest = float(np.max(np.abs(M)))
+        self._size = largest * float(np.linalg.norm(M / largest))
+        alpha = float(np.max(a))
+        self._rate = self._size * alpha
+        self._setup(a / alpha, M / self._size)
 
     def _setup(self, a: np.ndarray, M: np.ndarray) -> None:
         lo, mid, hi = (int(k) for k in np.argsort(a, kind="stable"))
@@ -201,7 +212,7 @@ class ExactRigidBodyFlow:
                 half = math.copysign(2.0, sn0)
                 u0 = half * K - f_red
                 pi0 = half * pi_complete - pi_red
-        G = math.sqrt(self.casimir)
+        G = math.sqrt(float(M @ M))  # 1 up to round-off in the scaled units of __init__
         self.m = m
         self.mc = mc
         self._perm = np.array([p1, p2, p3, b], dtype=np.int64)
@@ -239,7 +250,7 @@ class ExactRigidBodyFlow:
             return 0.0
         if self.mc == 0.0:
             return math.inf
-        return 4.0 * self._p[12] / self._p[3]
+        return 4.0 * self._p[12] / self._p[3] / self._rate
 
     def M(self, times: object) -> np.ndarray:
         """Body angular momentum ``M(t)`` (Jacobi elliptic solution of (250)).
@@ -256,8 +267,8 @@ class ExactRigidBodyFlow:
         if self.equilibrium:
             return np.tile(self.M0, (t.shape[0], 1))
         out = np.empty((t.shape[0], 3))
-        _eval_M(t, self._p, self._perm, self._em, self._en, out)
-        return out
+        _eval_M(t * self._rate, self._p, self._perm, self._em, self._en, out)
+        return out * self._size
 
     def state(self, times: object) -> tuple[np.ndarray, np.ndarray]:
         """``(M(t), R(t))`` at the given times.
@@ -276,8 +287,8 @@ class ExactRigidBodyFlow:
             return np.tile(self.M0, (t.shape[0], 1)), _uniform_rotation(self.R0, self.omega, t)
         M_out = np.empty((t.shape[0], 3))
         R_out = np.empty((t.shape[0], 3, 3))
-        _eval_state(t, self._p, self._perm, self._em, self._en, self._Q, M_out, R_out)
-        return M_out, R_out
+        _eval_state(t * self._rate, self._p, self._perm, self._em, self._en, self._Q, M_out, R_out)
+        return M_out * self._size, R_out
 
     def R(self, times: object) -> np.ndarray:
         """Attitude ``R(t)`` (body to lab) solving (251).

@@ -55,6 +55,13 @@ def validate_inertia(inertia: object) -> np.ndarray:
             f"inertia = {moments.tolist()} has a non-positive moment; every principal "
             "moment I_i must be > 0"
         )
+    with np.errstate(divide="ignore", over="ignore"):
+        reciprocal = 1.0 / moments
+    if not np.all(np.isfinite(reciprocal)):
+        raise InputError(
+            f"inertia = {moments.tolist()} has a moment so small that 1/I_i overflows; "
+            "rescale the units (e.g. measure lengths in smaller units)"
+        )
     for k in range(3):
         i, j = (k + 1) % 3, (k + 2) % 3
         if moments[i] + moments[j] < moments[k]:
@@ -123,6 +130,15 @@ def validate_momentum(momentum: object) -> np.ndarray:
     Raises
     ------
     InputError
-        Wrong shape or non-finite entries.
+        Wrong shape, non-finite entries, or so large that ``|M|^2`` overflows (then no
+        invariant of (247)-(249) can be evaluated).
     """
-    return _as_float_array(momentum, "M", (3,))
+    array = _as_float_array(momentum, "M", (3,))
+    with np.errstate(over="ignore"):
+        square = float(array @ array)
+    if not np.isfinite(square):
+        raise InputError(
+            f"M = {array.tolist()} is so large that |M|^2 overflows; rescale the units "
+            "(e.g. measure angular momentum in larger units)"
+        )
+    return array

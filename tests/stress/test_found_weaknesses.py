@@ -1,0 +1,92 @@
+"""Regression tests of weaknesses the stress tests found in the rigid-body kernels.
+
+F5: an ``M`` whose ``|M|^2`` overflows crashed ``exact`` (now an input error). F6: tiny
+moments of inertia printed raw numpy overflow warnings. F7: a slowly turning body
+(``|M|`` below ~1e-154) crashed ``exact`` with ZeroDivisionError. Bad input gives an
+``InputError``; legal input gives the correct result, checked by the homogeneity of the
+Euler-Poisson equations (250)-(251).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+RIGID = """
+[system]
+name = "rigid_body"
+inertia = {inertia}
+[initial]
+M = {M}
+[run]
+t_end = {t_end}
+{extra}
+"""
+
+
+def _one_error_line(status: int, err: str) -> str:
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert status == 2, err
+    assert len(lines) == 1 and lines[0].startswith("error:"), err
+    return lines[0]
+
+
+def _scene(tmp_path, **fields) -> str:  # noqa: ANN001
+    values = {"inertia": "[1.0, 2.0, 3.0]", "M": "[1.0, 0.2, 0.1]", "t_end": "1.0", "extra": ""} | fields
+    path = tmp_path / "scene.toml"
+    path.write_text(RIGID.format(**values))
+    return str(path)
+
+
+def test_f5_momentum_whose_square_overflows_is_an_input_error():
+    from dirac.errors import InputError
+    from dirac.flows.problem import RigidBodyProblem
+
+    with pytest.raises(InputError):
+        RigidBodyProblem([1.0, 2.0, 3.0], [1e308, 1e308, 0.0])
+
+
+def test_f6_tiny_inertia_gives_only_dirac_lines_on_stderr(tmp_path, run_cli):
+    scene = _scene(tmp_path, inertia="[1e-300, 1.0, 1.0]", M="[1.0, 1.0, 1.0]", extra='method = "exact"')
+    status, _, err = run_cli("run", scene, "--out", str(tmp_path / "o.npz"), "--no-progress")
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert status in (0, 2) and all(line.startswith(("error:", "warning:")) for line in lines), err
+
+
+def test_f6_tiny_moments_give_the_time_scaled_flow():
+    """``I -> c I`` slows the motion by ``c``: ``M(t; c I) = M(t / c; I)``, same for ``R``."""
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    M0 = [0.6, 0.48, 0.64]
+    tiny = ExactRigidBodyFlow([1e-300, 2e-300, 3e-300], M0)
+    unit = ExactRigidBodyFlow([1.0, 2.0, 3.0], M0)
+    times = np.array([0.0, 0.7, 5.0])
+    M_tiny, R_tiny = tiny.state(times * 1e-300)
+    M_unit, R_unit = unit.state(times)
+    assert np.allclose(M_tiny, M_unit, rtol=0, atol=1e-14)
+    assert np.allclose(R_tiny, R_unit, rtol=0, atol=1e-14)
+
+
+def test_f6_moments_whose_reciprocal_overflows_are_an_input_error():
+    from dirac.errors import InputError
+    from dirac.flows.problem import RigidBodyProblem
+
+    with pytest.raises(InputError, match="overflows"):
+        RigidBodyProblem([1e-310, 1.0, 1.0], [1.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("M", [[1e-170, 1e-170, 0.0], [8.8e-290, 1.9e-171, -2.4e-295], [3e-200, 4e-200, 5e-200]])
+def test_f7_exact_flow_of_a_slowly_turning_body_is_the_scaled_flow(M):
+    """Homogeneity of (250)-(251): M(t; s M0) = s M(s t; M0) and R(t; s M0) = R(s t; M0)."""
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    M = np.array(M)
+    largest = float(np.max(np.abs(M)))
+    scale = largest * float(np.linalg.norm(M / largest))  # |M| without underflow
+    unit = ExactRigidBodyFlow([1.0, 2.0, 3.0], M / scale)
+    tiny = ExactRigidBodyFlow([1.0, 2.0, 3.0], M)
+    times = np.array([0.0, 1.0, 2.0]) / scale
+    M_tiny, R_tiny = tiny.state(times)
+    M_unit, R_unit = unit.state(times * scale)
+    assert np.allclose(M_tiny / scale, M_unit, rtol=0, atol=1e-14)
+    assert np.allclose(R_tiny, R_unit, rtol=0, atol=1e-14)
