@@ -81,21 +81,25 @@ def main(args: argparse.Namespace) -> int:
 
     previous = signal.signal(signal.SIGTERM, terminate)
     try:
-        solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]
-    except IntegrationError as exc:
-        partial = exc.partial
-        if partial is None:
-            raise
-        target = write_results(partial, _partial_path(out), extra_meta=scene.meta)  # type: ignore[arg-type]
-        note = (f"{len(partial.t)} samples up to t = {partial.t[-1]:.6g} saved in {target} (meta complete = false)"  # type: ignore[attr-defined]
-                if len(partial.t) else f"no samples were computed; {target} records the failure (meta complete = false)")  # type: ignore[attr-defined]
-        if isinstance(exc, IntegrationInterrupted):
-            print(f"error: {exc}; {note}", file=sys.stderr)
-            return 130
-        raise IntegrationError(f"{exc}; {note}") from None
+        try:
+            solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]
+        except IntegrationError as exc:
+            partial = exc.partial
+            if partial is None:
+                raise
+            target = write_results(partial, _partial_path(out), extra_meta=scene.meta)  # type: ignore[arg-type]
+            note = (f"{len(partial.t)} samples up to t = {partial.t[-1]:.6g} saved in {target} (meta complete = false)"  # type: ignore[attr-defined]
+                    if len(partial.t) else f"no samples were computed; {target} records the failure (meta complete = false)")  # type: ignore[attr-defined]
+            if isinstance(exc, IntegrationInterrupted):
+                print(f"error: {exc}; {note}", file=sys.stderr)
+                return 130
+            raise IntegrationError(f"{exc}; {note}") from None
+        write_results(solution, out, extra_meta=scene.meta)
+    except KeyboardInterrupt:  # before the loop or while writing: no temporary file is left behind
+        print(f"error: interrupted; {out} was left as it was", file=sys.stderr)
+        return 130
     finally:
         signal.signal(signal.SIGTERM, previous)
-    write_results(solution, out, extra_meta=scene.meta)
     dt = f", dt = {solution.dt:.6g}" if solution.dt else ""
     print(
         f"{scene.system}: method {solution.method} (order {solution.order}{dt}), {solution.steps} steps, "
