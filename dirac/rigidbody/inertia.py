@@ -13,7 +13,20 @@ from dirac.errors import InputError, warn
 __all__ = ["validate_inertia", "validate_rotation", "validate_momentum"]
 
 
+def _has_boolean(value: object) -> bool:
+    """Whether ``value`` is or contains a boolean (``True`` would silently become 1.0)."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype == bool or (value.dtype == object and any(_has_boolean(v) for v in value.flat))
+    if isinstance(value, (list, tuple)):
+        return any(_has_boolean(v) for v in value)
+    return False
+
+
 def _as_float_array(value: object, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    if _has_boolean(value):
+        raise InputError(f"{name} = {value!r} contains true/false; give {shape} real numbers")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:

@@ -165,8 +165,7 @@ def bad_scene(draw) -> dict:  # noqa: ANN001
 @st.composite
 def good_rigid_scene(draw) -> dict:  # noqa: ANN001
     inertia = draw(st.lists(st.floats(0.1, 10.0), min_size=3, max_size=3))
-    M = draw(st.lists(st.one_of(st.just(0.0), st.floats(1e-3, 3.0), st.floats(-3.0, -1e-3)), min_size=3, max_size=3))
-    assume(np.linalg.norm(M) >= 1e-3)  # |M| below ~1e-154 underflows in exact: robustness_findings.md F7
+    M = draw(st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3))
     method = draw(st.sampled_from(["lie-poisson-2", "lie-poisson-4", "exact", "midpoint", "scipy-DOP853", "auto"]))
     run = {"t_end": draw(st.floats(0.05, 3.0)), "method": method, "samples": draw(st.integers(1, 12))}
     if method in ("lie-poisson-2", "lie-poisson-4", "midpoint"):

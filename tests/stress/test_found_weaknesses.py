@@ -2,7 +2,8 @@
 
 F5: an ``M`` whose ``|M|^2`` overflows crashed ``exact`` (now an input error). F6: tiny
 moments of inertia printed raw numpy overflow warnings. F7: a slowly turning body
-(``|M|`` below ~1e-154) crashed ``exact`` with ZeroDivisionError. Bad input gives an
+(``|M|`` below ~1e-154) crashed ``exact`` with ZeroDivisionError. F14: booleans were
+taken as numbers. Bad input gives an
 ``InputError``; legal input gives the correct result, checked by the homogeneity of the
 Euler-Poisson equations (250)-(251).
 """
@@ -90,3 +91,15 @@ def test_f7_exact_flow_of_a_slowly_turning_body_is_the_scaled_flow(M):
     M_unit, R_unit = unit.state(times * scale)
     assert np.allclose(M_tiny / scale, M_unit, rtol=0, atol=1e-14)
     assert np.allclose(R_tiny, R_unit, rtol=0, atol=1e-14)
+
+
+
+@pytest.mark.parametrize(("inertia", "M"), [([True, 2.0, 3.0], [1.0, 0.0, 0.0]), ([1.0, 2.0, 3.0], [False, 0.2, 0.1]),
+                                            (np.array([1.0, 2.0, 3.0]), np.array([True, False, True]))])
+def test_f14_booleans_are_not_numbers_for_the_rigid_body_kernels(inertia, M):
+    """``True`` would silently become 1.0 (hypothesis ran a scene with ``M = [false, 0.2, 0.1]``)."""
+    from dirac.errors import InputError
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    with pytest.raises(InputError, match="true/false"):
+        ExactRigidBodyFlow(inertia, M)
