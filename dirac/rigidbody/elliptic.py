@@ -86,6 +86,10 @@ def sncndn(u, em, en, agm):  # noqa: ANN001, ANN201
     if levels == 0:
         sech = 1.0 / math.cosh(u)
         return math.tanh(u), sech, sech
+    if abs(u) < 1e-150:
+        # sn = u - (1 + m) u^3 / 6 + ..., cn = 1 - u^2 / 2, dn = 1 - m u^2 / 2: exact in double
+        # here, and cn / sn below would overflow for a subnormal u
+        return u, 1.0, 1.0
     x = u * agm
     sn = math.sin(x)
     cn = math.cos(x)

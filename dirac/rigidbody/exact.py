@@ -153,20 +153,33 @@ class ExactRigidBodyFlow:
         lo, mid, hi = (int(k) for k in np.argsort(a, kind="stable"))
         p2 = mid
         d2 = M[hi] ** 2 * (a[hi] - a[mid]) - M[lo] ** 2 * (a[mid] - a[lo])
-        p3, p1 = (hi, lo) if d2 >= 0.0 else (lo, hi)
+        if a[hi] == a[mid]:  # symmetric body: the polhodes circle the distinct axis, whatever
+            p3, p1 = lo, hi  # d2 says after M_lo^2 underflowed (d2 = -0.0 would pick a = a)
+        elif a[mid] == a[lo]:
+            p3, p1 = hi, lo
+        else:
+            p3, p1 = (hi, lo) if d2 >= 0.0 else (lo, hi)
         a1, a2, a3 = a[p1], a[p2], a[p3]
         # same-sign sums: 2E - a_k G^2 = sum_{i != k} M_i^2 (a_i - a_k)
         e_a3 = M[p1] ** 2 * (a1 - a3) + M[p2] ** 2 * (a2 - a3)
         e_a1 = M[p2] ** 2 * (a2 - a1) + M[p3] ** 2 * (a3 - a1)
         e_a2 = M[p1] ** 2 * (a1 - a2) + M[p3] ** 2 * (a3 - a2)
-        A1 = math.sqrt(e_a3 / (a1 - a3))
-        A2 = math.sqrt(e_a3 / (a2 - a3))
-        A3 = math.sqrt(e_a1 / (a3 - a1))
-        m = e_a3 * (a2 - a1) / ((a2 - a3) * e_a1)
-        mc = (a1 - a3) * e_a2 / ((a2 - a3) * e_a1)
-        m = min(max(m, 0.0), 1.0)
-        mc = min(max(mc, 0.0), 1.0)
-        lam = abs((a3 - a2) * A2 * A3 / A1)
+        if a1 == a2:
+            # symmetric top, m = 0: the values below without squares, which may underflow
+            # (e_a1 = M_p3^2 (a3 - a1) gives A3 = |M_p3|, e_a3 / (a1 - a3) = M_p1^2 + M_p2^2)
+            A1 = A2 = math.hypot(float(M[p1]), float(M[p2]))
+            A3 = abs(float(M[p3]))
+            m, mc = 0.0, 1.0
+            lam = abs(a3 - a2) * A3
+        else:
+            A1 = math.sqrt(e_a3 / (a1 - a3))
+            A2 = math.sqrt(e_a3 / (a2 - a3))
+            A3 = math.sqrt(e_a1 / (a3 - a1))
+            m = e_a3 * (a2 - a1) / ((a2 - a3) * e_a1)
+            mc = (a1 - a3) * e_a2 / ((a2 - a3) * e_a1)
+            m = min(max(m, 0.0), 1.0)
+            mc = min(max(mc, 0.0), 1.0)
+            lam = abs((a3 - a2) * A2 * A3 / A1)
         s3 = 1.0 if M[p3] >= 0.0 else -1.0
         s1 = 1.0
         cn0 = M[p1] / A1
@@ -185,7 +198,7 @@ class ExactRigidBodyFlow:
         # (psi' = G (a_b + (a_o - a_b)/(1 - n sn^2)), o the other extreme axis). Take the
         # smaller |n|: Pi = F + n J cancels by a factor ~ sqrt|n| when |n| is large.
         n_p3 = (a2 - a1) / (a2 - a3)
-        n_p1 = -(A1 * A1) / (A3 * A3)
+        n_p1 = -(A1 * A1) / (A3 * A3) if n_p3 != 0.0 else -math.inf
         if abs(n_p3) <= abs(n_p1):
             b, a_b, a_o, n_char = p3, a3, a1, n_p3
         else:
@@ -228,8 +241,8 @@ class ExactRigidBodyFlow:
                 n_char,
                 pi_complete,
                 pi0,
-                G * a_b,
-                G * (a_o - a_b) / lam,
+                G * a_b if n_char != 0.0 else G * a_o,  # n = 0 (symmetric top): psi' = G a_o
+                G * (a_o - a_b) / lam if n_char != 0.0 else 0.0,  # (no 1/lam: lam may underflow)
                 G,
                 K,
                 math.sqrt(mc),

@@ -3,7 +3,8 @@
 F5: an ``M`` whose ``|M|^2`` overflows crashed ``exact`` (now an input error). F6: tiny
 moments of inertia printed raw numpy overflow warnings. F7: a slowly turning body
 (``|M|`` below ~1e-154) crashed ``exact`` with ZeroDivisionError. F14: booleans were
-taken as numbers. Bad input gives an
+taken as numbers. F15: a symmetric top with a component whose square underflows divided
+by zero. Bad input gives an
 ``InputError``; legal input gives the correct result, checked by the homogeneity of the
 Euler-Poisson equations (250)-(251).
 """
@@ -103,3 +104,25 @@ def test_f14_booleans_are_not_numbers_for_the_rigid_body_kernels(inertia, M):
 
     with pytest.raises(InputError, match="true/false"):
         ExactRigidBodyFlow(inertia, M)
+
+
+
+@pytest.mark.parametrize("M", [[0.0, 1.0, 2.225073858507e-311], [1.0, 0.0, 1e-200], [0.0, 1.0, -1e-170]])
+def test_f15_symmetric_body_with_an_underflowing_component_is_a_slow_precession(M):
+    """``I = (1, 1, 2)``: ``M_3`` is constant and ``(M_1, M_2)`` turns about axis 3 at the rate
+    ``(1/I_3 - 1/I_1) M_3`` (Euler's equations (250) with ``I_1 = I_2``); for ``M_3 ~ 1e-311``
+    that is no visible motion. Hypothesis found ``exact`` dividing by ``a_2 - a_3 = 0`` here."""
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    flow = ExactRigidBodyFlow([1.0, 1.0, 2.0], M)
+    times = np.array([0.0, 1.0, 10.0])
+    M_t, R_t = flow.state(times)
+    rate = (0.5 - 1.0) * M[2]
+    angle = rate * times
+    expected = np.stack([M[0] * np.cos(angle) + M[1] * np.sin(angle),
+                         -M[0] * np.sin(angle) + M[1] * np.cos(angle), np.full(3, M[2])], axis=1)
+    assert np.allclose(M_t, expected, rtol=0, atol=1e-15)
+    assert np.all(np.isfinite(R_t))
+    for R in R_t:
+        assert np.allclose(R.T @ R, np.eye(3), atol=1e-14)
+    assert np.allclose(np.einsum("tij,tj->ti", R_t, M_t), np.asarray(M, dtype=float)[None], atol=1e-14)
