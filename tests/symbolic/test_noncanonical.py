@@ -1,6 +1,6 @@
 """Brackets in noncanonical variables: the change (235) ``(R, p) -> (R, M, P)`` and the
-brackets (236)–(238), written out by hand here; Dirac brackets of the new variables on
-the constraint surface of (228) from the engine."""
+brackets (236)–(238), written out by hand here. (Dirac brackets of the new variables on
+the surface of (78) are exercised in test_compare.py and test_chetaev.py.)"""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 import sympy
 
-import dirac
 from dirac.errors import AnalysisError, InputError
 from dirac.symbolic.noncanonical import (
     NoncanonicalVariables,
@@ -90,7 +89,7 @@ def test_inverse_change_235_is_the_inverse(change_235):
 def test_brackets_236_237_symbolically_for_any_invertible_R(change_235):
     """{M_i, R_jk} = -eps_ikm R~^T_jm (236) and {R_ij, P_ab} = R~^T_ia delta_jb +
     R~^T_ib delta_ja (237), exactly, with R~ = R^{-1} of a general matrix."""
-    w = rigid_body_variables()
+    w = change_235
     Rt = R.inv(method="ADJ")
     for i in range(3):
         for j, k in [(0, 0), (1, 2), (2, 1)]:
@@ -178,39 +177,3 @@ def test_bad_new_variables_are_refused():
     assert w.bracket("q", "s", express=True) == 1
     with pytest.raises(InputError, match="not one of the new variables"):
         w.bracket("q", "x")
-
-
-def cached_analysis(config: pytest.Config, name: str):
-    """One engine analysis per built-in system for the whole test session."""
-    store = config.__dict__.setdefault("_dirac_rigid_body_analyses", {})
-    if name not in store:
-        store[name] = dirac.analyze(dirac.load_system(name))
-    return store[name]
-
-
-def hat(w_: np.ndarray) -> np.ndarray:
-    return np.array([[0, -w_[2], w_[1]], [w_[2], 0, -w_[0]], [-w_[1], w_[0], 0]], dtype=float)
-
-
-@pytest.mark.slow
-def test_dirac_brackets_of_R_M_P_on_the_surface_of_228(request):
-    """On the surface, the Dirac brackets of the new variables are (236) with R~ = R^T
-    = R^{-1}, i.e. Chetaev (248)-(249), and the constraints P are Casimirs (Sect. XI)."""
-    analysis = cached_analysis(request.config, "rigid_body_momentum")
-    w = rigid_body_variables(analysis.symbols, inverse="transpose")
-    rng = np.random.default_rng(7)
-    for _ in range(3):
-        q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-        R_ = q * np.sign(np.linalg.det(q))
-        M_ = rng.normal(size=3)
-        p_ = 0.5 * R_ @ hat(M_)  # (229)
-        given = {f"R_{i + 1}{j + 1}": R_[i, j] for i in range(3) for j in range(3)}
-        given |= {f"p_R_{i + 1}{j + 1}": p_[i, j] for i in range(3) for j in range(3)}
-        point = analysis.surface_point(values=given, seed=3)
-        J = w.dirac_bracket_matrix(analysis, point)
-        index = {name: k for k, name in enumerate(w.names)}
-        expected = hand_brackets(R_.T, M_)
-        for (a, b), value in expected.items():
-            if a.startswith("P") or b.startswith("P"):
-                value = 0.0  # P_ij are second-class constraints: Casimirs of { , }_D
-            assert J[index[a], index[b]] == pytest.approx(value, abs=1e-9), (a, b)
