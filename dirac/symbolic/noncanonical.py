@@ -119,19 +119,20 @@ def body_angular_momentum(R: sympy.Matrix, p: sympy.Matrix, inverse: str = "tran
         ``"inverse"``: ``R~ = R^{-1}`` exactly as in (229)–(233), which is what makes the
         brackets (236)–(238) hold for an arbitrary invertible ``R``.
     """
-    Q = _tilde(R, inverse) * p
-    result = []
-    for k in range(3):
-        M_k = -sum(sympy.LeviCivita(k, i, j) * Q[i, j] for i in range(3) for j in range(3))
-        result.append(sympy.expand(M_k) if inverse == "transpose" else M_k)
-    return result
+    N, D = _reduced_momentum(R, p, inverse)
+    return [
+        sympy.expand(-sum(sympy.LeviCivita(k, i, j) * N[i, j] for i in range(3) for j in range(3))) / D
+        for k in range(3)
+    ]
 
 
-def _tilde(R: sympy.Matrix, inverse: str) -> sympy.Matrix:
+def _reduced_momentum(R: sympy.Matrix, p: sympy.Matrix, inverse: str) -> tuple[sympy.Matrix, sympy.Expr]:
+    """``R~ p = N / D`` with polynomial ``N`` and ``D`` (``D = 1`` for ``R^T``, ``det R``
+    for ``R^{-1} = adj(R)/det(R)``): one division per function keeps derivatives small."""
     if inverse == "transpose":
-        return R.T
+        return (R.T * p).applyfunc(sympy.expand), sympy.Integer(1)
     if inverse == "inverse":
-        return R.adjugate() / R.det()
+        return (R.adjugate() * p).applyfunc(sympy.expand), sympy.expand(R.det())
     raise InputError(f"inverse = {inverse!r}: use 'transpose' or 'inverse'")
 
 
@@ -336,14 +337,12 @@ def rigid_body_variables(
         ``"inverse"`` or ``"transpose"`` (see above).
     """
     R, p = rotation_matrix_symbols(symbols)
-    Rt = _tilde(R, inverse)
-    Q = Rt * p
+    N, D = _reduced_momentum(R, p, inverse)
     M = body_angular_momentum(R, p, inverse)
     functions: dict[str, sympy.Expr] = {R[i, j].name: R[i, j] for i in range(3) for j in range(3)}
     functions.update({f"M_{k + 1}": M[k] for k in range(3)})
     for i, j in SYMMETRIC_PAIRS:
-        entry = Q[i - 1, j - 1] + Q[j - 1, i - 1]
-        functions[f"P_{i}{j}"] = sympy.expand(entry) if inverse == "transpose" else entry
+        functions[f"P_{i}{j}"] = sympy.expand(N[i - 1, j - 1] + N[j - 1, i - 1]) / D
     new_M = [sympy.Symbol(f"M_{k}", real=True) for k in (1, 2, 3)]
     new_P = sympy.Matrix(
         3, 3, lambda i, j: sympy.Symbol(f"P_{min(i, j) + 1}{max(i, j) + 1}", real=True)
