@@ -429,8 +429,9 @@ def named_bracket(name: str, analysis: Any, variables: NoncanonicalVariables | N
 def surface_points(analysis: Any, count: int, seed: int = 0) -> list[dict[str, float]]:
     """``count`` numeric points of the constraint surface of ``analysis``.
 
-    Uses ``analysis.surface_point(seed=…)``; parameters that are still symbolic take the
-    values the engine chooses for the point (they are part of the returned dict).
+    Uses ``analysis.surface_point(seed=…)`` (Gauss–Newton projection of random points);
+    parameters that are still symbolic take their default values, which the brackets
+    then use too.
     """
     if count < 1:
         raise InputError(f"number of points = {count}: give at least 1")

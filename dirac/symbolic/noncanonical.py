@@ -13,9 +13,9 @@ new variables whose brackets are no longer ``0`` and ``±1``. This module
 Example
 -------
 >>> from dirac.symbolic.noncanonical import rigid_body_variables
->>> w = rigid_body_variables()
->>> w.bracket("M_1", "M_2", express=True)      # (236), R an arbitrary invertible matrix
-... # doctest: +SKIP
+>>> w = rigid_body_variables(inverse="transpose")
+>>> w.bracket("M_1", "R_13")                    # (236) with R~ = R^T: -eps_13m R_1m
+R_12
 """
 
 from __future__ import annotations
