@@ -172,14 +172,18 @@ class ExactRigidBodyFlow:
             m, mc = 0.0, 1.0
             lam = abs(a3 - a2) * A3
         else:
-            A1 = math.sqrt(e_a3 / (a1 - a3))
-            A2 = math.sqrt(e_a3 / (a2 - a3))
-            A3 = math.sqrt(e_a1 / (a3 - a1))
-            m = e_a3 * (a2 - a1) / ((a2 - a3) * e_a1)
-            mc = (a1 - a3) * e_a2 / ((a2 - a3) * e_a1)
+            # A1^2 = e_a3 / (a1 - a3) etc. as hypotenuses: no square of a component near
+            # a principal axis underflows (M within 1e-170 of an axis keeps its amplitude)
+            A1 = math.hypot(float(M[p1]), float(M[p2]) * math.sqrt((a2 - a3) / (a1 - a3)))
+            A2 = math.hypot(float(M[p1]) * math.sqrt((a1 - a3) / (a2 - a3)), float(M[p2]))
+            A3 = math.hypot(float(M[p2]) * math.sqrt((a2 - a1) / (a3 - a1)), float(M[p3]))
+            m = (A2 / A3) ** 2 * ((a2 - a1) / (a3 - a1))
+            # 1 - m = (a1 - a3) e_a2 / ((a2 - a3) e_a1) with e_a1 = A3^2 (a3 - a1); e_a2 is
+            # the distance from the separatrix (it underflows only within ~1e-154 of it)
+            mc = (a1 - a3) / (a2 - a3) * (float(e_a2) / (A3 * A3 * (a3 - a1)))
             m = min(max(m, 0.0), 1.0)
             mc = min(max(mc, 0.0), 1.0)
-            lam = abs((a3 - a2) * A2 * A3 / A1)
+            lam = abs((a3 - a2) * A3 * (A2 / A1))
         s3 = 1.0 if M[p3] >= 0.0 else -1.0
         s1 = 1.0
         cn0 = M[p1] / A1
@@ -401,7 +405,7 @@ def _eval_state(times, p, perm, em, en, Q, M_out, R_out):  # noqa: ANN001, ANN20
         # e_p3 x mu: components j3 -> -mu[l3], l3 -> mu[j3] (cyclic p3, j3, l3)
         r1[j3] = -mu[l3]
         r1[l3] = mu[j3]
-        rho = math.sqrt(r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2])
+        rho = math.hypot(r1[j3], r1[l3])  # the only nonzero components; no underflow
         r1[0] /= rho
         r1[1] /= rho
         r1[2] /= rho

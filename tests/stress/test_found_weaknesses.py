@@ -126,3 +126,21 @@ def test_f15_symmetric_body_with_an_underflowing_component_is_a_slow_precession(
     for R in R_t:
         assert np.allclose(R.T @ R, np.eye(3), atol=1e-14)
     assert np.allclose(np.einsum("tij,tj->ti", R_t, M_t), np.asarray(M, dtype=float)[None], atol=1e-14)
+
+
+
+@pytest.mark.parametrize(("inertia", "M"), [((2.0, 1.0, 3.0), (0.0, 1.0, 1.5e-170)), ((1.0, 2.0, 1.0), (0.0, 1.0, 1.5e-170)),
+                                            ((3.0, 2.0, 1.0), (1e-200, 1e-190, 1.0))])
+def test_f15_momentum_within_1e_170_of_an_axis_is_finite_and_keeps_the_invariants(inertia, M):
+    """Found by hypothesis: amplitudes sqrt(M_i^2 ...) and the frame norm underflowed (NaN,
+    ZeroDivisionError). The motion stays within ~1e-170 of the axis: M(t) = M(0) and R(t) is
+    the rotation about that axis, |M| and m = R M conserved."""
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+    times = np.array([0.0, 0.3, 7.0])
+    M_t, R_t = ExactRigidBodyFlow(inertia, M).state(times)
+    assert np.all(np.isfinite(M_t)) and np.all(np.isfinite(R_t))
+    assert np.allclose(M_t, np.asarray(M)[None], rtol=0, atol=1e-15)
+    for R in R_t:
+        assert np.allclose(R.T @ R, np.eye(3), atol=1e-14)
+    assert np.allclose(np.einsum("tij,tj->ti", R_t, M_t), np.asarray(M)[None], atol=1e-14)
