@@ -18,7 +18,7 @@ import keyword
 import math
 import re
 import tomllib
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -78,6 +78,12 @@ class Lagrangian:
         the defaults.
     description
         One line saying what the system is.
+    validator
+        Optional check of parameter values: called by :meth:`fix` with every parameter
+        fixed so far (name -> number); raises :class:`~dirac.errors.InputError` for values
+        the system cannot take (e.g. an inertia whose mass matrix (66) is not positive).
+    fixed_values
+        The parameters fixed so far (name -> number); kept for ``validator``.
 
     Notes
     -----
@@ -94,6 +100,8 @@ class Lagrangian:
     constraints: tuple[sympy.Expr, ...] = ()
     parameters: Mapping[sympy.Symbol, float | None] = field(default_factory=dict)
     description: str = ""
+    validator: Callable[[Mapping[str, float]], None] | None = field(default=None, compare=False, repr=False)
+    fixed_values: Mapping[str, float] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "coordinates", tuple(self.coordinates))
@@ -101,6 +109,7 @@ class Lagrangian:
         object.__setattr__(self, "constraints", tuple(sympy.sympify(c) for c in self.constraints))
         object.__setattr__(self, "expression", sympy.sympify(self.expression))
         object.__setattr__(self, "parameters", dict(self.parameters))
+        object.__setattr__(self, "fixed_values", dict(self.fixed_values))
         self._validate()
 
     # ----------------------------------------------------------------- validation
@@ -228,7 +237,8 @@ class Lagrangian:
         Raises
         ------
         InputError
-            For a name that is not a parameter, or a value that is not a finite number.
+            For a name that is not a parameter, a value that is not a finite number, or
+            values the system's ``validator`` refuses.
         """
         symbols = self.parameter_symbols
         substitution: dict[sympy.Symbol, sympy.Expr] = {}
@@ -241,6 +251,9 @@ class Lagrangian:
                 raise InputError(f"parameter {label!r} = {value!r} must be a finite number")
             substitution[symbols[label]] = _as_rational(value)
             remaining.pop(symbols[label])
+        merged = {**self.fixed_values, **{k: float(v) for k, v in values.items()}}
+        if self.validator is not None:
+            self.validator(merged)
         return Lagrangian(
             self.name,
             self.coordinates,
@@ -249,6 +262,8 @@ class Lagrangian:
             tuple(c.subs(substitution) for c in self.constraints),
             remaining,
             self.description,
+            self.validator,
+            merged,
         )
 
     def with_defaults(self) -> "Lagrangian":

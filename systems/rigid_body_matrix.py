@@ -9,15 +9,15 @@ permutation of ``(1, 2, 3)``. ``R`` is first an arbitrary 3x3 matrix; the six co
 
 The module also holds the pieces shared with :mod:`dirac_systems.rigid_body_momentum`:
 the rotation-matrix symbols, the six constraints, the inertia check (the mass matrix
-``g`` must be positive: PHYSICS.md §2) and :class:`ValidatedLagrangian`, which runs that
-check whenever :meth:`~dirac.lagrangian.Lagrangian.fix` makes the moments numbers.
+``g`` must be positive: PHYSICS.md §2), which the factories pass to
+:class:`~dirac.lagrangian.Lagrangian` as its ``validator`` so that it runs whenever
+:meth:`~dirac.lagrangian.Lagrangian.fix` makes the moments numbers.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from collections.abc import Mapping
 
 import numpy as np
 import sympy
@@ -33,7 +33,6 @@ __all__ = [
     "orthogonality_constraints",
     "constraint_index_pairs",
     "inertia_symbols",
-    "ValidatedLagrangian",
     "surface_point",
     "multipliers_221",
 ]
@@ -137,29 +136,6 @@ def check_inertia(I_1: float, I_2: float, I_3: float) -> tuple[float, float, flo
     return g  # type: ignore[return-value]
 
 
-@dataclass(frozen=True)
-class ValidatedLagrangian(Lagrangian):
-    """A :class:`~dirac.lagrangian.Lagrangian` that checks its parameters when they are
-    fixed to numbers.
-
-    ``validator(values)`` receives every parameter fixed so far (name -> number) after
-    each :meth:`fix` (so also through :func:`dirac.load_system` keywords and
-    :meth:`with_defaults`) and raises :class:`~dirac.errors.InputError` for values the
-    system cannot take. Everything else behaves as the base class.
-    """
-
-    validator: Callable[[Mapping[str, float]], None] | None = None
-    fixed_values: Mapping[str, float] = field(default_factory=dict)
-
-    def fix(self, **values: float) -> Lagrangian:  # noqa: D102 - documented on the base class
-        plain = super().fix(**values)
-        merged = {**dict(self.fixed_values), **values}
-        if self.validator is not None:
-            self.validator(merged)
-        base = {f.name: getattr(plain, f.name) for f in fields(Lagrangian)}
-        return ValidatedLagrangian(**base, validator=self.validator, fixed_values=merged)
-
-
 def _validate_fixed_inertia(values: Mapping[str, float]) -> None:
     """Validator of (78): positivity of each fixed moment, the triangle inequality once
     all three are numbers."""
@@ -192,7 +168,7 @@ def system() -> Lagrangian:
     kinetic = sum(
         g[i] / 2 * sum((R_dot[k, i] ** 2 for k in range(3)), sympy.Integer(0)) for i in range(3)
     )
-    return ValidatedLagrangian(
+    return Lagrangian(
         "rigid_body_matrix",
         tuple(R),
         tuple(R_dot),

@@ -23,7 +23,6 @@ from dirac.lagrangian import Lagrangian
 from dirac_systems.rigid_body_matrix import (
     _PAIRS,
     DEFAULT_INERTIA,
-    ValidatedLagrangian,
     _hat,
     inertia_symbols,
     mass_matrix_from_inertia,
@@ -94,7 +93,7 @@ def system() -> Lagrangian:
     I = inertia_symbols()  # noqa: E741
     M = body_angular_momentum(R, R_dot, I)
     kinetic = sympy.Rational(1, 2) * sum(M[k] ** 2 / I[k] for k in range(3))
-    return ValidatedLagrangian(
+    return Lagrangian(
         "rigid_body_momentum",
         tuple(R),
         tuple(R_dot),

@@ -149,3 +149,22 @@ def test_python_system_file(tmp_path):
     raising = write(tmp_path, "raise RuntimeError('boom')\n", name="raising.py")
     with pytest.raises(InputError, match="boom"):
         read_system_file(raising)
+
+
+def test_validator_sees_every_fixed_parameter_and_can_refuse():
+    seen = []
+
+    def validator(values):
+        seen.append(dict(values))
+        if values.get("l", 1.0) <= 0:
+            raise InputError(f"l = {values['l']} must be positive")
+
+    lag = Lagrangian.from_strings(**PENDULUM)
+    lag = Lagrangian(
+        lag.name, lag.coordinates, lag.velocities, lag.expression, lag.constraints, lag.parameters, validator=validator
+    )
+    fixed = lag.fix(m=2.0).fix(g=9.81)
+    assert seen == [{"m": 2.0}, {"m": 2.0, "g": 9.81}]
+    assert fixed.fixed_values == {"m": 2.0, "g": 9.81}
+    with pytest.raises(InputError, match="l = -1.0 must be positive"):
+        fixed.fix(l=-1.0)
