@@ -98,7 +98,7 @@ def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.S
     return sympy.Add(*terms)
 
 
-def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = False) -> sympy.Expr:
+def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = False, rational: bool = True) -> sympy.Expr:
     """Readable exact form: expanded in the phase-space ``variables`` over one denominator.
 
     A polynomial in ``variables`` is expanded with coefficients functions of the
@@ -124,6 +124,8 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
         value = _evaluate(work, gens, ring, allow_division=False)
         out = _poly_to_expr(value, variables, others, back)
     except (_NotRational, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+        if not rational:  # rational normal forms need gcds: too slow for large expressions
+            return expr
         field = FracField(gens_all, sympy.QQ)
         fgens = dict(zip(gens_all, field.gens))
         try:

@@ -111,7 +111,7 @@ class ConstraintChain:
         """
         self._row_cache: dict = {}
         nsym = set(self.phase_space.variables)
-        primary = [tidy(p, self.phase_space.variables, sign=True) for p in self.primary]
+        primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
         self.primary = primary
         points = self.numerics.surface_points(primary, SAMPLE_POINTS) if primary else []
         base_grads = self._independent(primary, [], points) if primary else []
@@ -148,7 +148,7 @@ class ConstraintChain:
                 candidates.append(psi)
             if candidates:
                 keep = ~self.numerics.weakly_zero(candidates, points)
-                candidates = [tidy(c, self.phase_space.variables, sign=True) for c, k in zip(candidates, keep) if k]
+                candidates = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
             if not candidates:
                 break
             for c in candidates:

@@ -173,6 +173,7 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     S = pivots
     potential = V + sum((lam * chi for lam, chi in zip(lambdas, lagrangian.constraints)), sympy.S.Zero)
     primary: list[sympy.Expr] = list(momenta[n:])
+    singular_general = False
     method = "regular Hessian" if rank == n else ""
     if rank == n:
         W_inv = _inverse(W)
@@ -207,20 +208,40 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
                     f"singular Hessian of rank {rank}: L is a quadratic form in {A.shape[0]} linear velocity "
                     "combinations l = A q_dot, so null(W) = null(A) (no inverse of W needed)"
                 )
-        if not used_forms:
+        if not used_forms and W[S, S].is_diagonal():
             W_SS = W[S, S]
             W_inv = _inverse(W_SS)
             p_S = sympy.Matrix([shifted[s] for s in S])
             for j in others:
                 coeff = W[j, S] * W_inv
-                phi = shifted[j] - (coeff * p_S)[0, 0]
-                primary.append(sympy.cancel(phi))
+                primary.append(shifted[j] - (coeff * p_S)[0, 0])
             H_c = (p_S.T * W_inv * p_S)[0, 0] / 2 + potential
             velocity = None
-            method = f"singular Hessian of rank {rank}: null space from an invertible {rank}x{rank} block of W"
+            method = f"singular Hessian of rank {rank}: null space from an invertible diagonal {rank}x{rank} block of W"
+            used_forms = True
+        if not used_forms:
+            # fraction-free: null vectors det(W_SS) e_j - adj(W_SS) W_Sj, no rational cancellation
+            from dirac.symbolic.algebra import tidy
+
+            W_SS = W[S, S]
+            variables = space.variables
+            adj = W_SS.adjugate(method="berkowitz").applyfunc(lambda e: tidy(e, variables))
+            det = tidy(sum((W_SS[0, k] * adj[k, 0] for k in range(len(S))), sympy.S.Zero), variables)
+            p_S = sympy.Matrix([shifted[s] for s in S])
+            adj_p = (adj * p_S).applyfunc(lambda e: tidy(e, variables))
+            for j in others:
+                primary.append(shifted[j] - (W[j, S] * adj_p)[0, 0] / det)
+            H_c = (p_S.T * adj_p)[0, 0] / (2 * det) + potential
+            velocity = None
+            method = (
+                f"singular Hessian of rank {rank}: null space from an invertible {rank}x{rank} block of W, "
+                "fraction-free (adjugate)"
+            )
+            singular_general = True
     from dirac.symbolic.algebra import tidy
 
-    H_c = tidy(H_c, space.variables)
+    if not singular_general:
+        H_c = tidy(H_c, space.variables)
     full_rank = rank
     return LegendreTransform(
         phase_space=space,
