@@ -32,6 +32,14 @@ __all__ = [
     "load_system",
     "builtin_systems",
     "analyze",
+    "integrate",
+    "RigidBodyProblem",
+    "HeavyTopProblem",
+    "ConstrainedProblem",
+    "Solution",
+    "load_scene",
+    "write_results",
+    "read_results",
 ]
 
 #: public name -> module that defines it (imported on first access)
@@ -40,6 +48,14 @@ _LAZY: dict[str, str] = {
     "load_system": "dirac.registry",
     "builtin_systems": "dirac.registry",
     "analyze": "dirac.symbolic.analysis",
+    "integrate": "dirac.flows.integrate",
+    "RigidBodyProblem": "dirac.flows.problem",
+    "HeavyTopProblem": "dirac.flows.problem",
+    "ConstrainedProblem": "dirac.flows.problem",
+    "Solution": "dirac.flows.solution",
+    "load_scene": "dirac.flows.scene",
+    "write_results": "dirac.flows.results",
+    "read_results": "dirac.flows.results",
 }
 
 

@@ -1,0 +1,23 @@
+"""The lazy public names of `dirac` resolve to the objects CONTRACTS §5 promises."""
+
+from __future__ import annotations
+
+import inspect
+
+import dirac
+
+
+def test_every_public_name_resolves_and_is_not_a_module():
+    for name in dirac.__all__:
+        value = getattr(dirac, name)
+        assert not inspect.ismodule(value), f"dirac.{name} is a module, not the public object"
+        assert callable(value), f"dirac.{name} is not callable"
+
+
+def test_unknown_attribute_is_an_attribute_error():
+    try:
+        dirac.no_such_name  # noqa: B018
+    except AttributeError as exc:
+        assert "no_such_name" in str(exc)
+    else:
+        raise AssertionError("dirac.no_such_name did not raise AttributeError")
