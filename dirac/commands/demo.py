@@ -23,6 +23,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser.add_argument("--t-end", type=float, default=None, help="final time (default 1000)")
     parser.add_argument("--dt", type=float, default=None, help="step size for fixed-step methods (default 0.01)")
     parser.add_argument("--out", metavar="FILE.npz", default=None, help="also write the results")
+    parser.add_argument("--plot", metavar="FILE.png", default=None,
+                        help="also draw the run: polhode, body axes, M(t), conserved-quantity errors (needs matplotlib)")
     parser.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     return parser
 
@@ -35,6 +37,11 @@ def main(args: argparse.Namespace) -> int:
     from dirac.flows.integrate import integrate
     from dirac.flows.scene import FLAGSHIP_SCENE, scene_from_dict
 
+    plot_path = None
+    if args.plot:  # checked before the run, so that a bad name fails fast
+        from dirac.plots.canvas import check_png_path
+
+        plot_path = check_png_path(args.plot)
     data = copy.deepcopy(FLAGSHIP_SCENE)
     run = data["run"]
     assert isinstance(run, dict)
@@ -74,4 +81,9 @@ def main(args: argparse.Namespace) -> int:
     print(f"    Casimir |M|^2         {np.max(np.abs(casimir - casimir[0])):.3e}")
     print(f"    lab momentum m = R M  {np.max(np.linalg.norm(lab - lab[0], axis=1)):.3e}")
     print(f"    |R^T R - 1|           {orthogonality:.3e}")
+    if plot_path is not None:
+        from dirac.plots import plot_result
+
+        plot_result(solution, plot_path)
+        print(f"  picture        {plot_path}")
     return 0

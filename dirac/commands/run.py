@@ -1,4 +1,4 @@
-"""``dirac run SCENE.toml [--out FILE.npz] [--no-progress]``: run a scene, write its results.
+"""``dirac run SCENE.toml [--out FILE.npz] [--plot FILE.png] [--no-progress]``: run a scene, write its results.
 
 The results (CONTRACTS §7) are written atomically. When the integration stops early
 (non-finite state, Newton non-convergence, constraint drift, Ctrl-C or SIGTERM) the
@@ -26,6 +26,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
     parser.add_argument("--out", metavar="FILE.npz", help="result file (default: the scene's name with .npz)")
+    parser.add_argument("--plot", metavar="FILE.png", default=None,
+                        help="also draw the run (rigid body: polhode, body axes, errors; other systems: path, "
+                        "coordinates, errors); needs matplotlib")
     parser.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     return parser
 
@@ -73,6 +76,11 @@ def main(args: argparse.Namespace) -> int:
         raise InputError(f"--out {str(out)!r} must end in .npz")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise InputError(f"--out {str(out)!r}: directory {str(out.parent)!r} does not exist")
+    plot_path = None
+    if args.plot:  # checked before the run, so that a bad name fails fast
+        from dirac.plots.canvas import check_png_path
+
+        plot_path = check_png_path(args.plot)
     scene = load_scene(scene_path)
     progress = (not args.no_progress) and sys.stderr.isatty()
 
@@ -106,4 +114,10 @@ def main(args: argparse.Namespace) -> int:
         f"{solution.evaluations} evaluations, {solution.cpu_seconds:.3g} s CPU; "
         f"{len(solution.t)} samples of {', '.join(solution.outputs)} written to {out}"
     )
+    if plot_path is not None:
+        from dirac.plots import plot_result
+
+        names = getattr(getattr(scene.problem, "mechanics", None), "coordinate_names", None)
+        plot_result(solution, plot_path, coordinates=names)
+        print(f"picture written to {plot_path}")
     return 0
