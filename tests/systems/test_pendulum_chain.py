@@ -133,3 +133,12 @@ def test_hamiltonians(analysis):
     assert sympy.simplify(analysis.canonical_hamiltonian - hand) == 0
     (u,) = analysis.primary_multipliers
     assert sympy.simplify(analysis.total_hamiltonian - hand - u * plam) == 0
+
+
+def test_reports_render(analysis):
+    latex = analysis._repr_latex_()
+    assert latex.startswith("$$") and r"\begin{aligned}" in latex and "p_{\\lambda 1} = 0" in latex
+    text = analysis.to_text()
+    assert "stage 4: 1 constraint(s)" in text and "physical degrees of freedom" in text
+    data = analysis.to_json()
+    assert data["physical_degrees_of_freedom"] == 1 and data["hessian_rank"] == 2
