@@ -95,6 +95,39 @@ def _validate(t_end: object, samples: object, dt: object, tolerance: object) -> 
     return float(t_end), int(samples), dt, float(tolerance)
 
 
+#: Most steps a fixed-step run may take (about a year at 1e8 steps per second); beyond it
+#: t_end / dt is a mistake, and near 1e308 it overflows.
+MAX_STEPS = 2**62
+
+
+def _validate_guard_rails(drift_limit: object, newton_tolerance: object, max_newton_iterations: object) -> None:
+    """The guard-rail options of :func:`integrate` (the scene reader checks them too)."""
+    for name, value in (("drift_limit", drift_limit), ("newton_tolerance", newton_tolerance)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or math.isnan(value):
+            raise InputError(f"{name} = {value!r} must be a number > 0")
+    if isinstance(newton_tolerance, float) and not math.isfinite(newton_tolerance):
+        raise InputError(f"newton_tolerance = {newton_tolerance!r} must be finite")
+    if (isinstance(max_newton_iterations, bool) or not isinstance(max_newton_iterations, (int, np.integer))
+            or not 1 <= max_newton_iterations <= 10**6):
+        raise InputError(f"max_newton_iterations = {max_newton_iterations!r} must be an integer in [1, 1000000]")
+
+
+def _validate_size(samples: int, problem: object) -> None:
+    """Refuse a number of samples whose times alone would not fit in this machine's memory."""
+    import os
+
+    try:
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):  # not POSIX: assume 1 TiB
+        memory = 2**40
+    needed = 8 * samples * (1 + int(getattr(problem, "batch", 1)))  # t and one float per state, at least
+    if needed > memory:
+        raise InputError(
+            f"samples = {samples} needs more than {needed / 2**30:.3g} GiB for the output times alone, more than "
+            f"this machine's {memory / 2**30:.3g} GiB; give fewer samples"
+        )
+
+
 def _validate_outputs(outputs: Sequence[str] | None, kind: str, available: Sequence[str]) -> tuple[str, ...]:
     if outputs is None:
         return DEFAULT_OUTPUTS[kind]
@@ -171,6 +204,8 @@ def integrate(
         (``complete = False``). :class:`IntegrationInterrupted` on Ctrl-C.
     """
     t_end, samples, dt, tolerance = _validate(t_end, samples, dt, tolerance)
+    _validate_guard_rails(drift_limit, newton_tolerance, max_newton_iterations)
+    _validate_size(samples, problem)
     kind = problem_kind(problem)
     chosen_outputs = _validate_outputs(outputs, kind, problem.outputs)  # type: ignore[attr-defined]
     extra: dict[str, object] = {}
@@ -190,6 +225,10 @@ def integrate(
         )
     if method_object.kind == "fixed" and dt is None:
         raise InputError(f"method {method_object.name!r} takes fixed steps: give dt (the step size)")
+    if dt is not None and method_object.kind == "fixed" and not t_end / dt <= MAX_STEPS:
+        raise InputError(
+            f"t_end / dt = {t_end:.3g} / {dt:.3g} is more than {MAX_STEPS:.3g} steps; give a larger dt or a shorter t_end"
+        )
     if method_object.kind != "fixed":
         dt = None
     options = {
