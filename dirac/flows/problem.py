@@ -23,6 +23,22 @@ from dirac.errors import InputError
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
 
 
+def _refuse_booleans(value: object, name: str) -> None:
+    """``True``/``False`` are not numbers here (numpy would read them as 1.0 and 0.0)."""
+
+    def has_boolean(item: object) -> bool:
+        if isinstance(item, (bool, np.bool_)):
+            return True
+        if isinstance(item, np.ndarray):
+            return item.dtype == bool or (item.dtype == object and any(has_boolean(v) for v in item.flat))
+        if isinstance(item, (list, tuple)):
+            return any(has_boolean(v) for v in item)
+        return False
+
+    if has_boolean(value):
+        raise InputError(f"{name} = {value!r} contains true/false; give numbers")
+
+
 def _batched(array: np.ndarray, single_ndim: int, name: str) -> tuple[np.ndarray, bool]:
     """Return ``(array with a leading batch axis, whether the input had one)``."""
     if array.ndim == single_ndim:
@@ -64,6 +80,8 @@ class RigidBodyProblem:
         from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
 
         self.inertia = validate_inertia(self.inertia)
+        _refuse_booleans(self.M0, "M0")
+        _refuse_booleans(self.R0, "R0")
         moments = np.asarray(self.M0, dtype=float)
         self.M0, self.batched = _batched(moments, 1, "M0")
         for body in self.M0:

@@ -112,7 +112,18 @@ def _number(value: object, name: str, source: str, positive: bool = False) -> fl
     return float(value)
 
 
+def _has_boolean(value: object) -> bool:
+    """Whether ``value`` is or contains true/false (numpy would read them as 1.0 and 0.0)."""
+    if isinstance(value, bool):
+        return True
+    if isinstance(value, (list, tuple)):
+        return any(_has_boolean(v) for v in value)
+    return False
+
+
 def _vector(value: object, name: str, source: str, shape: tuple[int, ...]) -> np.ndarray:
+    if _has_boolean(value):
+        raise InputError(f"{source}: {name} = {value!r} contains true/false; give numbers of shape {shape}")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError):
