@@ -66,6 +66,26 @@ def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) 
     return _state(stepper)
 
 
+def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float, options) -> float:  # noqa: ANN001
+    """``dt0`` halved until a pilot of 64 steps runs without a failed step.
+
+    A first guess such as ``t_end / 1000`` can be far beyond the system's own time scale
+    (a pendulum run to ``t = 1000``), where RATTLE's Newton iteration cannot converge.
+    """
+    from dirac.errors import InputError
+    from dirac.flows.methods import StepFailure
+
+    dt = dt0
+    for _ in range(60):
+        try:
+            span = min(t_end, 64 * dt)
+            _pilot(method_name, problem, outputs, span, dt, options)
+            return dt
+        except StepFailure:
+            dt /= 2
+    raise InputError(f"method auto: {method_name} fails even with dt = {dt:.3g}; choose a method and dt in [run]")
+
+
 def _frequency(problem) -> float:  # noqa: ANN001
     M = np.asarray(problem.M0, dtype=float)
     return float(np.max(np.linalg.norm(M, axis=-1)) * np.max(1.0 / np.asarray(problem.inertia)) + 1e-300)
@@ -94,6 +114,7 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
     best_cost = math.inf
     for name in candidates:
         method = get_method(name)
+        dt0 = _working_step(name, problem, outputs, dt0, t_end, options)
         span = min(t_end, 64 * dt0)
         coarse = _pilot(name, problem, outputs, span, dt0, options)
         fine = _pilot(name, problem, outputs, span, dt0 / 2, options)
