@@ -74,6 +74,8 @@ def main(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else scene_path.with_suffix(".npz")
     if out.suffix != ".npz":
         raise InputError(f"--out {str(out)!r} must end in .npz")
+    if out.is_dir():
+        raise InputError(f"--out {str(out)!r} is a directory; give a file name ending in .npz")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise InputError(f"--out {str(out)!r}: directory {str(out.parent)!r} does not exist")
     plot_path = None
