@@ -1,12 +1,14 @@
-"""Regression tests of weaknesses the stress tests found in the rigid-body kernels.
+"""Regression tests of weaknesses the stress tests found (robustness findings F1-F15).
 
-F5: an ``M`` whose ``|M|^2`` overflows crashed ``exact`` (now an input error). F6: tiny
-moments of inertia printed raw numpy overflow warnings. F7: a slowly turning body
-(``|M|`` below ~1e-154) crashed ``exact`` with ZeroDivisionError. F14: booleans were
-taken as numbers. F15: a symmetric top with a component whose square underflows divided
-by zero. Bad input gives an
-``InputError``; legal input gives the correct result, checked by the homogeneity of the
-Euler-Poisson equations (250)-(251).
+Kernels: F5 an ``M`` whose ``|M|^2`` overflows crashed ``exact`` (now an input error); F6 tiny
+moments of inertia printed raw numpy overflow warnings; F7 a slowly turning body (``|M|``
+below ~1e-154) crashed ``exact``; F14 booleans were taken as numbers; F15 components whose
+squares underflow gave NaN or ZeroDivisionError. Flows and ``dirac run``: F1 an absurd number
+of samples and F2 a step count beyond 2^62 gave MemoryError/OverflowError tracebacks; F4
+``--out`` naming a directory crashed after the whole run; F10 ``auto`` crashed on a long
+constrained run; F12 the guard-rail options of ``integrate`` were not validated. Bad input
+gives an ``InputError`` (one ``error:`` line, exit status 2); legal input gives the correct
+result, checked by the homogeneity of the Euler-Poisson equations (250)-(251).
 """
 
 from __future__ import annotations
@@ -144,3 +146,57 @@ def test_f15_momentum_within_1e_170_of_an_axis_is_finite_and_keeps_the_invariant
     for R in R_t:
         assert np.allclose(R.T @ R, np.eye(3), atol=1e-14)
     assert np.allclose(np.einsum("tij,tj->ti", R_t, M_t), np.asarray(M)[None], atol=1e-14)
+
+
+def test_f1_absurd_number_of_samples_is_an_input_error(tmp_path, run_cli):
+    scene = _scene(tmp_path, extra="samples = 100000000000000")
+    status, _, err = run_cli("run", scene, "--out", str(tmp_path / "o.npz"), "--no-progress")
+    assert "samples" in _one_error_line(status, err)
+
+
+def test_f2_step_count_overflow_is_an_input_error(tmp_path, run_cli):
+    scene = _scene(tmp_path, t_end="1e300", extra='method = "lie-poisson-2"\ndt = 1e-300\nsamples = 2')
+    status, _, err = run_cli("run", scene, "--out", str(tmp_path / "o.npz"), "--no-progress")
+    _one_error_line(status, err)
+
+
+def test_f4_out_naming_a_directory_is_an_input_error(tmp_path, run_cli):
+    (tmp_path / "d.npz").mkdir()
+    status, _, err = run_cli("run", _scene(tmp_path), "--out", str(tmp_path / "d.npz"), "--no-progress")
+    assert "d.npz" in _one_error_line(status, err)
+
+
+def test_f10_auto_on_a_long_constrained_run_chooses_a_working_step(tmp_path, run_cli):
+    path = tmp_path / "scene.toml"
+    path.write_text('[system]\nname = "pendulum"\n[initial]\nq = { x = 1.0, y = 0.0 }\n'
+                    '[run]\nt_end = 1000.0\nmethod = "auto"\ntolerance = 1e-2\nsamples = 11\n')
+    status, _, err = run_cli("run", str(path), "--out", str(tmp_path / "o.npz"), "--no-progress")
+    assert status == 0, err
+
+
+@pytest.mark.parametrize("options", [{"drift_limit": float("nan")}, {"drift_limit": -1.0},
+                                     {"newton_tolerance": -1.0}, {"newton_tolerance": float("nan")},
+                                     {"max_newton_iterations": 0}, {"max_newton_iterations": 10**30}])
+def test_f12_integrate_validates_its_guard_rail_options(options):
+    from dirac.errors import InputError
+    from dirac.flows.integrate import integrate
+    from dirac.flows.problem import RigidBodyProblem
+
+    problem = RigidBodyProblem([1.0, 2.0, 3.0], [1.0, 0.2, 0.1])
+    with pytest.raises(InputError):
+        integrate(problem, "midpoint", t_end=1.0, dt=0.1, samples=3, **options)
+
+
+@pytest.mark.parametrize("M", [[False, 0.2, 0.1], np.array([True, False, True])])
+def test_f14_booleans_are_not_numbers_in_rigid_body_problem(M):
+    from dirac.errors import InputError
+    from dirac.flows.problem import RigidBodyProblem
+
+    with pytest.raises(InputError):
+        RigidBodyProblem([1.0, 2.0, 3.0], M)
+
+
+def test_f14_booleans_are_not_numbers_in_scenes(tmp_path, run_cli):
+    path = _scene(tmp_path, M="[false, 0.2, 0.1]", extra='method = "exact"')
+    status, _, err = run_cli("run", path, "--out", str(tmp_path / "o.npz"), "--no-progress")
+    _one_error_line(status, err)
