@@ -29,7 +29,7 @@ from numba import njit
 
 from dirac.flows.lie_poisson import RigidBodyStepper
 from dirac.flows.methods import Method, Stepper, StepFailure, register_method
-from dirac.flows.rattle import ConstrainedStepper
+from dirac.flows.rattle import ConstrainedStepper, singular_as_step_failure
 
 __all__ = ["midpoint_rigid_body"]
 
@@ -199,7 +199,7 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
 
         n, m = self.mechanics.dimension, self.mechanics.n_constraints
         for b in range(self.z.shape[0]):
-            with quiet():
+            with quiet(), singular_as_step_failure("midpoint"):
                 self._kernel(0, self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
             self._sync()

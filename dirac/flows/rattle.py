@@ -56,6 +56,28 @@ class ConstrainedStepper(Stepper):
             )
 
 
+class singular_as_step_failure:  # noqa: N801 - used as a context manager
+    """Turn the kernels' division by a zero pivot into a :class:`StepFailure`.
+
+    The Newton matrix ``G M^{-1} G^T`` is singular where the constraints are not independent
+    (e.g. a pendulum of length 0 at the origin); the compiled solve then divides by zero.
+    """
+
+    def __init__(self, what: str) -> None:
+        self.what = what
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind, value, traceback) -> bool:  # noqa: ANN001
+        if kind is not None and issubclass(kind, ZeroDivisionError):
+            raise StepFailure(
+                f"{self.what}: the Newton matrix G M^-1 G^T is singular (the constraints are not independent "
+                "here); check the constraints and the state"
+            ) from None
+        return False
+
+
 class RattleStepper(ConstrainedStepper):
     """RATTLE composed with the coefficients of ``method.data`` (fractions of a step)."""
 
@@ -94,7 +116,7 @@ class RattleStepper(ConstrainedStepper):
         from dirac.flows.constrained_kernels import quiet
 
         for b in range(self.q.shape[0]):
-            with quiet():
+            with quiet(), singular_as_step_failure(self.name):
                 self._call(self.q[b], self.p[b], n_steps, dt)
             self.evaluations += int(self.info[2])
             self._raise_if_failed(self.name)

@@ -6,7 +6,7 @@ below ~1e-154) crashed ``exact``; F14 booleans were taken as numbers; F15 compon
 squares underflow gave NaN or ZeroDivisionError. Flows and ``dirac run``: F1 an absurd number
 of samples and F2 a step count beyond 2^62 gave MemoryError/OverflowError tracebacks; F4
 ``--out`` naming a directory crashed after the whole run; F10 ``auto`` crashed on a long
-constrained run; F12 the guard-rail options of ``integrate`` were not validated. Bad input
+constrained run; F3 a singular Newton matrix in RATTLE divided by zero; F12 the guard-rail options of ``integrate`` were not validated. Bad input
 gives an ``InputError`` (one ``error:`` line, exit status 2); legal input gives the correct
 result, checked by the homogeneity of the Euler-Poisson equations (250)-(251).
 """
@@ -199,4 +199,12 @@ def test_f14_booleans_are_not_numbers_in_rigid_body_problem(M):
 def test_f14_booleans_are_not_numbers_in_scenes(tmp_path, run_cli):
     path = _scene(tmp_path, M="[false, 0.2, 0.1]", extra='method = "exact"')
     status, _, err = run_cli("run", path, "--out", str(tmp_path / "o.npz"), "--no-progress")
+    _one_error_line(status, err)
+
+
+def test_f3_singular_constraint_jacobian_is_reported_not_a_traceback(tmp_path, run_cli):
+    path = tmp_path / "scene.toml"
+    path.write_text('[system]\nname = "pendulum"\nparameters = { l = 0.0 }\n[initial]\nq = { x = 0.0, y = 0.0 }\n'
+                    '[run]\nt_end = 1.0\nmethod = "rattle-2"\ndt = 0.01\n')
+    status, _, err = run_cli("run", str(path), "--out", str(tmp_path / "o.npz"), "--no-progress")
     _one_error_line(status, err)
