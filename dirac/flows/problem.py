@@ -164,8 +164,9 @@ class ConstrainedProblem:
 
     Parameters
     ----------
-    mechanics : dirac.flows.mechanics.MechanicalSystem
-        The compiled system (mass matrix, potential, constraints).
+    mechanics : dirac.Lagrangian or dirac.flows.mechanics.MechanicalSystem
+        The system: a :class:`~dirac.lagrangian.Lagrangian` (compiled here with its
+        default parameter values) or an already compiled ``MechanicalSystem``.
     q0 : array_like, shape (n,) or (B, n)
         Initial coordinates, on the constraint surface ``chi(q) = 0``.
     p0 : array_like, shape (n,) or (B, n)
@@ -189,6 +190,12 @@ class ConstrainedProblem:
     outputs = ("q", "p", "q_dot", "energy", "constraint_residual")
 
     def __post_init__(self) -> None:
+        from dirac.lagrangian import Lagrangian
+
+        if isinstance(self.mechanics, Lagrangian):
+            from dirac.flows.mechanics import MechanicalSystem
+
+            self.mechanics = MechanicalSystem.from_lagrangian(self.mechanics)
         n = self.mechanics.dimension  # type: ignore[attr-defined]
         q0, self.batched = _batched(np.asarray(self.q0, dtype=float), 1, "q")
         p0, _ = _batched(np.asarray(self.p0, dtype=float), 1, "p")
