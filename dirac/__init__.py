@@ -48,7 +48,7 @@ _LAZY: dict[str, str] = {
     "load_system": "dirac.registry",
     "builtin_systems": "dirac.registry",
     "analyze": "dirac.symbolic.analysis",
-    "integrate": "dirac.flows.integrate",
+    "integrate": "dirac.flows.integration",
     "RigidBodyProblem": "dirac.flows.problem",
     "HeavyTopProblem": "dirac.flows.problem",
     "ConstrainedProblem": "dirac.flows.problem",

@@ -21,3 +21,12 @@ def test_unknown_attribute_is_an_attribute_error():
         assert "no_such_name" in str(exc)
     else:
         raise AssertionError("dirac.no_such_name did not raise AttributeError")
+
+
+def test_flows_integrate_is_the_function_whatever_was_imported_first():
+    # regression: robustness finding F9 (module and function shared the name `integrate`)
+    import dirac.flows.integration  # noqa: F401
+    from dirac.flows import integrate
+
+    assert callable(integrate) and not inspect.ismodule(integrate)
+    assert integrate is dirac.integrate

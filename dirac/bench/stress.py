@@ -223,7 +223,7 @@ def long_run(method: str, steps: int, dt: float, samples: int = 1001) -> dict:
     ``casimir`` is ``max | |M|^2 - |M(0)|^2 |``, ``orthogonality`` is
     ``max |R^T R - 1|`` over the samples; both must stay within ``2e-12``.
     """
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
     from dirac.flows.problem import RigidBodyProblem
 
     problem = _quiet_problem(lambda: RigidBodyProblem(STANDARD_INERTIA, STANDARD_M0))
@@ -312,7 +312,7 @@ def exact_tolerance(body: HardBody) -> float:
 def _method_error(body: HardBody, method: str, times: np.ndarray, M_ref: np.ndarray, R_ref: np.ndarray | None,
                   step_radians: float) -> dict:
     from dirac.errors import IntegrationError
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
     from dirac.flows.problem import RigidBodyProblem
 
     problem = _quiet_problem(lambda: RigidBodyProblem(body.inertia, body.M0))
@@ -396,7 +396,7 @@ def constrained_long_run(system: str, method: str, steps: int, dt: float, sample
     ``|G M^{-1} p|`` at round-off (``<= 1e3 eps (1 + |q|^2)(1 + |p|)``) and a bounded energy
     error (:func:`energy_drift_verdict`).
     """
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
 
     problem = _constrained_problem(system)
     mechanics = problem.mechanics

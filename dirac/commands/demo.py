@@ -34,7 +34,7 @@ def main(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
     from dirac.flows.scene import FLAGSHIP_SCENE, scene_from_dict
 
     plot_path = None

@@ -66,7 +66,7 @@ def _partial_path(out: Path) -> Path:
 
 def main(args: argparse.Namespace) -> int:
     from dirac.errors import InputError, IntegrationError
-    from dirac.flows.integrate import IntegrationInterrupted, integrate
+    from dirac.flows.integration import IntegrationInterrupted, integrate
     from dirac.flows.results import write_results
     from dirac.flows.scene import load_scene
 

@@ -14,8 +14,8 @@ from importlib import import_module
 from typing import Any
 
 _LAZY = {
-    "integrate": "dirac.flows.integrate",
-    "IntegrationInterrupted": "dirac.flows.integrate",
+    "integrate": "dirac.flows.integration",
+    "IntegrationInterrupted": "dirac.flows.integration",
     "Solution": "dirac.flows.solution",
     "RigidBodyProblem": "dirac.flows.problem",
     "HeavyTopProblem": "dirac.flows.problem",

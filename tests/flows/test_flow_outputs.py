@@ -8,7 +8,7 @@ import pytest
 
 from dirac.errors import InputError
 from dirac.flows import RigidBodyProblem, integrate
-from dirac.flows.integrate import sample_times
+from dirac.flows.integration import sample_times
 
 INERTIA = np.array([1.0, 2.0, 3.0])
 M0 = np.array([0.6, 0.8, 0.5])

@@ -9,7 +9,7 @@ import pytest
 
 from dirac.errors import IntegrationError
 from dirac.flows import ConstrainedProblem, MechanicalSystem, RigidBodyProblem, integrate
-from dirac.flows.integrate import IntegrationInterrupted
+from dirac.flows.integration import IntegrationInterrupted
 from dirac.lagrangian import Lagrangian
 
 

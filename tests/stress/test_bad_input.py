@@ -335,7 +335,7 @@ def test_integrate_refuses_bad_arguments_with_input_error_and_runs_good_ones(t_e
     import warnings
 
     from dirac.errors import InputError
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
     from dirac.flows.problem import RigidBodyProblem
 
     problem = RigidBodyProblem([1.0, 2.0, 2.5], [1.0, 0.2, 0.1])

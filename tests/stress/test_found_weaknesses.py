@@ -179,7 +179,7 @@ def test_f10_auto_on_a_long_constrained_run_chooses_a_working_step(tmp_path, run
                                      {"max_newton_iterations": 0}, {"max_newton_iterations": 10**30}])
 def test_f12_integrate_validates_its_guard_rail_options(options):
     from dirac.errors import InputError
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
     from dirac.flows.problem import RigidBodyProblem
 
     problem = RigidBodyProblem([1.0, 2.0, 3.0], [1.0, 0.2, 0.1])

@@ -32,7 +32,7 @@ samples = 3
 
 
 def test_standard_body_warns_once_and_integrates():
-    from dirac.flows.integrate import integrate
+    from dirac.flows.integration import integrate
     from dirac.flows.problem import RigidBodyProblem
 
     with warnings.catch_warnings(record=True) as caught:
