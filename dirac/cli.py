@@ -86,6 +86,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if getattr(args, "handler", None) is None:
         parser.print_help()
+        print(f"error: no command given: choose one of {', '.join(COMMANDS)}", file=sys.stderr)
         return 2
     try:
         return int(args.handler(args) or 0)

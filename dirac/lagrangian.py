@@ -24,7 +24,7 @@ from pathlib import Path
 
 import sympy
 
-from dirac.errors import InputError, warn
+from dirac.errors import DiracError, InputError, warn
 from dirac.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
 
 __all__ = ["Lagrangian", "read_system_file", "velocity_name", "momentum_name", "multiplier_name"]
@@ -386,7 +386,12 @@ def _read_python_system(path: Path) -> Lagrangian:
     factory = getattr(module, "system", None)
     if not callable(factory):
         raise InputError(f"system file {str(path)!r} must define a function system() returning a dirac.Lagrangian")
-    result = factory()
+    try:
+        result = factory()
+    except DiracError:
+        raise
+    except Exception as exc:  # the user's own code failed: report it, do not crash
+        raise InputError(f"system() in {str(path)!r} failed: {type(exc).__name__}: {exc}") from exc
     if not isinstance(result, Lagrangian):
         raise InputError(f"system() in {str(path)!r} returned {type(result).__name__}, not a dirac.Lagrangian")
     return result

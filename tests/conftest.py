@@ -1,19 +1,13 @@
 """Shared test configuration.
 
 ``@pytest.mark.slow`` marks long stress runs. CI runs them too, in a bounded form: a slow
-test reads :func:`stress_scale` and shortens itself unless ``DIRAC_FULL_STRESS=1``.
+test reads ``stress_scaling.stress_scale()`` and shortens itself unless
+``DIRAC_FULL_STRESS=1``.
 """
 
 from __future__ import annotations
 
-import os
-
 import pytest
-
-
-def stress_scale() -> float:
-    """1.0 for the full stress runs (``DIRAC_FULL_STRESS=1``), else a small fraction."""
-    return 1.0 if os.environ.get("DIRAC_FULL_STRESS") == "1" else 0.01
 
 
 @pytest.fixture

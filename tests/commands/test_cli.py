@@ -38,3 +38,23 @@ def test_help_does_not_import_sympy_or_numba():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "[]"
+
+
+def test_bare_dirac_prints_help_and_one_error_line(run_cli):
+    # regression: robustness finding F8 (status 2 with no error: line)
+    status, out, err = run_cli()
+    assert status == 2
+    assert "COMMAND" in out
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: no command given")
+
+
+def test_python_system_file_whose_system_fails_is_one_error_line(tmp_path, run_cli):
+    # regression: robustness finding F11 (the call of system() was not guarded)
+    for source in ('def system():\n    raise RuntimeError("boom")\n', "def system(a):\n    return a\n"):
+        path = tmp_path / "broken.py"
+        path.write_text(source)
+        status, _, err = run_cli("analyze", str(path))
+        lines = [line for line in err.splitlines() if line.strip()]
+        assert status == 2, err
+        assert len(lines) == 1 and lines[0].startswith("error: system() in"), err

@@ -41,17 +41,9 @@ def standard_problem():
         return RigidBodyProblem(STANDARD_INERTIA, STANDARD_M0)
 
 
-def stress_scale() -> float:
-    """Same as ``tests/conftest.py::stress_scale`` (1.0 with ``DIRAC_FULL_STRESS=1``, else a
-    small fraction). Conftest modules of test folders without ``__init__.py`` share the
-    module name ``conftest``; defining it here too keeps ``from conftest import
-    stress_scale`` working in other folders whichever conftest pytest imported last."""
-    import os
-
-    return 1.0 if os.environ.get("DIRAC_FULL_STRESS") == "1" else 0.01
-
-
 @pytest.fixture
 def stress() -> float:
-    """:func:`stress_scale` as a fixture."""
+    """:func:`stress_scaling.stress_scale` as a fixture."""
+    from stress_scaling import stress_scale
+
     return stress_scale()

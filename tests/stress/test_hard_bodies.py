@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import stress_scale
+from stress_scaling import stress_scale
 from dirac.bench.stress import HARD_BODIES, HardBody, exact_tolerance, hard_body_rows, taylor_reference
 from dirac.errors import DiracWarning
 

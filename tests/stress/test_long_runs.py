@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import stress_scale
+from stress_scaling import stress_scale
 from dirac.bench.stress import constrained_long_run, energy_drift_verdict, long_run
 
 
