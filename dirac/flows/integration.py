@@ -36,6 +36,8 @@ CHUNK_STEPS = 20_000
 #: The constraint drift is measured at least this many steps apart (and at the end):
 #: it costs more than a step of the compiled kernels.
 DRIFT_CHECK_STEPS = 1_000
+#: Fewest steps per call, whatever the batch size.
+MIN_CHUNK_STEPS = 100
 #: Exact-flow samples evaluated per call.
 CHUNK_SAMPLES = 2_000
 
@@ -376,7 +378,9 @@ class _Loop:
             self._keep(0, self.stepper.observe())
         first = 1 if self.times[0] == 0.0 else 0
         batch = int(getattr(self.problem, "batch", 1))
-        chunk = max(1, CHUNK_STEPS // max(1, batch))
+        # at least MIN_CHUNK_STEPS steps per call, so that large batches are not advanced
+        # (and checked) one step at a time
+        chunk = max(MIN_CHUNK_STEPS, CHUNK_STEPS // max(1, batch))
         dt = float(self.dt)  # type: ignore[arg-type]
         for index, (a, _b, n_steps) in enumerate(intervals):
             done = 0
