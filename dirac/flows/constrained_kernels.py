@@ -180,6 +180,35 @@ def _max_abs(x):
 
 # ---------------------------------------------------------------- RATTLE, constant mass
 @numba.njit(cache=True)
+def _project_momentum(G, W, u, p, h, m, n):
+    """RATTLE's closing projection onto the hidden constraints, in place.
+
+    With ``G`` the constraint Jacobian at the new position, ``W = M^{-1} G^T`` and
+    ``u = M^{-1} p``, solve ``(h/2) G W mu = G u`` and set ``p <- p - (h/2) G^T mu``, so
+    that ``G M^{-1} p = 0`` (the third-stage constraints) holds afterwards
+    (Hairer, Lubich & Wanner, VII.1.4).
+    """
+    S = np.empty((m, m))
+    rhs = np.empty(m)
+    for a in range(m):
+        acc = 0.0
+        for i in range(n):
+            acc += G[a, i] * u[i]
+        rhs[a] = acc
+        for b in range(m):
+            acc = 0.0
+            for i in range(n):
+                acc += G[a, i] * W[i, b]
+            S[a, b] = 0.5 * h * acc
+    mu = _solve_vec(S, rhs)
+    for i in range(n):
+        acc = 0.0
+        for a in range(m):
+            acc += G[a, i] * mu[a]
+        p[i] -= 0.5 * h * acc
+
+
+@numba.njit(cache=True)
 def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol, max_iter, info):
     """RATTLE (Andersen 1983; Hairer, Lubich & Wanner VII.1.4) with constant M.
 
@@ -281,24 +310,13 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                         for j in range(n):
                             acc += minv[i, j] * G1[a, j]
                         A[i, a] = acc
-                S = np.empty((m, m))
-                rhs = np.empty(m)
-                for a in range(m):
-                    for b in range(m):
-                        acc2 = 0.0
-                        for i in range(n):
-                            acc2 += G1[a, i] * A[i, b]
-                        S[a, b] = 0.5 * h * acc2
+                u = np.empty(n)
+                for j in range(n):
                     acc = 0.0
                     for i in range(n):
-                        acc += A[i, a] * p[i]
-                    rhs[a] = acc
-                mu = _solve_vec(S, rhs)
-                for i in range(n):
-                    acc = 0.0
-                    for a in range(m):
-                        acc += G1[a, i] * mu[a]
-                    p[i] -= 0.5 * h * acc
+                        acc += minv[i, j] * p[i]
+                    u[j] = acc
+                _project_momentum(G1, A, u, p, h, m, n)
     info[0] = n_steps
     info[1] = 0.0
     info[2] = evals
@@ -410,24 +428,7 @@ def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, 
                 mm = _mass(fns, q, params, n)
                 W = _solve(mm, np.ascontiguousarray(G1.T))
                 u = _solve_vec(mm, p)
-                S = np.empty((m, m))
-                rhs = np.empty(m)
-                for a in range(m):
-                    acc = 0.0
-                    for i in range(n):
-                        acc += G1[a, i] * u[i]
-                    rhs[a] = acc
-                    for b in range(m):
-                        acc = 0.0
-                        for i in range(n):
-                            acc += G1[a, i] * W[i, b]
-                        S[a, b] = 0.5 * h * acc
-                mu = _solve_vec(S, rhs)
-                for i in range(n):
-                    acc = 0.0
-                    for a in range(m):
-                        acc += G1[a, i] * mu[a]
-                    p[i] -= 0.5 * h * acc
+                _project_momentum(G1, W, u, p, h, m, n)
     info[0] = n_steps
     info[1] = 0.0
     info[2] = evals
