@@ -14,9 +14,75 @@ __all__ = ["to_json", "to_text", "to_latex"]
 #: longest expression printed in full in the text report
 TEXT_LIMIT = 400
 
+#: expressions whose unordered text is longer than this are printed without sorting
+#: their terms (sympy's canonical term order costs more than the whole analysis on the
+#: large multipliers of the particle rigid body)
+ORDERED_LIMIT = 5000
+
+
+#: expressions whose tree (shared sub-expressions counted each time) has more nodes
+#: than this are printed through common sub-expressions (their full text can take
+#: megabytes: block solves share sub-expressions, printing repeats them)
+TREE_LIMIT = 20000
+
+#: prefix of the names of common sub-expressions in reports
+SUBEXPRESSION_PREFIX = "cse_"
+
+
+def tree_size(expr: sympy.Basic) -> int:
+    """Number of nodes of ``expr`` as a tree (what printing visits), counted on the DAG."""
+    memo: dict = {}
+
+    def size(e):
+        hit = memo.get(e)
+        if hit is None:
+            hit = 1 + sum(size(a) for a in e.args)
+            memo[e] = hit
+        return hit
+
+    return size(expr)
+
+
+def expression_text(expr: sympy.Expr) -> str:
+    """``str(expr)``, except that long expressions keep their terms in stored order.
+
+    The text is the same expression either way (``sympy.sympify`` reads it back); only
+    the order of the terms of sums differs.
+    """
+    text = sympy.sstr(expr, order="none")
+    return str(expr) if len(text) <= ORDERED_LIMIT else text
+
+
+def shared_form(exprs: dict) -> tuple[dict, dict]:
+    """Texts of ``{name: expr}``; huge trees through common sub-expressions.
+
+    Returns ``(texts, definitions)``: ``texts[name]`` is the expression's text, in which
+    the names ``cse_0, cse_1, ...`` stand for ``definitions[cse_k]`` (each definition may
+    use earlier ones). ``definitions`` is empty when every tree is small.
+    """
+    big = [k for k, e in exprs.items() if tree_size(e) > TREE_LIMIT]
+    texts = {k: expression_text(e) for k, e in exprs.items() if k not in big}
+    definitions: dict = {}
+    if big:
+        names = sympy.numbered_symbols(SUBEXPRESSION_PREFIX)
+        replacements, reduced = sympy.cse([exprs[k] for k in big], symbols=names, optimizations=None, order="none")
+        definitions = {str(s): expression_text(e) for s, e in replacements}
+        texts.update({k: expression_text(r) for k, r in zip(big, reduced)})
+    return {k: texts[k] for k in exprs}, definitions
+
+
+def _latex(expr: sympy.Expr) -> str:
+    if tree_size(expr) > TREE_LIMIT:
+        return rf"\text{{(an expression of {tree_size(expr)} tree nodes; see --json)}}"
+    if len(sympy.sstr(expr, order="none")) <= ORDERED_LIMIT:
+        return sympy.latex(expr)
+    return sympy.latex(expr, order="none")
+
 
 def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
-    text = str(expr)
+    if tree_size(expr) > TREE_LIMIT:
+        return f"(an expression of {tree_size(expr)} tree nodes; see --json)"
+    text = expression_text(expr)
     if len(text) <= limit:
         return text
     return f"{text[: limit - 40]} ... ({len(text)} characters; full form in --json)"
@@ -27,28 +93,34 @@ def to_json(analysis: "ConstraintAnalysis") -> dict:
 
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
-    ``bracket_strategy``, ``notes``.
+    ``bracket_strategy``, ``notes``; ``multiplier_subexpressions`` (name -> text) when a
+    multiplier is too large to print as one tree: its text then uses those names
+    (see :func:`shared_form`).
     """
-    return {
+    multipliers, definitions = shared_form(dict(analysis.multipliers))
+    out = {
         "system": analysis.name,
         "coordinates": [s.name for s in analysis.coordinates],
         "phase_space_dimension": len(analysis.phase_space),
         "stages": [
-            {"stage": k, "constraints": [str(c) for c in stage]} for k, stage in enumerate(analysis.stages, start=1)
+            {"stage": k, "constraints": [expression_text(c) for c in stage]} for k, stage in enumerate(analysis.stages, start=1)
         ],
-        "first_class": [str(c) for c in analysis.first_class],
-        "second_class": [str(c) for c in analysis.second_class],
-        "multipliers": {name: str(value) for name, value in analysis.multipliers.items()},
+        "first_class": [expression_text(c) for c in analysis.first_class],
+        "second_class": [expression_text(c) for c in analysis.second_class],
+        "multipliers": multipliers,
         "physical_degrees_of_freedom": analysis.physical_degrees_of_freedom,
         "phase_space": [s.name for s in analysis.phase_space],
         "parameters": [p.name for p in analysis.parameters],
-        "canonical_hamiltonian": str(analysis.canonical_hamiltonian),
+        "canonical_hamiltonian": expression_text(analysis.canonical_hamiltonian),
         "primary_multipliers": [u.name for u in analysis.primary_multipliers],
         "undetermined_multipliers": [u.name for u in analysis.undetermined_multipliers],
         "hessian_rank": analysis.hessian_rank,
         "bracket_strategy": analysis.bracket_strategy,
         "notes": list(analysis.notes),
     }
+    if definitions:
+        out["multiplier_subexpressions"] = definitions
+    return out
 
 
 def to_text(analysis: "ConstraintAnalysis") -> str:
@@ -112,7 +184,7 @@ def to_text(analysis: "ConstraintAnalysis") -> str:
 def to_latex(analysis: "ConstraintAnalysis", display: bool = False) -> str:
     """LaTeX rendering: one ``align*`` environment (``display=True``: ``$$ aligned $$`` for Jupyter)."""
     a = analysis
-    lx = sympy.latex
+    lx = _latex
     name = a.name.replace("_", r"\_")
     rows = [rf"&\text{{Dirac--Bergmann analysis of {name}}}"]
     rows.append(rf"L &= {lx(a.lagrangian.expression)}")
