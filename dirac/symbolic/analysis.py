@@ -9,7 +9,7 @@ paper's (1); Sect. X for the rigid body (78), Sect. XI for (228)).
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import sympy
@@ -20,12 +20,16 @@ from dirac.symbolic.classification import bracket_matrix, classify
 from dirac.symbolic.constraint_chain import ConstraintChain
 from dirac.symbolic.dirac_bracket import DiracBracket
 from dirac.symbolic.legendre import legendre_transform
+from dirac.symbolic.linear_solve import SolveTooLarge
 from dirac.symbolic.numeric import Numerics
 
 __all__ = ["ConstraintAnalysis", "analyze"]
 
 #: largest second-class set whose bracket matrix counts as small
 SMALL_SECOND_CLASS = 8
+
+#: seconds allowed for the exact solve of one component of equations_of_motion()
+EXACT_BRACKET_SECONDS = 60.0
 
 
 def _generic_parameter_values(lagrangian: Lagrangian, rng: np.random.Generator) -> dict:
@@ -152,18 +156,62 @@ class ConstraintAnalysis:
             return self._bracket.at(f, g, at)
         return self._bracket.exact(self._bracket._sympify(f), self._bracket._sympify(g))
 
-    def equations_of_motion(self) -> dict[sympy.Symbol, sympy.Expr]:
+    def equations_of_motion(
+        self,
+        variables: Sequence[sympy.Expr | str] | None = None,
+        at: Mapping[str, float] | None = None,
+        time_limit: float = EXACT_BRACKET_SECONDS,
+    ) -> dict:
         """Reduced Hamiltonian vector field ``z_dot = {z, H}_D`` on the constraint surface.
 
         ``H = H_c + u_k phi_k`` over the primary constraints whose multipliers stay free
         (first class); those ``u_k`` stay as symbols. Second-class terms of ``H_T`` drop
-        out of Dirac brackets.
+        out of Dirac brackets ((240); for the rigid body (250)-(251) follow).
+
+        Parameters
+        ----------
+        variables
+            The phase-space functions ``z`` to compute ``z_dot`` of: symbols, names of
+            phase-space variables, or expressions (e.g. ``M_k = -eps_kij (R^T p)_ij``,
+            (233)). Default: every phase-space variable.
+        at
+            Optional numeric point ``{name: value}``: then each ``z_dot`` is a float
+            computed there (no symbolic solve).
+        time_limit
+            Seconds allowed for the exact solve of each component.
+
+        Returns
+        -------
+        dict
+            ``z -> z_dot`` (keys are the sympy expressions of ``variables``).
+
+        Raises
+        ------
+        AnalysisError
+            If a component's exact Dirac bracket is too large to solve symbolically
+            (bracket matrix block or time over its limit); the message names it.
+        InputError
+            For a name that is not a phase-space variable.
         """
         free = set(self.undetermined_multipliers)
         H = self.canonical_hamiltonian + sum(
             (u * phi for u, phi in zip(self.primary_multipliers, self.primary_constraints) if u in free), sympy.S.Zero
         )
-        return {z: self.dirac_bracket(z, H) for z in self.phase_space}
+        items = list(self.phase_space) if variables is None else [self._bracket._sympify(z) for z in variables]
+        result: dict = {}
+        for z in items:
+            if at is not None:
+                result[z] = self._bracket.at(z, H, at)
+                continue
+            try:
+                result[z] = self._bracket.exact(z, H, time_limit=time_limit)
+            except SolveTooLarge as exc:
+                raise AnalysisError(
+                    f"the exact Dirac bracket {{{z}, H}}_D of {self.name!r} cannot be found symbolically: {exc}; "
+                    "evaluate it at a point with equations_of_motion(..., at=point), or ask only for the "
+                    "components you need with equations_of_motion(variables=[...])"
+                ) from None
+        return result
 
     # ------------------------------------------------------------------ points
     def surface_point(self, values: Mapping[str, float] | None = None, seed: int | None = None) -> dict[str, float]:

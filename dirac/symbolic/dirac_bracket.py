@@ -66,8 +66,21 @@ class DiracBracket:
         self._args = (*phase_space.variables, *phase_space.parameters)
 
     # ------------------------------------------------------------------ exact
-    def exact(self, f: sympy.Expr, g: sympy.Expr) -> sympy.Expr:
-        """``{f, g}_D`` as an exact expression, equal to (240) on the constraint surface."""
+    def exact(self, f: sympy.Expr, g: sympy.Expr, time_limit: float | None = None) -> sympy.Expr:
+        """``{f, g}_D`` as an exact expression, equal to (240) on the constraint surface.
+
+        Parameters
+        ----------
+        f, g
+            Phase-space functions.
+        time_limit
+            Seconds allowed for the block solve of ``C x = {Phi, g}`` (``None``: no limit).
+
+        Raises
+        ------
+        SolveTooLarge
+            If the solve needs a block above the size limit or runs over ``time_limit``.
+        """
         f, g = sympy.sympify(f), sympy.sympify(g)
         pb = self.space.poisson_bracket
         plain = pb(f, g)
@@ -88,10 +101,10 @@ class DiracBracket:
         contribution = np.einsum("ki,ki->k", a_vals, x_vals)
         if np.all(np.abs(contribution) <= 1e-9 * (1 + np.abs(a_vals).sum(1) * np.abs(x_vals).max(1))):
             return plain  # the correction vanishes weakly, e.g. (246) with (239)
-        x = weak_solve(self.C, sympy.Matrix(beta), list(c_vals), [b.reshape(-1, 1) for b in b_vals], variables=self.space.variables)
+        x = weak_solve(self.C, sympy.Matrix(beta), list(c_vals), [b.reshape(-1, 1) for b in b_vals], variables=self.space.variables, time_limit=time_limit)
         correction = sum((alpha[a] * x[a, 0] for a in range(m) if alpha[a] != 0 and x[a, 0] != 0), sympy.S.Zero)
         result = plain - correction
-        if sympy.count_ops(result) < 600:
+        if len(str(result)) < 3000 and sympy.count_ops(result) < 600:
             result = sympy.cancel(result)
         return result
 

@@ -16,6 +16,7 @@ solution on the surface.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 
 import numpy as np
@@ -29,6 +30,17 @@ from dirac.symbolic.algebra import tidy
 __all__ = ["weak_solve", "block_order"]
 
 RELATIVE_ZERO = 1e-9
+
+#: expressions longer than this (characters of ``str``) are not given a rational normal
+#: form: the gcds of ``cancel`` hang on them (the 24x24 solves of the rigid body)
+TIDY_LIMIT = 4000
+
+#: largest diagonal block solved by symbolic LU when a time limit is set
+MAX_EXACT_BLOCK = 6
+
+
+class SolveTooLarge(AnalysisError):
+    """An exact weak solve would exceed its size or time limit (see :func:`weak_solve`)."""
 
 
 def _zero_mask(values: np.ndarray) -> np.ndarray:
@@ -98,6 +110,7 @@ def weak_solve(
     b_num: Sequence[np.ndarray],
     simplify: bool = True,
     variables: Sequence[sympy.Symbol] = (),
+    time_limit: float | None = None,
 ) -> sympy.Matrix:
     """Solve ``A X = B`` exactly, weakly (on the surface where ``a_num``, ``b_num`` were taken).
 
@@ -109,13 +122,23 @@ def weak_solve(
         ``A`` and ``B`` evaluated at several points of the constraint surface.
     simplify
         Bring solutions of 1x1 blocks to the readable form of
-        :func:`~dirac.symbolic.constraint_chain.tidy` (in the phase-space ``variables``).
+        :func:`~dirac.symbolic.constraint_chain.tidy` (in the phase-space ``variables``);
+        solutions longer than ``TIDY_LIMIT`` characters are left as they are (no gcd).
+    time_limit
+        Seconds allowed (``None``: no limit). With a limit, diagonal blocks larger than
+        ``MAX_EXACT_BLOCK`` are refused at once and the clock is checked between blocks.
 
     Returns
     -------
     sympy.Matrix
         ``X`` (``k x c``), equal to ``A^{-1} B`` on the surface.
+
+    Raises
+    ------
+    SolveTooLarge
+        When a limit is exceeded (only with ``time_limit``).
     """
+    start = time.monotonic()
     k = a_sym.shape[0]
     cols = b_sym.shape[1]
     a_vals = np.asarray(a_num, dtype=float).reshape(-1, k, k)
@@ -140,6 +163,14 @@ def weak_solve(
                         rhs[r, c] -= A[i, j] * X[j, c]
         if all(x_zero[u, c] for u in unknowns for c in range(cols)):
             continue
+        if time_limit is not None:
+            if len(block) > MAX_EXACT_BLOCK:
+                raise SolveTooLarge(
+                    f"the exact solve needs a {len(block)}x{len(block)} block that does not vanish weakly "
+                    f"(limit {MAX_EXACT_BLOCK}x{MAX_EXACT_BLOCK})"
+                )
+            if time.monotonic() - start > time_limit:
+                raise SolveTooLarge(f"the exact solve took more than {time_limit:g} s")
         sub = sympy.Matrix(len(block), len(block), lambda r, s: A[block[r], unknowns[s]])
         if len(block) == 1:
             sol = rhs / sub[0, 0]
@@ -151,6 +182,6 @@ def weak_solve(
                     continue
                 value = sol[r, c]
                 if simplify and len(block) == 1:
-                    value = tidy(value, variables)
+                    value = tidy(value, variables, rational=len(str(value)) < TIDY_LIMIT)
                 X[u, c] = value
     return X
