@@ -14,30 +14,15 @@ import pytest
 import sympy
 
 import dirac
+from rigid_body_analyses import cached_analysis, eps, hat
 
 PAIRS = ((1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3))
 POINTS = 100
 
 
-def cached_analysis(config: pytest.Config, name: str):
-    """One engine analysis per built-in system for the whole test session."""
-    store = config.__dict__.setdefault("_dirac_rigid_body_analyses", {})
-    if name not in store:
-        store[name] = dirac.analyze(dirac.load_system(name))
-    return store[name]
-
-
 @pytest.fixture(scope="module")
 def analysis(request):
     return cached_analysis(request.config, "rigid_body_matrix")
-
-
-def eps(i: int, j: int, k: int) -> int:
-    return int((i - j) * (j - k) * (k - i) / 2)
-
-
-def hat(w: np.ndarray) -> np.ndarray:
-    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
 
 
 def surface_points(count: int, seed: int):

@@ -10,6 +10,7 @@ import pytest
 import sympy
 
 import dirac
+from rigid_body_analyses import cached_analysis
 from dirac.errors import InputError
 from dirac.symbolic.compare import (
     CanonicalBracket,
@@ -29,14 +30,6 @@ M = sympy.symbols("M_1:4", real=True)
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 P_R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"p_R_{i + 1}{j + 1}", real=True))
 NAMES = [*(f"M_{k}" for k in (1, 2, 3)), *(f"R_{i}{j}" for i in (1, 2, 3) for j in (1, 2, 3))]
-
-
-def cached_analysis(config: pytest.Config, name: str):
-    """One engine analysis per built-in system for the whole test session."""
-    store = config.__dict__.setdefault("_dirac_rigid_body_analyses", {})
-    if name not in store:
-        store[name] = dirac.analyze(dirac.load_system(name))
-    return store[name]
 
 
 @pytest.fixture(scope="module")

@@ -14,14 +14,11 @@ from dirac.symbolic.noncanonical import (
     canonical_bracket,
     rigid_body_variables,
 )
+from rigid_body_analyses import eps
 
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 M = sympy.symbols("M_1:4", real=True)
 SYM = ((1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3))
-
-
-def eps(i: int, j: int, k: int) -> int:
-    return int((i - j) * (j - k) * (k - i) / 2)
 
 
 def delta(i: int, j: int) -> int:

@@ -16,19 +16,12 @@ import sympy
 import dirac
 from dirac.errors import InputError
 from dirac_systems import rigid_body_matrix
+from rigid_body_analyses import cached_analysis, eps, hat
 
 I1, I2, I3 = (sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3))
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 R_DOT = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}_dot", real=True))
 PAIRS = ((1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3))
-
-
-def cached_analysis(config: pytest.Config, name: str):
-    """One engine analysis per built-in system for the whole test session."""
-    store = config.__dict__.setdefault("_dirac_rigid_body_analyses", {})
-    if name not in store:
-        store[name] = dirac.analyze(dirac.load_system(name))
-    return store[name]
 
 
 @pytest.fixture(scope="module")
@@ -37,14 +30,6 @@ def analysis(request):
 
 
 # ------------------------------------------------------------------ hand formulas
-def eps(i: int, j: int, k: int) -> int:
-    return int((i - j) * (j - k) * (k - i) / 2)
-
-
-def hat(w: np.ndarray) -> np.ndarray:
-    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
-
-
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
     q, r = np.linalg.qr(rng.normal(size=(3, 3)))
     q = q @ np.diag(np.sign(np.diag(r)))

@@ -17,14 +17,11 @@ import sympy
 import dirac
 from dirac.errors import DiracWarning, InputError
 from dirac_systems import rigid_body_momentum
+from rigid_body_analyses import eps
 
 I = [sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3)]  # noqa: E741
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 R_DOT = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}_dot", real=True))
-
-
-def eps(i: int, j: int, k: int) -> int:
-    return int((i - j) * (j - k) * (k - i) / 2)
 
 
 def test_lagrangian_is_228_with_M_of_227():

@@ -11,16 +11,9 @@ import sympy
 import dirac
 from dirac.errors import InputError
 from dirac_systems import rigid_body_particles
+from rigid_body_analyses import cached_analysis
 
 UNIT_TETRAHEDRON = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
-
-
-def cached_analysis(config: pytest.Config, name: str):
-    """One engine analysis per built-in system for the whole test session."""
-    store = config.__dict__.setdefault("_dirac_rigid_body_analyses", {})
-    if name not in store:
-        store[name] = dirac.analyze(dirac.load_system(name))
-    return store[name]
 
 
 def test_body_data_of_the_unit_tetrahedron():
