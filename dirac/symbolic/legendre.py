@@ -36,6 +36,7 @@ from dirac.errors import AnalysisError
 from dirac.lagrangian import Lagrangian, momentum_name, multiplier_name
 from dirac.symbolic.numeric import independent_rows
 from dirac.symbolic.phase_space import PhaseSpace
+from dirac.symbolic.polynomial_kernel import polynomial_kernel
 
 __all__ = ["LegendreTransform", "legendre_transform"]
 
@@ -190,7 +191,35 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
                 z = rng.uniform(0.5, 1.5, n) * rng.choice([-1.0, 1.0], n)
                 a_samples.append(np.array(a_fn(*z, *pvals), dtype=float).reshape(A.shape))
             col_pivots = independent_rows([m.T for m in a_samples], list(range(n)))
-            if len(col_pivots) == rank == A.shape[0]:
+            kernel = (
+                polynomial_kernel(A, q, parameter_values, rng, rank, holonomic=lagrangian.constraints) if len(col_pivots) == rank == A.shape[0] else None
+            )
+            if kernel is not None:
+                from dirac.symbolic.algebra import tidy as _tidy
+
+                for vec in kernel.null_basis:
+                    phi = sum((c * s for c, s in zip(vec, shifted)), sympy.S.Zero)
+                    primary.append(_tidy(phi, space.variables, sign=True))
+                m, den = kernel.momentum_solution(shifted)
+                m = m.applyfunc(lambda e: _tidy(e, space.variables))
+                den = _tidy(den, space.variables)
+                G_inv = _inverse(G)
+                kinetic = (m.T * G_inv * m)[0, 0] / (2 * den**2)
+                H_c = kinetic + potential
+                velocity = None
+                used_forms = True
+                singular_general = True  # H_c is kept as written: expanding it over one denominator only grows it
+                method = (
+                    f"singular Hessian of rank {rank}: L is a quadratic form in {A.shape[0]} linear velocity "
+                    f"combinations l = A q_dot; primary constraints from polynomial null vectors of A (degree "
+                    f"{kernel.degree[0]}); G l = B^T (p - a) / d on the primary surface with polynomial B of degree "
+                    f"{kernel.degree[1]}, A B = d 1, d = {den}"
+                    + (" (constant on the holonomic constraint surface)" if kernel.unit_denominator else "")
+                    if kernel.unit_denominator or len(kernel.right_inverses) == 1
+                    else f"{kernel.degree[0]}); G l = sum_r d_r B_r^T (p - a) / sum_r d_r^2 on the primary surface "
+                    f"with polynomial B_r of degree {kernel.degree[1]}, A B_r = d_r 1"
+                )
+            elif len(col_pivots) == rank == A.shape[0]:
                 S = col_pivots
                 others = [j for j in range(n) if j not in S]
                 A_S = A[:, S]
