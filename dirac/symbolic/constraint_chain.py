@@ -11,7 +11,13 @@ independent on the surface fix multipliers; every other row ``a`` is, after elim
 coefficients of row ``a`` in the pivot rows). Each ``psi_a`` is (i) weakly zero — an
 identity, or (ii) a new constraint of the next stage. Pivot rows are chosen among rows
 whose ``b`` already vanishes weakly first, so that usually ``psi_a = b_a`` exactly
-(this reproduces the chains (206), (209), (210), (215) of the paper). New constraints
+(this reproduces the chains (206), (209), (210), (215) of the paper). When a stage has
+new constraints of that direct kind, the conditions that would need multipliers
+eliminated are deferred to the next stage and re-examined there, on the smaller
+surface, where more multipliers are usually fixed by rows with ``b ≈ 0``: the final
+surface is the same (the chain only stops when no row of any kind adds a constraint),
+and the stages follow the paper's order for (228) — ``pi -> R^T R - 1`` first, then
+``d(R^T R)/dt = 0`` fixes ``v = 0`` and ``P_dot = 0`` fixes ``lambda`` (Sect. XI). New constraints
 that follow from the earlier ones (gradient dependent on the new surface) are dropped; a
 condition free of phase-space variables (``1 = 0``) is an inconsistency. The chain stops
 when a stage adds nothing; the last system then fixes the determined multipliers.
@@ -110,7 +116,6 @@ class ConstraintChain:
             When the chain does not terminate within the phase-space dimension.
         """
         self._row_cache: dict = {}
-        nsym = set(self.phase_space.variables)
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
         self.primary = primary
         points = self.numerics.surface_points(primary, SAMPLE_POINTS) if primary else []
@@ -134,40 +139,25 @@ class ConstraintChain:
             order += [i for i in range(len(constraints)) if not b_zero[i] and not a_row_zero[i]]
             pivots_rows = independent_rows(list(A_num), order) if K else []
             pivot_cols = independent_rows([m[pivots_rows].T for m in A_num], list(range(K))) if pivots_rows else []
-            candidates: list[sympy.Expr] = []
+            direct: list[sympy.Expr] = []
+            deferred: list[int] = []
             for i, c in enumerate(constraints):
                 if i in pivots_rows or (b_zero[i] and a_row_zero[i]):
                     continue
-                b_i = exprs_b[i]
-                if a_row_zero[i]:
-                    psi = b_i
+                if a_row_zero[i] or not self._needed(i, pivots_rows, pivot_cols, A_num, b_zero):
+                    direct.append(exprs_b[i])
                 else:
-                    psi = self._eliminate(i, constraints, pivots_rows, pivot_cols, b_num, A_num, b_zero, points)
-                    if psi is None:
-                        continue
-                candidates.append(psi)
-            if candidates:
-                keep = ~self.numerics.weakly_zero(candidates, points)
-                candidates = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
-            if not candidates:
-                break
-            for c in candidates:
-                if not (c.free_symbols & nsym):
-                    raise InconsistentSystemError(
-                        f"the consistency conditions of the constraints demand {c} = 0, which cannot hold "
-                        f"(stage {len(self.stages) + 1}): the Lagrangian has no consistent motion"
-                    )
-            if len(self.stages) >= limit:
-                raise AnalysisError(f"the constraint chain did not terminate after {limit} stages")
-            try:
-                new_points = self.numerics.surface_points(constraints + candidates, SAMPLE_POINTS)
-            except AnalysisError:
-                shown = "; ".join(f"{c} = 0" for c in candidates[:4])
-                raise InconsistentSystemError(
-                    f"the stage-{len(self.stages) + 1} conditions {shown} have no real solution together with "
-                    "the earlier constraints: the Lagrangian has no consistent motion"
-                ) from None
-            chosen = self._independent(candidates, constraints, new_points)
+                    deferred.append(i)
+            candidates, chosen = self._settle(self._nonzero(direct, points), constraints, limit) if direct else ([], [])
+            if not chosen and deferred:
+                # nothing new without them: build the conditions that need multipliers eliminated
+                eliminated = [self._eliminate(i, constraints, pivots_rows, pivot_cols, b_num, A_num, b_zero, points) for i in deferred]
+                candidates, chosen = self._settle(self._nonzero(eliminated, points), constraints, limit)
+            elif deferred:
+                self.notes.append(
+                    f"stage {len(self.stages) + 1}: {len(deferred)} consistency condition(s) that need multipliers "
+                    "eliminated were deferred to the next stage and re-examined there on the smaller surface"
+                )
             if not chosen:
                 break
             self.stages.append([candidates[i] for i in chosen])
@@ -175,6 +165,44 @@ class ConstraintChain:
         self.points = points
         self._solve_multipliers(points, pivots_rows, pivot_cols)
         return self
+
+    def _nonzero(self, candidates: list[sympy.Expr], points: list[np.ndarray]) -> list[sympy.Expr]:
+        """The candidates that are not weakly zero, tidied (constraints: the sign is free)."""
+        if not candidates:
+            return []
+        keep = ~self.numerics.weakly_zero(candidates, points)
+        return [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+
+    def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
+        """Check new conditions for inconsistency and keep the independent ones (indices into ``candidates``)."""
+        if not candidates:
+            return [], []
+        nsym = set(self.phase_space.variables)
+        for c in candidates:
+            if not (c.free_symbols & nsym):
+                raise InconsistentSystemError(
+                    f"the consistency conditions of the constraints demand {c} = 0, which cannot hold "
+                    f"(stage {len(self.stages) + 1}): the Lagrangian has no consistent motion"
+                )
+        if len(self.stages) >= limit:
+            raise AnalysisError(f"the constraint chain did not terminate after {limit} stages")
+        try:
+            new_points = self.numerics.surface_points(constraints + candidates, SAMPLE_POINTS)
+        except AnalysisError:
+            shown = "; ".join(f"{c} = 0" for c in candidates[:4])
+            raise InconsistentSystemError(
+                f"the stage-{len(self.stages) + 1} conditions {shown} have no real solution together with "
+                "the earlier constraints: the Lagrangian has no consistent motion"
+            ) from None
+        return candidates, self._independent(candidates, constraints, new_points)
+
+    def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> list[int]:
+        """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by."""
+        if not P:
+            return []
+        coeff = np.array([np.linalg.lstsq(A[np.ix_(P, Q)].T, A[row, Q], rcond=None)[0] for A in A_num])
+        scale = 1 + np.max(np.abs(coeff), axis=1, keepdims=True)
+        return [k for k, p in enumerate(P) if not b_zero[p] and not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
 
     def _independent(self, candidates: list[sympy.Expr], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
         n = len(self.phase_space.variables)
@@ -189,11 +217,7 @@ class ConstraintChain:
 
     def _eliminate(self, row, constraints, P, Q, b_num, A_num, b_zero, points):
         """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows."""
-        if not P:
-            return self._rows(constraints[row])[0]
-        coeff = np.array([np.linalg.lstsq(A[np.ix_(P, Q)].T, A[row, Q], rcond=None)[0] for A in A_num])
-        scale = 1 + np.max(np.abs(coeff), axis=1, keepdims=True)
-        needed = [k for k, p in enumerate(P) if not b_zero[p] and not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
+        needed = self._needed(row, P, Q, A_num, b_zero)
         b_row = self._rows(constraints[row])[0]
         if not needed:
             return b_row
