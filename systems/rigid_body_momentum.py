@@ -92,12 +92,14 @@ def system() -> Lagrangian:
     R, R_dot = rotation_symbols()
     I = inertia_symbols()  # noqa: E741
     M = body_angular_momentum(R, R_dot, I)
+    # written through Omega_k = M_k / I_k as in (227)-(228), not expanded: the engine sees the
+    # three velocity combinations and finds the primary constraints from them
     kinetic = sympy.Rational(1, 2) * sum(M[k] ** 2 / I[k] for k in range(3))
     return Lagrangian(
         "rigid_body_momentum",
         tuple(R),
         tuple(R_dot),
-        sympy.expand(kinetic),
+        kinetic,
         orthogonality_constraints(R),
         {I[k]: DEFAULT_INERTIA[k] for k in range(3)},
         "free rigid body, angular-momentum Lagrangian (228)",

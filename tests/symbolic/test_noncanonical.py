@@ -1,6 +1,7 @@
 """Brackets in noncanonical variables: the change (235) ``(R, p) -> (R, M, P)`` and the
-brackets (236)–(238), written out by hand here. (Dirac brackets of the new variables on
-the surface of (78) are exercised in test_compare.py and test_chetaev.py.)"""
+brackets (236)–(238), written out by hand here; Dirac brackets of the new variables on
+the constraint surface of (228) from the engine. (Those on the surface of (78) are
+exercised in test_compare.py and test_chetaev.py.)"""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from dirac.symbolic.noncanonical import (
     canonical_bracket,
     rigid_body_variables,
 )
-from rigid_body_analyses import eps
+from rigid_body_analyses import cached_analysis, eps, hat
 
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 M = sympy.symbols("M_1:4", real=True)
@@ -174,3 +175,27 @@ def test_bad_new_variables_are_refused():
     assert w.bracket("q", "s", express=True) == 1
     with pytest.raises(InputError, match="not one of the new variables"):
         w.bracket("q", "x")
+
+
+@pytest.mark.slow
+def test_dirac_brackets_of_R_M_P_on_the_surface_of_228(request):
+    """On the surface, the Dirac brackets of the new variables are (236) with R~ = R^T
+    = R^{-1}, i.e. Chetaev (248)-(249), and the constraints P are Casimirs (Sect. XI)."""
+    analysis = cached_analysis(request.config, "rigid_body_momentum")
+    w = rigid_body_variables(analysis.symbols, inverse="transpose")
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+        R_ = q * np.sign(np.linalg.det(q))
+        M_ = rng.normal(size=3)
+        p_ = 0.5 * R_ @ hat(M_)  # (229)
+        given = {f"R_{i + 1}{j + 1}": R_[i, j] for i in range(3) for j in range(3)}
+        given |= {f"p_R_{i + 1}{j + 1}": p_[i, j] for i in range(3) for j in range(3)}
+        point = analysis.surface_point(values=given, seed=3)
+        J = w.dirac_bracket_matrix(analysis, point)
+        index = {name: k for k, name in enumerate(w.names)}
+        expected = hand_brackets(R_.T, M_)
+        for (a, b), value in expected.items():
+            if a.startswith("P") or b.startswith("P"):
+                value = 0.0  # P_ij are second-class constraints: Casimirs of { , }_D
+            assert J[index[a], index[b]] == pytest.approx(value, abs=1e-9), (a, b)
