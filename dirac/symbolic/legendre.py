@@ -21,8 +21,12 @@ and on the primary surface the canonical Hamiltonian is
 through linear combinations of velocities, ``W = A^T G A`` with ``A`` the ``k x n``
 coefficient matrix of ``k`` such combinations; then ``null W = null A`` and the
 primary constraints ``phi_j = (p - a)_j - (A_S^{-1} A_j)^T (p - a)_S`` avoid the
-``r x r`` inverse of ``W_SS`` (whose entries are products) — used for the rigid-body
-Lagrangian (228), where the velocity combinations are the body angular velocities (227).
+``r x r`` inverse of ``W_SS`` (whose entries are products). When ``A`` is polynomial,
+:mod:`dirac.symbolic.polynomial_kernel` first looks for polynomial null vectors of ``A``
+and a polynomial ``B`` with ``A B = d 1`` (``G l = B^T (p - a) / d`` on the primary
+surface), which avoids denominators that vanish on the physical surface — used for the
+rigid-body Lagrangian (228), where the velocity combinations are the body angular
+velocities (227) and this gives ``sym(p R^T) = 0`` and the paper's (232).
 """
 
 from __future__ import annotations
@@ -209,15 +213,19 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
                 velocity = None
                 used_forms = True
                 singular_general = True  # H_c is kept as written: expanding it over one denominator only grows it
+                if kernel.unit_denominator or len(kernel.right_inverses) == 1:
+                    solved = f"G l = B^T (p - a) / d with polynomial B of degree {kernel.degree[1]}, A B = d 1, d = {den}"
+                    if kernel.unit_denominator:
+                        solved += " (constant on the holonomic constraint surface, B tangent to it)"
+                else:
+                    solved = (
+                        f"G l = sum_r d_r B_r^T (p - a) / sum_r d_r^2 with polynomial B_r of degree "
+                        f"{kernel.degree[1]}, A B_r = d_r 1"
+                    )
                 method = (
                     f"singular Hessian of rank {rank}: L is a quadratic form in {A.shape[0]} linear velocity "
                     f"combinations l = A q_dot; primary constraints from polynomial null vectors of A (degree "
-                    f"{kernel.degree[0]}); G l = B^T (p - a) / d on the primary surface with polynomial B of degree "
-                    f"{kernel.degree[1]}, A B = d 1, d = {den}"
-                    + (" (constant on the holonomic constraint surface)" if kernel.unit_denominator else "")
-                    if kernel.unit_denominator or len(kernel.right_inverses) == 1
-                    else f"{kernel.degree[0]}); G l = sum_r d_r B_r^T (p - a) / sum_r d_r^2 on the primary surface "
-                    f"with polynomial B_r of degree {kernel.degree[1]}, A B_r = d_r 1"
+                    f"{kernel.degree[0]}); on the primary surface {solved}"
                 )
             elif len(col_pivots) == rank == A.shape[0]:
                 S = col_pivots
