@@ -16,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cli_output import one_error_line
+
 RIGID = """
 [system]
 name = "rigid_body"
@@ -26,13 +28,6 @@ M = {M}
 t_end = {t_end}
 {extra}
 """
-
-
-def _one_error_line(status: int, err: str) -> str:
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert status == 2, err
-    assert len(lines) == 1 and lines[0].startswith("error:"), err
-    return lines[0]
 
 
 def _scene(tmp_path, **fields) -> str:  # noqa: ANN001
@@ -151,19 +146,19 @@ def test_f15_momentum_within_1e_170_of_an_axis_is_finite_and_keeps_the_invariant
 def test_f1_absurd_number_of_samples_is_an_input_error(tmp_path, run_cli):
     scene = _scene(tmp_path, extra="samples = 100000000000000")
     status, _, err = run_cli("run", scene, "--out", str(tmp_path / "o.npz"), "--no-progress")
-    assert "samples" in _one_error_line(status, err)
+    assert "samples" in one_error_line(status, err)
 
 
 def test_f2_step_count_overflow_is_an_input_error(tmp_path, run_cli):
     scene = _scene(tmp_path, t_end="1e300", extra='method = "lie-poisson-2"\ndt = 1e-300\nsamples = 2')
     status, _, err = run_cli("run", scene, "--out", str(tmp_path / "o.npz"), "--no-progress")
-    _one_error_line(status, err)
+    one_error_line(status, err)
 
 
 def test_f4_out_naming_a_directory_is_an_input_error(tmp_path, run_cli):
     (tmp_path / "d.npz").mkdir()
     status, _, err = run_cli("run", _scene(tmp_path), "--out", str(tmp_path / "d.npz"), "--no-progress")
-    assert "d.npz" in _one_error_line(status, err)
+    assert "d.npz" in one_error_line(status, err)
 
 
 def test_f10_auto_on_a_long_constrained_run_chooses_a_working_step(tmp_path, run_cli):
@@ -199,7 +194,7 @@ def test_f14_booleans_are_not_numbers_in_rigid_body_problem(M):
 def test_f14_booleans_are_not_numbers_in_scenes(tmp_path, run_cli):
     path = _scene(tmp_path, M="[false, 0.2, 0.1]", extra='method = "exact"')
     status, _, err = run_cli("run", path, "--out", str(tmp_path / "o.npz"), "--no-progress")
-    _one_error_line(status, err)
+    one_error_line(status, err)
 
 
 def test_f3_singular_constraint_jacobian_is_reported_not_a_traceback(tmp_path, run_cli):
@@ -207,4 +202,4 @@ def test_f3_singular_constraint_jacobian_is_reported_not_a_traceback(tmp_path, r
     path.write_text('[system]\nname = "pendulum"\nparameters = { l = 0.0 }\n[initial]\nq = { x = 0.0, y = 0.0 }\n'
                     '[run]\nt_end = 1.0\nmethod = "rattle-2"\ndt = 0.01\n')
     status, _, err = run_cli("run", str(path), "--out", str(tmp_path / "o.npz"), "--no-progress")
-    _one_error_line(status, err)
+    one_error_line(status, err)

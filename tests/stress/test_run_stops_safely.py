@@ -13,6 +13,7 @@ import re
 import numpy as np
 import pytest
 
+from cli_output import one_error_line
 from dirac.flows.results import read_results
 
 RUNAWAY = """
@@ -83,10 +84,7 @@ def test_guard_rail_stops_the_run_and_keeps_the_samples(scene, method, cause, tm
     path.write_text(scene)
     out = tmp_path / "out.npz"
     status, _, err = run_cli("run", str(path), "--out", str(out), "--no-progress")
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert status == 2, err
-    assert len(lines) == 1 and lines[0].startswith("error:"), err
-    line = lines[0]
+    line = one_error_line(status, err)
     assert cause in line
     where = re.search(r"at t = ([0-9.eE+-]+) \(step (\d+)\) with method (\S+)", line)
     assert where is not None, line
