@@ -76,6 +76,25 @@ def cli(run_cli):  # noqa: ANN001, ANN201
     return run
 
 
+@pytest.fixture
+def run_scene(cli, tmp_path):  # noqa: ANN001, ANN201
+    """``dirac run`` of a scene text, written to ``scene.toml``, into a fresh ``out.npz``.
+
+    Returns ``(status, stderr, out)``. Hypothesis reuses ``tmp_path`` across examples, so a
+    result file of an earlier example is removed first.
+    """
+
+    def run(text: str) -> tuple[int, str, Path]:
+        path = tmp_path / "scene.toml"
+        path.write_text(text, encoding="utf-8")
+        out = tmp_path / "out.npz"
+        out.unlink(missing_ok=True)
+        status, _, err = cli("run", str(path), "--out", str(out), "--no-progress")
+        return status, err, out
+
+    return run
+
+
 def assert_one_error_line(status: int, err: str) -> str:
     """Exit status 2 and one ``error:`` line (only ``warning:`` lines besides); return it."""
     lines = [line for line in err.splitlines() if line.strip()]
@@ -176,42 +195,32 @@ def good_rigid_scene(draw) -> dict:  # noqa: ANN001
 # ----------------------------------------------------------------------------- scenes
 @SETTINGS
 @given(scene=bad_scene())
-def test_bad_scene_exits_2_with_one_error_line_and_writes_nothing(scene, cli, tmp_path):
-    path = tmp_path / "scene.toml"
-    path.write_text(toml_document(scene))
-    out = tmp_path / "out.npz"
-    out.unlink(missing_ok=True)
-    status, _, err = cli("run", str(path), "--out", str(out), "--no-progress")
+def test_bad_scene_exits_2_with_one_error_line_and_writes_nothing(scene, run_scene):
+    status, err, out = run_scene(toml_document(scene))
     assert_one_error_line(status, err)
     assert not out.exists()
 
 
 @SETTINGS
 @given(text=st.text(max_size=60))
-def test_malformed_toml_exits_2_with_one_error_line(text, cli, tmp_path):
+def test_malformed_toml_exits_2_with_one_error_line(text, run_scene):
     try:
         tomllib.loads(text.replace("\r\n", "\n").replace("\r", "\n"))  # as read_text() will see it
     except tomllib.TOMLDecodeError:
         pass
     else:
         assume(False)  # only malformed documents here
-    path = tmp_path / "scene.toml"
-    path.write_text(text, encoding="utf-8")
-    status, _, err = cli("run", str(path), "--out", str(tmp_path / "out.npz"), "--no-progress")
+    status, err, _ = run_scene(text)
     line = assert_one_error_line(status, err)
     assert "TOML" in line
 
 
 @SETTINGS
 @given(scene=good_rigid_scene())
-def test_good_scene_runs_and_writes_a_complete_file(scene, cli, tmp_path):
+def test_good_scene_runs_and_writes_a_complete_file(scene, run_scene):
     from dirac.flows.results import read_results
 
-    path = tmp_path / "scene.toml"
-    path.write_text(toml_document(scene))
-    out = tmp_path / "out.npz"
-    out.unlink(missing_ok=True)
-    status, _, err = cli("run", str(path), "--out", str(out), "--no-progress")
+    status, err, out = run_scene(toml_document(scene))
     assert status == 0, err
     assert all(line.startswith("warning:") for line in err.splitlines() if line.strip()), err
     arrays, meta = read_results(out)
@@ -223,7 +232,7 @@ def test_good_scene_runs_and_writes_a_complete_file(scene, cli, tmp_path):
 @SETTINGS
 @given(keys=st.lists(st.text(alphabet="abcdefghij_", min_size=3, max_size=8), min_size=1, max_size=3, unique=True),
        table=st.sampled_from(["system", "initial", "run"]))
-def test_unknown_keys_are_warned_about_by_name_and_the_run_goes_on(keys, table, cli, tmp_path):
+def test_unknown_keys_are_warned_about_by_name_and_the_run_goes_on(keys, table, run_scene):
     scene = good_scene()
     known = {"system": {"name", "inertia", "description"}, "initial": {"M", "omega", "m", "R"},
              "run": {"t_end", "method", "dt", "tolerance", "samples", "outputs", "drift_limit",
@@ -231,9 +240,7 @@ def test_unknown_keys_are_warned_about_by_name_and_the_run_goes_on(keys, table, 
     assume(not set(keys) & known[table])
     for key in keys:
         scene[table][key] = 1.0
-    path = tmp_path / "scene.toml"
-    path.write_text(toml_document(scene))
-    status, _, err = cli("run", str(path), "--out", str(tmp_path / "out.npz"), "--no-progress")
+    status, err, _ = run_scene(toml_document(scene))
     assert status == 0, err
     warnings = [line for line in err.splitlines() if line.startswith("warning:")]
     assert len(warnings) == 1, err
@@ -375,7 +382,7 @@ def test_load_system_refuses_unknown_names_and_bad_parameters(name, value):
 @settings(max_examples=10, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(angle=st.floats(-3.0, 3.0), radius=st.one_of(st.floats(0.5, 0.999), st.floats(1.001, 2.0)),
        radial_speed=st.one_of(st.floats(-2.0, -1e-3), st.floats(1e-3, 2.0)), which=st.booleans())
-def test_initial_data_off_the_constraint_surface_is_refused(angle, radius, radial_speed, which, cli, tmp_path):
+def test_initial_data_off_the_constraint_surface_is_refused(angle, radius, radial_speed, which, run_scene):
     """Pendulum (l = 1): q off the circle, or q on it with a radial velocity."""
     x, y = math.sin(angle), -math.cos(angle)
     if which:
@@ -386,9 +393,6 @@ def test_initial_data_off_the_constraint_surface_is_refused(angle, radius, radia
         phrase = "not tangent"
     scene = {"system": {"name": "pendulum"}, "initial": initial,
              "run": {"t_end": 0.1, "method": "rattle-2", "dt": 0.01, "samples": 2}}
-    path = tmp_path / "scene.toml"
-    path.write_text(toml_document(scene))
-    out = tmp_path / "out.npz"
-    status, _, err = cli("run", str(path), "--out", str(out), "--no-progress")
+    status, err, out = run_scene(toml_document(scene))
     assert phrase in assert_one_error_line(status, err)
     assert not out.exists()
