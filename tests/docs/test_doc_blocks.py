@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from doc_blocks import console_commands, parse_blocks, run_page
 
 PAGE = '''# Page
@@ -41,9 +43,19 @@ def _write(tmp_path: Path, text: str) -> Path:
     return page
 
 
-def test_a_correct_page_runs_every_block(tmp_path: Path, monkeypatch) -> None:
+@pytest.fixture
+def run_text(tmp_path: Path, monkeypatch):  # noqa: ANN201
+    """Run a page text as ``page.md`` in ``tmp_path``, which is made the working directory."""
     monkeypatch.chdir(tmp_path)
-    problems, executed = run_page(_write(tmp_path, PAGE), "page.md")
+
+    def run(text: str) -> tuple[list[str], int]:
+        return run_page(_write(tmp_path, text), "page.md")
+
+    return run
+
+
+def test_a_correct_page_runs_every_block(tmp_path: Path, run_text) -> None:
+    problems, executed = run_text(PAGE)
     assert problems == []
     assert executed == 4  # the file, two python blocks, one dirac command
     assert (tmp_path / "data.txt").read_text() == "hello\n"
@@ -60,44 +72,38 @@ def test_parse_attaches_output_and_markers(tmp_path: Path) -> None:
     assert commands[0].expected == "dirac ...\n"
 
 
-def test_wrong_output_is_reported(tmp_path: Path, monkeypatch) -> None:
-    monkeypatch.chdir(tmp_path)
-    problems, _ = run_page(_write(tmp_path, PAGE.replace("\n5\n", "\n6\n")), "page.md")
+def test_wrong_output_is_reported(run_text) -> None:
+    problems, _ = run_text(PAGE.replace("\n5\n", "\n6\n"))
     assert len(problems) == 1 and "printed output differs" in problems[0]
 
 
-def test_an_error_is_reported(tmp_path: Path, monkeypatch) -> None:
-    monkeypatch.chdir(tmp_path)
-    problems, _ = run_page(_write(tmp_path, PAGE.replace("x = 2 + 3", "x = undefined_name")), "page.md")
+def test_an_error_is_reported(run_text) -> None:
+    problems, _ = run_text(PAGE.replace("x = 2 + 3", "x = undefined_name"))
     assert len(problems) == 1 and "NameError" in problems[0]
 
 
-def test_a_raises_block_that_does_not_raise_is_reported(tmp_path: Path, monkeypatch) -> None:
-    monkeypatch.chdir(tmp_path)
-    problems, _ = run_page(_write(tmp_path, PAGE.replace("1 / 0", "1 / 1")), "page.md")
+def test_a_raises_block_that_does_not_raise_is_reported(run_text) -> None:
+    problems, _ = run_text(PAGE.replace("1 / 0", "1 / 1"))
     assert len(problems) == 1 and "ran without an error" in problems[0]
 
 
-def test_a_failing_command_is_reported(tmp_path: Path, monkeypatch) -> None:
-    monkeypatch.chdir(tmp_path)
-    problems, _ = run_page(_write(tmp_path, PAGE.replace("$ dirac --version", "$ dirac no-such-command")), "page.md")
+def test_a_failing_command_is_reported(run_text) -> None:
+    problems, _ = run_text(PAGE.replace("$ dirac --version", "$ dirac no-such-command"))
     assert len(problems) == 1 and "exit status 2" in problems[0]
 
 
-def test_expected_status_and_error_line_are_checked(tmp_path: Path, monkeypatch) -> None:
+def test_expected_status_and_error_line_are_checked(run_text) -> None:
     page = "<!-- status: 2 -->\n```console\n$ dirac systems --no-such-option\nerror: ...--no-such-option...\n```\n"
-    monkeypatch.chdir(tmp_path)
-    problems, executed = run_page(_write(tmp_path, page), "page.md")
+    problems, executed = run_text(page)
     assert executed == 1 and problems == []
-    problems, _ = run_page(_write(tmp_path, page.replace("status: 2", "status: 0")), "page.md")
+    problems, _ = run_text(page.replace("status: 2", "status: 0"))
     assert len(problems) == 1 and "exit status 2" in problems[0]
 
 
-def test_a_placeholder_output_is_reported(tmp_path: Path, monkeypatch) -> None:
-    monkeypatch.chdir(tmp_path)
-    problems, _ = run_page(_write(tmp_path, PAGE.replace("\n5\n", "\n...\n")), "page.md")
+def test_a_placeholder_output_is_reported(run_text) -> None:
+    problems, _ = run_text(PAGE.replace("\n5\n", "\n...\n"))
     assert len(problems) == 1 and "only '...'" in problems[0]
-    problems, _ = run_page(_write(tmp_path, PAGE.replace("dirac ...\n", "...\n")), "page.md")
+    problems, _ = run_text(PAGE.replace("dirac ...\n", "...\n"))
     assert len(problems) == 1 and "only '...'" in problems[0]
 
 
