@@ -178,6 +178,28 @@ def _max_abs(x):
     return r
 
 
+@numba.njit(cache=True)
+def report(info, steps_done, failed, evals, residual):
+    """Fill ``info = [steps_done, failed (0/1), evaluations, last_residual]``."""
+    info[0] = steps_done
+    info[1] = 1.0 if failed else 0.0
+    info[2] = evals
+    info[3] = residual
+
+
+@numba.njit(cache=True)
+def _minv_gt(minv, G, A):
+    """``A <- M^{-1} G^T`` (n, m) for a constant ``M^{-1}``."""
+    n = minv.shape[0]
+    m = G.shape[0]
+    for i in range(n):
+        for a in range(m):
+            acc = 0.0
+            for j in range(n):
+                acc += minv[i, j] * G[a, j]
+            A[i, a] = acc
+
+
 # ---------------------------------------------------------------- RATTLE, constant mass
 @numba.njit(cache=True)
 def _project_momentum(G, W, u, p, h, m, n):
@@ -229,6 +251,8 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
     ph = np.empty(n)
     qp = np.empty(n)
     q1 = np.empty(n)
+    u = np.empty(n)
+    J = np.empty((m, m))
     evals = 0.0
     residual = 0.0
     for step in range(n_steps):
@@ -247,12 +271,7 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                 qp[i] = q[i] + h * acc
             if m > 0:
                 G0[:, :] = _jacobian(fns, q, params, m, n)
-                for i in range(n):
-                    for a in range(m):
-                        acc = 0.0
-                        for j in range(n):
-                            acc += minv[i, j] * G0[a, j]
-                        A[i, a] = acc
+                _minv_gt(minv, G0, A)
                 for a in range(m):
                     lam[a] = 0.0
                 q1[:] = qp
@@ -267,7 +286,6 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                     if residual != residual:
                         break
                     G1[:, :] = _jacobian(fns, q1, params, m, n)
-                    J = np.empty((m, m))
                     for a in range(m):
                         for b in range(m):
                             acc = 0.0
@@ -285,10 +303,7 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                 if not converged:
                     q[:] = q_save
                     p[:] = p_save
-                    info[0] = step
-                    info[1] = 1.0
-                    info[2] = evals
-                    info[3] = residual
+                    report(info, step, True, evals, residual)
                     return
                 for i in range(n):
                     acc = 0.0
@@ -304,23 +319,14 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                 p[i] = ph[i] - 0.5 * h * gv[i]
             if m > 0:
                 G1[:, :] = _jacobian(fns, q, params, m, n)
-                for i in range(n):
-                    for a in range(m):
-                        acc = 0.0
-                        for j in range(n):
-                            acc += minv[i, j] * G1[a, j]
-                        A[i, a] = acc
-                u = np.empty(n)
+                _minv_gt(minv, G1, A)
                 for j in range(n):
                     acc = 0.0
                     for i in range(n):
                         acc += minv[i, j] * p[i]
                     u[j] = acc
                 _project_momentum(G1, A, u, p, h, m, n)
-    info[0] = n_steps
-    info[1] = 0.0
-    info[2] = evals
-    info[3] = residual
+    report(info, n_steps, False, evals, residual)
 
 
 # ---------------------------------------------------------------- RATTLE, general mass
@@ -411,10 +417,7 @@ def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, 
             if not converged:
                 q[:] = q_save
                 p[:] = p_save
-                info[0] = step
-                info[1] = 1.0
-                info[2] = evals
-                info[3] = residual
+                report(info, step, True, evals, residual)
                 return
             ph = x[:n].copy()
             q[:] = x[n:2 * n]
@@ -429,10 +432,7 @@ def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, 
                 W = _solve(mm, np.ascontiguousarray(G1.T))
                 u = _solve_vec(mm, p)
                 _project_momentum(G1, W, u, p, h, m, n)
-    info[0] = n_steps
-    info[1] = 0.0
-    info[2] = evals
-    info[3] = residual
+    report(info, n_steps, False, evals, residual)
 
 
 # ---------------------------------------------------------------- Dirac vector field
@@ -604,29 +604,21 @@ def midpoint_run(kind, fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
             for i in range(N):
                 r[i] = z1[i] - z[i] - dt * fz[i]
             delta = _solve_vec(J, r)
-            size = 0.0
             scale = 1.0
             for i in range(N):
                 z1[i] -= delta[i]
-                if abs(delta[i]) > size or delta[i] != delta[i]:
-                    size = abs(delta[i]) if delta[i] == delta[i] else np.inf
                 if abs(z1[i]) > scale:
                     scale = abs(z1[i])
+            size = _max_abs(delta)
             if size <= tol * scale:
                 converged = True
                 break
             if size != size or size == np.inf:
                 break
         if not converged:
-            info[0] = step
-            info[1] = 1.0
-            info[2] = evals
-            info[3] = size
+            report(info, step, True, evals, size)
             return
         z[:] = z1
         if kind == 1:
             _project_analysed(fns, z, params, N, m, tol)
-    info[0] = n_steps
-    info[1] = 0.0
-    info[2] = evals
-    info[3] = size
+    report(info, n_steps, False, evals, size)

@@ -27,6 +27,7 @@ import math
 import numpy as np
 from numba import njit
 
+from dirac.flows.constrained_kernels import report
 from dirac.flows.lie_poisson import RigidBodyStepper
 from dirac.flows.methods import Method, Stepper, StepFailure, register_method
 from dirac.flows.rattle import ConstrainedStepper, singular_as_step_failure
@@ -102,10 +103,7 @@ def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, i
             if size != size:
                 break
         if not converged:
-            info[0] = step
-            info[1] = 1.0
-            info[2] = evals
-            info[3] = size
+            report(info, step, True, evals, size)
             return
         M[0] = 2.0 * m0 - x0
         M[1] = 2.0 * m1 - x1
@@ -138,10 +136,14 @@ def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, i
                 r2 = R[i, 2]
                 for j in range(3):
                     R[i, j] = r0 * C[0, j] + r1 * C[1, j] + r2 * C[2, j]
-    info[0] = n_steps
-    info[1] = 0.0
-    info[2] = evals
-    info[3] = size
+    report(info, n_steps, False, evals, size)
+
+
+def _raise_if_failed(info: np.ndarray, max_iter: int) -> None:
+    """The :class:`StepFailure` of a midpoint kernel whose ``info`` reports a failed step."""
+    if info[1] != 0.0:
+        raise StepFailure(f"midpoint: Newton iteration did not converge in {max_iter} iterations "
+                          f"(increment {info[3]:.3g}); reduce dt", steps_done=int(info[0]))
 
 
 class RigidBodyMidpointStepper(RigidBodyStepper):
@@ -162,10 +164,7 @@ class RigidBodyMidpointStepper(RigidBodyStepper):
             midpoint_rigid_body(self.M[b], self.R[b], self.inv_inertia, dt, n_steps, self.with_R,
                                 self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
-            if self.info[1] != 0.0:
-                raise StepFailure(
-                    f"midpoint: Newton iteration did not converge in {self.max_iter} iterations "
-                    f"(increment {self.info[3]:.3g}); reduce dt", steps_done=int(self.info[0]))
+            _raise_if_failed(self.info, self.max_iter)
         self.steps += n_steps
 
 
@@ -177,14 +176,13 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         for q in self.q:
             self.mechanics.mass_matrix(q)
         self.z = np.ascontiguousarray(np.concatenate([self.q, self.p], axis=1))
-        from dirac.flows import constrained_kernels
-
-        self._kernel = constrained_kernels.midpoint_run
-
-    def _sync(self) -> None:
+        # q and p are views of z, so the kernel's updates of z show in them
         n = self.mechanics.dimension
         self.q = self.z[:, :n]
         self.p = self.z[:, n:]
+        from dirac.flows import constrained_kernels
+
+        self._kernel = constrained_kernels.midpoint_run
 
     def warm_up(self) -> None:
         from dirac.flows.constrained_kernels import quiet
@@ -192,7 +190,6 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         n, m = self.mechanics.dimension, self.mechanics.n_constraints
         with quiet():
             self._kernel(0, self.mechanics.functions, self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
-        self._sync()
 
     def step(self, n_steps: int, dt: float) -> None:
         from dirac.flows.constrained_kernels import quiet
@@ -202,7 +199,6 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
             with quiet(), singular_as_step_failure("midpoint"):
                 self._kernel(0, self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
-            self._sync()
             self._raise_if_failed("midpoint")
         self.steps += n_steps
 
@@ -237,9 +233,7 @@ class AnalysedMidpointStepper(Stepper):
         for b in range(self.z.shape[0]):
             self._run(self.z[b], n_steps, dt)
             self.evaluations += int(self.info[2])
-            if self.info[1] != 0.0:
-                raise StepFailure(f"midpoint: Newton iteration did not converge in {self.max_iter} iterations "
-                                  f"(increment {self.info[3]:.3g}); reduce dt", steps_done=int(self.info[0]))
+            _raise_if_failed(self.info, self.max_iter)
         self.steps += n_steps
 
     def observe(self) -> dict[str, np.ndarray]:
