@@ -23,6 +23,7 @@ the bodies (the baseline of ``dirac bench``).
 
 from __future__ import annotations
 
+from functools import lru_cache
 import math
 
 import numpy as np
@@ -72,16 +73,32 @@ _C6 = -1.13596475577881948265e-11
 
 
 @njit(cache=True, inline="always")
+def _sin_poly(z):  # noqa: ANN001, ANN202 -- numba kernel
+    """``S2 + z (S3 + z (S4 + z (S5 + z S6)))`` of fdlibm ``k_sin.c`` (``z = r^2``)."""
+    return _S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))
+
+
+@njit(cache=True, inline="always")
+def _cos_poly(z):  # noqa: ANN001, ANN202 -- numba kernel
+    """``z (C1 + z (C2 + ... + z C6))`` of fdlibm ``k_cos.c`` (``z = r^2``)."""
+    return z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
+
+
+@njit(cache=True, inline="always")
+def _cos_sum(z, rest):  # noqa: ANN001, ANN202 -- numba kernel
+    """``1 - z/2 + rest`` with the compensated sum of fdlibm ``k_cos.c``."""
+    hz = 0.5 * z
+    w = 1.0 - hz
+    return w + (((1.0 - w) - hz) + rest)
+
+
+@njit(cache=True, inline="always")
 def _sincos_reduced(r):  # noqa: ANN001, ANN202 -- numba kernel
     """``(sin r, cos r)`` for ``|r| <= pi/4``: fdlibm ``k_sin.c`` / ``k_cos.c`` kernels."""
     z = r * r
     v = z * r
-    ps = _S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))
-    sr = r + v * (_S1 + z * ps)
-    pc = z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-    hz = 0.5 * z
-    w = 1.0 - hz
-    cr = w + (((1.0 - w) - hz) + z * pc)
+    sr = r + v * (_S1 + z * _sin_poly(z))
+    cr = _cos_sum(z, z * _cos_poly(z))
     return sr, cr
 
 
@@ -91,12 +108,8 @@ def _sincos_reduced_tail(x, y):  # noqa: ANN001, ANN202 -- numba kernel
     with the tail ``y`` of a double-double reduced angle)."""
     z = x * x
     v = z * x
-    ps = _S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))
-    sr = x - ((z * (0.5 * y - v * ps) - y) - v * _S1)
-    pc = z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-    hz = 0.5 * z
-    w = 1.0 - hz
-    cr = w + (((1.0 - w) - hz) + (z * pc - x * y))
+    sr = x - ((z * (0.5 * y - v * _sin_poly(z)) - y) - v * _S1)
+    cr = _cos_sum(z, z * _cos_poly(z) - x * y)
     return sr, cr
 
 
@@ -261,12 +274,34 @@ def _advance_blocks(M, R, inv, axes, fractions, dt, n_steps, with_R, trig, n_wor
                             R[b, a, col] = X[6 + 3 * a + col, i]
 
 
+@lru_cache(maxsize=64)
 def _sequence(coefficients: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Axes and step fractions of the merged composed step (inertia-independent)."""
+    """Axes and step fractions of the merged composed step (inertia-independent).
+
+    Cached: an ensemble calls the kernel once per sample with the same coefficients. The
+    arrays are shared between calls and only read.
+    """
     from dirac.rigidbody.splitting import build_sequence
 
-    axes, _, fractions, _ = build_sequence(np.ones(3), tuple(float(c) for c in coefficients), "axes")
+    axes, _, fractions, _ = build_sequence(np.ones(3), coefficients, "axes")
     return axes, fractions
+
+
+def _prepare(
+    M: np.ndarray,
+    R: np.ndarray | None,
+    inv_inertia: np.ndarray,
+    n_steps: int,
+    coefficients: tuple[float, ...],
+    with_R: bool,
+) -> tuple[np.ndarray, int, np.ndarray, np.ndarray] | None:
+    """Validate a batch call; ``(inv, n_steps, axes, fractions)``, or None if nothing moves."""
+    inv = _validate_batch(M, R, inv_inertia, with_R)
+    n_steps = int(n_steps)
+    if n_steps <= 0 or M.shape[0] == 0:
+        return None
+    axes, fractions = _sequence(tuple(float(c) for c in coefficients))
+    return inv, n_steps, axes, fractions
 
 
 def _validate_batch(
@@ -336,11 +371,10 @@ def advance_batch(
     InputError
         Wrong shapes, dtypes or non-positive inverse inertias.
     """
-    inv = _validate_batch(M, R, inv_inertia, with_R)
-    n_steps = int(n_steps)
-    if n_steps <= 0 or M.shape[0] == 0:
+    prepared = _prepare(M, R, inv_inertia, n_steps, coefficients, with_R)
+    if prepared is None:
         return
-    axes, fractions = _sequence(tuple(coefficients))
+    inv, n_steps, axes, fractions = prepared
     # largest rotation angle of any sub-step: |theta| <= max(fraction) |dt| max(1/I) |M|
     bound = (
         float(np.max(np.abs(fractions)) + np.abs(fractions[0]))
@@ -379,11 +413,10 @@ def advance_batch_numpy(
     Same arguments and result; every sub-flow is a handful of whole-array numpy
     operations over the ``B`` bodies (``np.sin``, ``np.cos`` and column updates).
     """
-    inv = _validate_batch(M, R, inv_inertia, with_R)
-    n_steps = int(n_steps)
-    if n_steps <= 0 or M.shape[0] == 0:
+    prepared = _prepare(M, R, inv_inertia, n_steps, coefficients, with_R)
+    if prepared is None:
         return
-    axes, fractions = _sequence(tuple(coefficients))
+    inv, n_steps, axes, fractions = prepared
     last = len(axes) - 1
     fd = fractions * float(dt)
     fd_join = (fractions[0] + fractions[last]) * float(dt)
