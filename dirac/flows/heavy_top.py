@@ -103,11 +103,11 @@ class ExactKickStepper(RigidBodyStepper):
         self.R[b] = R1[0]
 
     def _kick(self, b: int, tau: float) -> None:
-        gamma = self.R[b, 2]
-        self.M[b] += tau * np.cross(gamma, self.w)
+        _kick(self.M[b], self.R[b], self.w, tau)  # compiled: np.cross costs ~100x more per call
 
     def warm_up(self) -> None:
         exact_flow(self.inertia, self.M[0], self.R[0]).state(np.array([1e-3]))
+        _kick(self.M[0].copy(), self.R[0], self.w, 0.0)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):
