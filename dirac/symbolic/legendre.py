@@ -38,7 +38,8 @@ import sympy
 
 from dirac.errors import AnalysisError
 from dirac.lagrangian import Lagrangian, momentum_name, multiplier_name
-from dirac.symbolic.numeric import independent_rows
+from dirac.symbolic.algebra import tidy
+from dirac.symbolic.numeric import Numerics, independent_rows
 from dirac.symbolic.phase_space import PhaseSpace
 from dirac.symbolic.polynomial_kernel import polynomial_kernel
 
@@ -178,7 +179,7 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     S = pivots
     potential = V + sum((lam * chi for lam, chi in zip(lambdas, lagrangian.constraints)), sympy.S.Zero)
     primary: list[sympy.Expr] = list(momenta[n:])
-    singular_general = False
+    tidy_hamiltonian = True  # expand H_c over one denominator (not when that only grows it)
     method = "regular Hessian" if rank == n else ""
     if rank == n:
         W_inv = _inverse(W)
@@ -196,23 +197,22 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
                 a_samples.append(np.array(a_fn(*z, *pvals), dtype=float).reshape(A.shape))
             col_pivots = independent_rows([m.T for m in a_samples], list(range(n)))
             kernel = (
-                polynomial_kernel(A, q, parameter_values, rng, rank, holonomic=lagrangian.constraints) if len(col_pivots) == rank == A.shape[0] else None
+                polynomial_kernel(A, Numerics(space, parameter_values, seed=int(rng.integers(2**31))), rank, lagrangian.constraints)
+                if len(col_pivots) == rank == A.shape[0] else None
             )
             if kernel is not None:
-                from dirac.symbolic.algebra import tidy as _tidy
-
                 for vec in kernel.null_basis:
                     phi = sum((c * s for c, s in zip(vec, shifted)), sympy.S.Zero)
-                    primary.append(_tidy(phi, space.variables, sign=True))
+                    primary.append(tidy(phi, space.variables, sign=True))
                 m, den = kernel.momentum_solution(shifted)
-                m = m.applyfunc(lambda e: _tidy(e, space.variables))
-                den = _tidy(den, space.variables)
+                m = m.applyfunc(lambda e: tidy(e, space.variables))
+                den = tidy(den, space.variables)
                 G_inv = _inverse(G)
                 kinetic = (m.T * G_inv * m)[0, 0] / (2 * den**2)
                 H_c = kinetic + potential
                 velocity = None
                 used_forms = True
-                singular_general = True  # H_c is kept as written: expanding it over one denominator only grows it
+                tidy_hamiltonian = False
                 if kernel.unit_denominator or len(kernel.right_inverses) == 1:
                     solved = f"G l = B^T (p - a) / d with polynomial B of degree {kernel.degree[1]}, A B = d 1, d = {den}"
                     if kernel.unit_denominator:
@@ -258,8 +258,6 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
             used_forms = True
         if not used_forms:
             # fraction-free: null vectors det(W_SS) e_j - adj(W_SS) W_Sj, no rational cancellation
-            from dirac.symbolic.algebra import tidy
-
             W_SS = W[S, S]
             variables = space.variables
             adj = W_SS.adjugate(method="berkowitz").applyfunc(lambda e: tidy(e, variables))
@@ -274,10 +272,8 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
                 f"singular Hessian of rank {rank}: null space from an invertible {rank}x{rank} block of W, "
                 "fraction-free (adjugate)"
             )
-            singular_general = True
-    from dirac.symbolic.algebra import tidy
-
-    if not singular_general:
+            tidy_hamiltonian = False
+    if tidy_hamiltonian:
         H_c = tidy(H_c, space.variables)
     full_rank = rank
     return LegendreTransform(

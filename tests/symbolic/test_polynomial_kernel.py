@@ -5,9 +5,18 @@ from __future__ import annotations
 import numpy as np
 import sympy
 
+from dirac.symbolic.numeric import Numerics
+from dirac.symbolic.phase_space import PhaseSpace
 from dirac.symbolic.polynomial_kernel import polynomial_kernel
 
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
+
+
+def numerics_on(coordinates, parameter_values=None) -> Numerics:
+    """The engine's evaluator on the phase space of ``coordinates`` (momenta p_<name>)."""
+    momenta = tuple(sympy.Symbol(f"p_{c.name}", real=True) for c in coordinates)
+    parameters = tuple(parameter_values or {})
+    return Numerics(PhaseSpace(tuple(coordinates), momenta, parameters), dict(parameter_values or {}), seed=0)
 
 
 def body_velocity_map() -> sympy.Matrix:
@@ -21,7 +30,7 @@ def test_rigid_body_null_vectors_and_det_R_right_inverse():
     A = body_velocity_map()
     T = R.T * R - sympy.eye(3)
     holonomic = [T[i, j] for i in range(3) for j in range(i, 3)]
-    kernel = polynomial_kernel(A, list(R), {}, np.random.default_rng(0), 3, holonomic=holonomic)
+    kernel = polynomial_kernel(A, numerics_on(list(R)), 3, holonomic)
     assert kernel is not None and kernel.unit_denominator
     assert len(kernel.null_basis) == 6
     N = sympy.Matrix(kernel.null_basis).T
@@ -42,7 +51,7 @@ def test_rigid_body_null_vectors_and_det_R_right_inverse():
 
 def test_without_holonomic_constraints_the_cofactors_are_combined():
     A = body_velocity_map()
-    kernel = polynomial_kernel(A, list(R), {}, np.random.default_rng(0), 3)
+    kernel = polynomial_kernel(A, numerics_on(list(R)), 3)
     assert kernel is not None and not kernel.unit_denominator
     p = sympy.Matrix(9, 1, lambda i, _: sympy.Symbol(f"p{i}"))
     m, den = kernel.momentum_solution(p)
@@ -54,14 +63,14 @@ def test_without_holonomic_constraints_the_cofactors_are_combined():
 def test_non_polynomial_map_is_declined():
     x, y = sympy.symbols("x y", real=True)
     A = sympy.Matrix([[sympy.sin(x), y]])
-    assert polynomial_kernel(A, [x, y], {}, np.random.default_rng(0), 1) is None
+    assert polynomial_kernel(A, numerics_on([x, y]), 1) is None
 
 
 def test_parameters_stay_in_the_coefficient_field():
     x, y = sympy.symbols("x y", real=True)
     a = sympy.Symbol("a", positive=True)
     A = sympy.Matrix([[a * x, y]])  # null vector (y, -a x)
-    kernel = polynomial_kernel(A, [x, y], {a: 2.0}, np.random.default_rng(0), 1)
+    kernel = polynomial_kernel(A, numerics_on([x, y], {a: 2.0}), 1)
     assert kernel is not None
     (n,) = kernel.null_basis
     assert sympy.expand(A[0, 0] * n[0] + A[0, 1] * n[1]) == 0
