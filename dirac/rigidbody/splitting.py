@@ -225,6 +225,18 @@ def _turn_R(R, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
         R[row, l] = c * rl - s * rj
 
 
+@njit(cache=True, inline="always")
+def _sub_step(M, R, k, j, l, h, with_R):  # noqa: ANN001, ANN202, N803, E741, PLR0913 -- numba kernel
+    """Exact flow of ``rate M_k^2 / 2`` for ``h = fraction dt rate``: ``theta = h M_k``,
+    ``M`` turned about ``e_k`` by ``-theta`` and (``with_R``) ``R`` on the right by ``+theta``."""
+    theta = h * M[k]
+    c = math.cos(theta)
+    s = math.sin(theta)
+    _turn_M(M, j, l, c, s)
+    if with_R:
+        _turn_R(R, j, l, c, s)
+
+
 @njit(cache=True)
 def advance_sequence(M, R, axes, rates, fractions, casimir_rate, dt, n_steps, with_R):  # noqa: ANN001, N803, PLR0913
     """Advance ``(M, R)`` in place by ``n_steps`` composed steps of size ``dt``.
@@ -257,43 +269,12 @@ def advance_sequence(M, R, axes, rates, fractions, casimir_rate, dt, n_steps, wi
         m0 = R[0, 0] * M[0] + R[0, 1] * M[1] + R[0, 2] * M[2]
         m1 = R[1, 0] * M[0] + R[1, 1] * M[1] + R[1, 2] * M[2]
         m2 = R[2, 0] * M[0] + R[2, 1] * M[1] + R[2, 2] * M[2]
-    q = 0
-    k = axes[q]
-    theta = h[q] * M[k]
-    c = math.cos(theta)
-    s = math.sin(theta)
-    _turn_M(M, js[q], ls[q], c, s)
-    if with_R:
-        _turn_R(R, js[q], ls[q], c, s)
-        for step in range(n_steps):
-            for q in range(1, last):
-                k = axes[q]
-                theta = h[q] * M[k]
-                c = math.cos(theta)
-                s = math.sin(theta)
-                _turn_M(M, js[q], ls[q], c, s)
-                _turn_R(R, js[q], ls[q], c, s)
-            q = last
-            k = axes[q]
-            theta = (h_join if step < n_steps - 1 else h[last]) * M[k]
-            c = math.cos(theta)
-            s = math.sin(theta)
-            _turn_M(M, js[q], ls[q], c, s)
-            _turn_R(R, js[q], ls[q], c, s)
-    else:
-        for step in range(n_steps):
-            for q in range(1, last):
-                k = axes[q]
-                theta = h[q] * M[k]
-                c = math.cos(theta)
-                s = math.sin(theta)
-                _turn_M(M, js[q], ls[q], c, s)
-            q = last
-            k = axes[q]
-            theta = (h_join if step < n_steps - 1 else h[last]) * M[k]
-            c = math.cos(theta)
-            s = math.sin(theta)
-            _turn_M(M, js[q], ls[q], c, s)
+    _sub_step(M, R, axes[0], js[0], ls[0], h[0], with_R)
+    for step in range(n_steps):
+        for q in range(1, last):
+            _sub_step(M, R, axes[q], js[q], ls[q], h[q], with_R)
+        h_last = h_join if step < n_steps - 1 else h[last]
+        _sub_step(M, R, axes[last], js[last], ls[last], h_last, with_R)
     if with_R and casimir_rate != 0.0:
         norm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
         if norm > 0.0:
