@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dirac.errors import InputError, warn
+from dirac.rigidbody.inertia import as_float_array
 
 __all__ = [
     "Distribution",
@@ -176,17 +177,9 @@ _KEYS = {
 
 
 def _vector(table: dict, key: str, where: str, shape: tuple[int, ...] = (3,)) -> np.ndarray:
-    try:
-        value = np.array(table[key], dtype=float)
-    except KeyError:
-        raise InputError(f"{where} needs '{key}' ({shape[0]} numbers)") from None
-    except (TypeError, ValueError):
-        raise InputError(f"{where}.{key} = {table[key]!r} is not numeric; give numbers") from None
-    if value.shape != shape:
-        raise InputError(f"{where}.{key} has shape {value.shape}; give shape {shape}")
-    if not np.all(np.isfinite(value)):
-        raise InputError(f"{where}.{key} = {value.tolist()} has non-finite entries; give finite numbers")
-    return value
+    if key not in table:
+        raise InputError(f"{where} needs '{key}' ({shape[0]} numbers)")
+    return as_float_array(table[key], f"{where}.{key}", shape)
 
 
 def _positive(table: dict, key: str, where: str) -> float:

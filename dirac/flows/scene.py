@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from dirac.errors import InputError, warn
+from dirac.rigidbody.inertia import as_float_array
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "SCENE_SYSTEMS", "FLAGSHIP_SCENE"]
 
@@ -112,27 +113,8 @@ def _number(value: object, name: str, source: str, positive: bool = False) -> fl
     return float(value)
 
 
-def _has_boolean(value: object) -> bool:
-    """Whether ``value`` is or contains true/false (numpy would read them as 1.0 and 0.0)."""
-    if isinstance(value, bool):
-        return True
-    if isinstance(value, (list, tuple)):
-        return any(_has_boolean(v) for v in value)
-    return False
-
-
 def _vector(value: object, name: str, source: str, shape: tuple[int, ...]) -> np.ndarray:
-    if _has_boolean(value):
-        raise InputError(f"{source}: {name} = {value!r} contains true/false; give numbers of shape {shape}")
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{source}: {name} = {value!r} must be numbers of shape {shape}") from None
-    if array.shape != shape:
-        raise InputError(f"{source}: {name} has shape {array.shape}; it must have shape {shape}")
-    if not np.all(np.isfinite(array)):
-        raise InputError(f"{source}: {name} has non-finite entries")
-    return array
+    return as_float_array(value, name, shape, prefix=f"{source}: ")
 
 
 def load_scene(path: str | Path) -> Scene:

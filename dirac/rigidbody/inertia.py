@@ -24,17 +24,39 @@ def _has_boolean(value: object) -> bool:
     return False
 
 
-def _as_float_array(value: object, name: str, shape: tuple[int, ...]) -> np.ndarray:
+def as_float_array(value: object, name: str, shape: tuple[int, ...], prefix: str = "") -> np.ndarray:
+    """Read ``value`` as a finite float64 array of the given shape (scene and API inputs).
+
+    Parameters
+    ----------
+    value : object
+        A number, list or array; booleans are refused (``True`` would become 1.0).
+    name : str
+        How messages name the value, e.g. ``"inertia"`` or ``"[initial] M"``.
+    shape : tuple of int
+        Required shape.
+    prefix : str
+        Prepended to every message (e.g. ``"scene.toml: "``).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    InputError
+        Booleans, non-numeric entries, wrong shape or non-finite entries.
+    """
     if _has_boolean(value):
-        raise InputError(f"{name} = {value!r} contains true/false; give {shape} real numbers")
+        raise InputError(f"{prefix}{name} = {value!r} contains true/false; give {shape} real numbers")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} = {value!r} is not numeric; give {shape} real numbers") from exc
+        raise InputError(f"{prefix}{name} = {value!r} is not numeric; give {shape} real numbers") from exc
     if array.shape != shape:
-        raise InputError(f"{name} has shape {array.shape}; it must have shape {shape}")
+        raise InputError(f"{prefix}{name} has shape {array.shape}; it must have shape {shape}")
     if not np.all(np.isfinite(array)):
-        raise InputError(f"{name} = {array.tolist()} has non-finite entries; give finite numbers")
+        raise InputError(f"{prefix}{name} = {array.tolist()} has non-finite entries; give finite numbers")
     return array
 
 
@@ -62,7 +84,7 @@ def validate_inertia(inertia: object) -> np.ndarray:
     InputError
         Wrong shape, non-finite or non-positive entries.
     """
-    moments = _as_float_array(inertia, "inertia", (3,))
+    moments = as_float_array(inertia, "inertia", (3,))
     if np.any(moments <= 0.0):
         raise InputError(
             f"inertia = {moments.tolist()} has a non-positive moment; every principal "
@@ -107,7 +129,7 @@ def validate_rotation(rotation: object, tol: float = 1e-10) -> np.ndarray:
     InputError
         Wrong shape, non-finite entries, not orthogonal, or left-handed (``det R = -1``).
     """
-    matrix = _as_float_array(rotation, "R", (3, 3))
+    matrix = as_float_array(rotation, "R", (3, 3))
     defect = float(np.max(np.abs(matrix.T @ matrix - np.eye(3))))
     if defect > tol:
         raise InputError(
@@ -146,7 +168,7 @@ def validate_momentum(momentum: object) -> np.ndarray:
         Wrong shape, non-finite entries, or so large that ``|M|^2`` overflows (then no
         invariant of (247)-(249) can be evaluated).
     """
-    array = _as_float_array(momentum, "M", (3,))
+    array = as_float_array(momentum, "M", (3,))
     with np.errstate(over="ignore"):
         square = float(array @ array)
     if not np.isfinite(square):
