@@ -34,6 +34,7 @@ __all__ = [
     "constraint_index_pairs",
     "inertia_symbols",
     "surface_point",
+    "phase_point",
     "multipliers_221",
 ]
 
@@ -217,7 +218,16 @@ def surface_point(rotation: np.ndarray, angular_velocity: np.ndarray, inertia: n
     omega = np.asarray(angular_velocity, dtype=float)
     g = np.array(check_inertia(*(float(v) for v in inertia)))
     p = R @ _hat(omega) @ np.diag(g)
-    lam = multipliers_221(omega, inertia)
+    return phase_point(R, p, multipliers_221(omega, inertia), inertia)
+
+
+def phase_point(R: np.ndarray, p: np.ndarray, lam: np.ndarray, inertia) -> dict[str, float]:  # noqa: ANN001, N803
+    """Name -> value of a phase-space point of the rigid-body Lagrangians (78) and (228).
+
+    ``R``, its momentum ``p`` and the symmetric multipliers ``lam`` (3x3, stored as
+    ``lambda_1 … lambda_6`` in the order of ``_PAIRS``); ``pi = 0``; the moments
+    ``I_1, I_2, I_3`` are included.
+    """
     point = {f"R_{i + 1}{j + 1}": R[i, j] for i in range(3) for j in range(3)}
     point.update({f"p_R_{i + 1}{j + 1}": p[i, j] for i in range(3) for j in range(3)})
     for k, (i, j) in enumerate(_PAIRS, start=1):

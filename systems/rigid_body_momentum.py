@@ -21,12 +21,12 @@ import sympy
 from dirac.errors import InputError, warn
 from dirac.lagrangian import Lagrangian
 from dirac_systems.rigid_body_matrix import (
-    _PAIRS,
     DEFAULT_INERTIA,
     _hat,
     inertia_symbols,
     mass_matrix_from_inertia,
     orthogonality_constraints,
+    phase_point,
     rotation_symbols,
 )
 
@@ -135,11 +135,4 @@ def surface_point(rotation: np.ndarray, angular_velocity: np.ndarray, inertia: n
     inertia = np.asarray(inertia, dtype=float)
     M = inertia * np.asarray(angular_velocity, dtype=float)
     p = 0.5 * R @ _hat(M)
-    lam = multipliers_on_surface(M, inertia)
-    point = {f"R_{i + 1}{j + 1}": R[i, j] for i in range(3) for j in range(3)}
-    point.update({f"p_R_{i + 1}{j + 1}": p[i, j] for i in range(3) for j in range(3)})
-    for k, (i, j) in enumerate(_PAIRS, start=1):
-        point[f"lambda_{k}"] = lam[i - 1, j - 1]
-        point[f"p_lambda_{k}"] = 0.0
-    point.update({f"I_{k + 1}": float(inertia[k]) for k in range(3)})
-    return {name: float(value) for name, value in point.items()}
+    return phase_point(R, p, multipliers_on_surface(M, inertia), inertia)
