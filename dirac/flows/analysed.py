@@ -96,12 +96,9 @@ class AnalysedSystem:
         )
 
     def _call(self, name: str, z: np.ndarray, size: int) -> np.ndarray:
-        from dirac.flows.constrained_kernels import evaluate, quiet
+        from dirac.flows.constrained_kernels import call
 
-        out = np.empty(size)
-        with quiet():
-            evaluate(getattr(self.module, name), np.ascontiguousarray(z, dtype=float), self.params, out)
-        return out
+        return call(getattr(self.module, name), z, self.params, size)
 
     def energy(self, z: np.ndarray) -> float:
         """``H_c(z)``."""

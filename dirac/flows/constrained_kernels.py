@@ -56,6 +56,14 @@ def evaluate(f, x, params, out):
     f(x, params, out)
 
 
+def call(f: object, x: np.ndarray, params: np.ndarray, size: int) -> np.ndarray:
+    """``f(x, params, out)`` from Python with a fresh flat ``out`` of ``size`` entries, returned."""
+    out = np.empty(size)
+    with quiet():
+        evaluate(f, np.ascontiguousarray(x, dtype=float), params, out)
+    return out
+
+
 @numba.njit(cache=True)
 def _mass(fns, q, params, n):
     out = np.empty(n * n)

@@ -150,10 +150,7 @@ class MechanicalSystem:
         functions_tuple = tuple(getattr(module, name) for name in constrained_kernels.FUNCTION_NAMES)
         constant_mass = None
         if constant:
-            flat = np.empty(n * n)
-            with constrained_kernels.quiet():
-                constrained_kernels.evaluate(module.mass, np.zeros(n), param_array, flat)
-            constant_mass = flat.reshape(n, n)
+            constant_mass = constrained_kernels.call(module.mass, np.zeros(n), param_array, n * n).reshape(n, n)
         system = cls(
             name=lagrangian.name,
             coordinate_names=tuple(s.name for s in q),
@@ -171,12 +168,9 @@ class MechanicalSystem:
 
     # ------------------------------------------------------------------ numerics (numpy side)
     def _call(self, name: str, q: np.ndarray, size: int) -> np.ndarray:
-        from dirac.flows.constrained_kernels import evaluate, quiet
+        from dirac.flows.constrained_kernels import call
 
-        out = np.empty(size)
-        with quiet():
-            evaluate(getattr(self.module, name), np.ascontiguousarray(q, dtype=float), self.params, out)
-        return out
+        return call(getattr(self.module, name), q, self.params, size)
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """``M(q)``, checked to be symmetric positive definite."""
