@@ -9,9 +9,6 @@ Heavy dependencies (sympy, numba, scipy) load on first use of the names that nee
 
 from __future__ import annotations
 
-from importlib import import_module
-from typing import Any
-
 from dirac.errors import (
     AnalysisError,
     DiracError,
@@ -20,6 +17,7 @@ from dirac.errors import (
     InputError,
     IntegrationError,
 )
+from dirac.lazy_exports import lazy_exports
 
 __all__ = [
     "DiracError",
@@ -59,14 +57,4 @@ _LAZY: dict[str, str] = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'dirac' has no attribute {name!r}")
-    value = getattr(import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_exports("dirac", globals(), _LAZY)
