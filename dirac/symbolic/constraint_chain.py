@@ -131,7 +131,7 @@ class ConstraintChain:
             constraints = self.constraints
             if not constraints:
                 break
-            b_num, A_num = self._numeric_rows(constraints, points)
+            _, A_num = self._numeric_rows(constraints, points)
             exprs_b = [self._rows(c)[0] for c in constraints]
             b_zero = self.numerics.weakly_zero(exprs_b, points)
             a_row_zero = np.all(np.abs(A_num) <= 1e-9 * (1 + np.max(np.abs(A_num), axis=(1, 2), keepdims=True)), axis=(0, 2)) if K else np.ones(len(constraints), bool)
@@ -140,18 +140,19 @@ class ConstraintChain:
             pivots_rows = independent_rows(list(A_num), order) if K else []
             pivot_cols = independent_rows([m[pivots_rows].T for m in A_num], list(range(K))) if pivots_rows else []
             direct: list[sympy.Expr] = []
-            deferred: list[int] = []
+            deferred: list[tuple[int, list[int]]] = []  # (row, pivot positions it must be reduced by)
             for i, c in enumerate(constraints):
                 if i in pivots_rows or (b_zero[i] and a_row_zero[i]):
                     continue
-                if a_row_zero[i] or not self._needed(i, pivots_rows, pivot_cols, A_num, b_zero):
-                    direct.append(exprs_b[i])
+                needed = [] if a_row_zero[i] else self._needed(i, pivots_rows, pivot_cols, A_num, b_zero)
+                if needed:
+                    deferred.append((i, needed))
                 else:
-                    deferred.append(i)
+                    direct.append(exprs_b[i])
             candidates, chosen = self._settle(self._nonzero(direct, points), constraints, limit) if direct else ([], [])
             if not chosen and deferred:
                 # nothing new without them: build the conditions that need multipliers eliminated
-                eliminated = [self._eliminate(i, constraints, pivots_rows, pivot_cols, b_num, A_num, b_zero, points) for i in deferred]
+                eliminated = [self._eliminate(i, needed, constraints, pivots_rows, pivot_cols, A_num) for i, needed in deferred]
                 candidates, chosen = self._settle(self._nonzero(eliminated, points), constraints, limit)
             elif deferred:
                 self.notes.append(
@@ -215,12 +216,9 @@ class ConstraintChain:
             base = None
         return independent_rows(list(cand), list(range(len(candidates))), base=base)
 
-    def _eliminate(self, row, constraints, P, Q, b_num, A_num, b_zero, points):
-        """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows."""
-        needed = self._needed(row, P, Q, A_num, b_zero)
+    def _eliminate(self, row, needed, constraints, P, Q, A_num):
+        """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows ``needed``."""
         b_row = self._rows(constraints[row])[0]
-        if not needed:
-            return b_row
         A_sym = sympy.Matrix([[self._rows(constraints[p])[1][k] for k in Q] for p in P])
         rhs = sympy.Matrix([self._rows(constraints[row])[1][k] for k in Q])
         c = weak_solve(A_sym.T, rhs, [A[np.ix_(P, Q)].T for A in A_num], [A[row, Q].reshape(-1, 1) for A in A_num], variables=self.phase_space.variables)
