@@ -251,8 +251,10 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
     q_save = q.copy()
     p_save = p.copy()
     gv = np.empty(n)
-    G0 = np.zeros((m, n))
-    G1 = np.zeros((m, n))
+    G0_flat = np.zeros(m * n)  # the generated Jacobian writes here; G0, G1 are (m, n) views
+    G1_flat = np.zeros(m * n)
+    G0 = G0_flat.reshape((m, n))
+    G1 = G1_flat.reshape((m, n))
     chi = np.zeros(m)
     A = np.zeros((n, m))
     lam = np.zeros(m)
@@ -278,7 +280,7 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                     acc += minv[i, j] * ph[j]
                 qp[i] = q[i] + h * acc
             if m > 0:
-                G0[:, :] = _jacobian(fns, q, params, m, n)
+                fns[CONSTRAINT_JACOBIAN](q, params, G0_flat)
                 _minv_gt(minv, G0, A)
                 for a in range(m):
                     lam[a] = 0.0
@@ -293,7 +295,7 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                         break
                     if residual != residual:
                         break
-                    G1[:, :] = _jacobian(fns, q1, params, m, n)
+                    fns[CONSTRAINT_JACOBIAN](q1, params, G1_flat)
                     for a in range(m):
                         for b in range(m):
                             acc = 0.0
@@ -326,7 +328,7 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
             for i in range(n):
                 p[i] = ph[i] - 0.5 * h * gv[i]
             if m > 0:
-                G1[:, :] = _jacobian(fns, q, params, m, n)
+                fns[CONSTRAINT_JACOBIAN](q, params, G1_flat)
                 _minv_gt(minv, G1, A)
                 for j in range(n):
                     acc = 0.0

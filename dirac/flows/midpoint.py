@@ -64,6 +64,8 @@ def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, i
     size = 0.0
     J = np.empty((3, 3))
     r = np.empty(3)
+    B = np.zeros((3, 3))  # hat(b): only the off-diagonal entries are set, per step
+    C = np.empty((3, 3))
     for step in range(n_steps):
         x0 = M[0]
         x1 = M[1]
@@ -116,14 +118,12 @@ def midpoint_rigid_body(M, R, inv_inertia, dt, n_steps, with_R, tol, max_iter, i
             # (1 - B)^{-1} = (1 + B + b b^T) / (1 + |b|^2)   for skew B = hat(b)
             nb = 1.0 + b0 * b0 + b1 * b1 + b2 * b2
             # Cayley: cay = 1 + 2 (B + B^2) / (1 + |b|^2)
-            B = np.zeros((3, 3))
             B[0, 1] = -b2
             B[0, 2] = b1
             B[1, 0] = b2
             B[1, 2] = -b0
             B[2, 0] = -b1
             B[2, 1] = b0
-            C = np.zeros((3, 3))
             for i in range(3):
                 for j in range(3):
                     acc = 0.0
