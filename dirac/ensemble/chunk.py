@@ -12,7 +12,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from dirac.ensemble.reductions import make_reductions
+from dirac.ensemble.reductions import casimir_of, energy_of, make_reductions
 from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
 
 __all__ = ["advance_members", "compute_chunk", "warm_up", "KERNEL_LOCK"]
@@ -111,9 +111,9 @@ def compute_chunk(
             elif name == "R":
                 array[:, k] = R
             elif name == "energy":
-                array[:, k] = 0.5 * np.einsum("ij,ij->i", M * inv, M)
+                array[:, k] = energy_of(M, inv)
             elif name == "casimir":
-                array[:, k] = np.einsum("ij,ij->i", M, M)
+                array[:, k] = casimir_of(M)
             elif name == "lab_momentum":
                 array[:, k] = np.einsum("nij,nj->ni", R, M)
 

@@ -26,6 +26,16 @@ import numpy as np
 __all__ = ["Reduction", "make_reductions", "reduction_arrays"]
 
 
+def energy_of(M: np.ndarray, inv_inertia: np.ndarray) -> np.ndarray:  # noqa: N803
+    """``H_0 = sum_i M_i^2 / (2 I_i)`` (247) of each member (rows of ``M``)."""
+    return 0.5 * np.einsum("ij,ij->i", M * inv_inertia, M)
+
+
+def casimir_of(M: np.ndarray) -> np.ndarray:  # noqa: N803
+    """``|M|^2``, the Casimir (248), of each member (rows of ``M``)."""
+    return np.einsum("ij,ij->i", M, M)
+
+
 def reduction_arrays(name: str) -> dict[str, tuple[int, ...]]:
     """The arrays a reduction stores: array name -> shape of one member's entry."""
     return {
@@ -90,8 +100,8 @@ class MaxRelativeError(Reduction):
 
     def _value(self, M: np.ndarray) -> np.ndarray:  # noqa: N803
         if self.name == "max_energy_error":
-            return 0.5 * np.einsum("ij,ij->i", M * self.inv, M)
-        return np.einsum("ij,ij->i", M, M)
+            return energy_of(M, self.inv)
+        return casimir_of(M)
 
     def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
         self.inv = 1.0 / inertia
