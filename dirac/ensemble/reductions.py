@@ -27,7 +27,11 @@ __all__ = ["Reduction", "make_reductions", "reduction_arrays"]
 
 
 def energy_of(M: np.ndarray, inv_inertia: np.ndarray) -> np.ndarray:  # noqa: N803
-    """``H_0 = sum_i M_i^2 / (2 I_i)`` (247) of each member (rows of ``M``)."""
+    """``H_0 = sum_i M_i^2 / (2 I_i)`` (247) of each member (rows of ``M``).
+
+    The row-wise form of :func:`dirac.rigidbody.euler_poisson.energy` with the members'
+    ``1/I`` precomputed; kept separate so stored ensemble arrays keep their bits.
+    """
     return 0.5 * np.einsum("ij,ij->i", M * inv_inertia, M)
 
 
