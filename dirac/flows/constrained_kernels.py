@@ -341,7 +341,9 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
 
 # ---------------------------------------------------------------- RATTLE, general mass
 @numba.njit(cache=True)
-def _rattle_residual(fns, x, q, p, h, params, n, m, r):
+def _rattle_residual(fns, x, q, p, G0, h, params, n, m, r):
+    """Residual of RATTLE's implicit stage at ``x = (p_half, q1, lam)``; ``G0 = G(q)``
+    is fixed over the sub-step and passed in."""
     ph = x[:n].copy()
     q1 = x[n:2 * n].copy()
     v0 = np.empty(n)
@@ -349,7 +351,6 @@ def _rattle_residual(fns, x, q, p, h, params, n, m, r):
     v1 = np.empty(n)
     _velocity(fns, q, ph, params, v0)
     _force(fns, q, v0, params, f0)
-    G0 = _jacobian(fns, q, params, m, n)
     for i in range(n):
         acc = 0.0
         for a in range(m):
@@ -401,13 +402,14 @@ def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, 
                 x[n + i] = q[i] + h * v[i]
             for a in range(m):
                 x[2 * n + a] = 0.0
-            _rattle_residual(fns, x, q, p, h, params, n, m, r)
+            G0 = _jacobian(fns, q, params, m, n)
+            _rattle_residual(fns, x, q, p, G0, h, params, n, m, r)
             evals += 1.0
             for j in range(N):
                 xx[:] = x
                 d = 1e-7 * (1.0 + abs(x[j]))
                 xx[j] += d
-                _rattle_residual(fns, xx, q, p, h, params, n, m, rr)
+                _rattle_residual(fns, xx, q, p, G0, h, params, n, m, rr)
                 for i in range(N):
                     J[i, j] = (rr[i] - r[i]) / d
             evals += N
@@ -416,7 +418,7 @@ def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, 
                 delta = _solve_vec(J, r)
                 for i in range(N):
                     x[i] -= delta[i]
-                _rattle_residual(fns, x, q, p, h, params, n, m, r)
+                _rattle_residual(fns, x, q, p, G0, h, params, n, m, r)
                 evals += 1.0
                 residual = _max_abs(r)
                 if residual <= tol * _scale(x[:2 * n]):
