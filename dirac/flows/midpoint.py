@@ -30,7 +30,7 @@ from numba import njit
 from dirac.flows.constrained_kernels import report
 from dirac.flows.lie_poisson import RigidBodyStepper
 from dirac.flows.methods import Method, Stepper, StepFailure, register_method
-from dirac.flows.rattle import ConstrainedStepper, singular_as_step_failure
+from dirac.flows.rattle import ConstrainedStepper, newton_options, singular_as_step_failure
 
 __all__ = ["midpoint_rigid_body"]
 
@@ -151,9 +151,7 @@ class RigidBodyMidpointStepper(RigidBodyStepper):
 
     def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
         super().__init__(problem, outputs)
-        self.tol = float(options.get("newton_tolerance", 1e-12))
-        self.max_iter = int(options.get("max_newton_iterations", 50))
-        self.info = np.zeros(4)
+        self.tol, self.max_iter, self.info = newton_options(options)
 
     def warm_up(self) -> None:
         midpoint_rigid_body(self.M[0].copy(), self.R[0].copy(), self.inv_inertia, 1e-3, 1, self.with_R,
@@ -214,9 +212,7 @@ class AnalysedMidpointStepper(Stepper):
         self.analysed = problem.analysed
         self.outputs = outputs
         self.z = np.ascontiguousarray(problem.z0, dtype=float).copy()
-        self.tol = float(options.get("newton_tolerance", 1e-12))
-        self.max_iter = int(options.get("max_newton_iterations", 50))
-        self.info = np.zeros(4)
+        self.tol, self.max_iter, self.info = newton_options(options)
         self._kernel = constrained_kernels.midpoint_run
 
     def _run(self, z: np.ndarray, n_steps: int, dt: float) -> None:

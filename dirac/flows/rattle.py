@@ -24,6 +24,12 @@ from dirac.flows.methods import Method, Stepper, StepFailure, register_method
 __all__ = ["ConstrainedStepper", "RattleStepper"]
 
 
+def newton_options(options: dict) -> tuple[float, int, np.ndarray]:
+    """``(tol, max_iter, info)`` of a stepper with a Newton iteration: the run's
+    ``newton_tolerance`` and ``max_newton_iterations`` and the ``info`` buffer its kernel fills."""
+    return float(options.get("newton_tolerance", 1e-12)), int(options.get("max_newton_iterations", 50)), np.zeros(4)
+
+
 class ConstrainedStepper(Stepper):
     """Common state ``(q, p)`` (batched) and outputs of steppers of constrained systems."""
 
@@ -34,9 +40,7 @@ class ConstrainedStepper(Stepper):
         self.outputs = outputs
         self.q = np.ascontiguousarray(problem.q0, dtype=float).copy()
         self.p = np.ascontiguousarray(problem.p0, dtype=float).copy()
-        self.tol = float(options.get("newton_tolerance", 1e-12))
-        self.max_iter = int(options.get("max_newton_iterations", 50))
-        self.info = np.zeros(4)
+        self.tol, self.max_iter, self.info = newton_options(options)
 
     def observe(self) -> dict[str, np.ndarray]:
         return constrained_outputs(self.mechanics, self.outputs, self.q, self.p)
