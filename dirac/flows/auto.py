@@ -66,8 +66,10 @@ def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) 
     return _state(stepper)
 
 
-def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float, options) -> float:  # noqa: ANN001
-    """``dt0`` halved until a pilot of 64 steps runs without a failed step.
+def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float,  # noqa: ANN001
+                  options) -> tuple[float, np.ndarray]:  # noqa: ANN001
+    """``dt0`` halved until a pilot of 64 steps runs without a failed step: that step and
+    the pilot's final state (the coarse run of the Richardson estimate).
 
     A first guess such as ``t_end / 1000`` can be far beyond the system's own time scale
     (a pendulum run to ``t = 1000``), where RATTLE's Newton iteration cannot converge.
@@ -79,8 +81,7 @@ def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float, 
     for _ in range(60):
         try:
             span = min(t_end, 64 * dt)
-            _pilot(method_name, problem, outputs, span, dt, options)
-            return dt
+            return dt, _pilot(method_name, problem, outputs, span, dt, options)
         except StepFailure:
             dt /= 2
     raise InputError(f"method auto: {method_name} fails even with dt = {dt:.3g}; choose a method and dt in [run]")
@@ -114,9 +115,8 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
     best_cost = math.inf
     for name in candidates:
         method = get_method(name)
-        dt0 = _working_step(name, problem, outputs, dt0, t_end, options)
+        dt0, coarse = _working_step(name, problem, outputs, dt0, t_end, options)
         span = min(t_end, 64 * dt0)
-        coarse = _pilot(name, problem, outputs, span, dt0, options)
         fine = _pilot(name, problem, outputs, span, dt0 / 2, options)
         error = float(np.max(np.abs(coarse - fine))) / (1.0 - 2.0 ** (-method.order))
         growth = t_end / span
