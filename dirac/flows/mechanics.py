@@ -237,6 +237,7 @@ class MechanicalSystem:
                 f"(residual {np.max(np.abs(chi)):.3g}): give q closer to the surface"
             )
         G = self._call("constraint_jacobian", q, m * self.dimension).reshape(shape)
-        A = np.linalg.solve(self.mass_matrix(q), G.T)
-        p = p - G.T @ np.linalg.solve(G @ A, G @ np.linalg.solve(self.mass_matrix(q), p))
+        mass = self.mass_matrix(q)
+        A = np.linalg.solve(mass, G.T)
+        p = p - G.T @ np.linalg.solve(G @ A, G @ np.linalg.solve(mass, p))
         return q, p
