@@ -333,7 +333,8 @@ class _Loop:
         from tqdm import tqdm
 
         kind = self.stepper.kind
-        total = self._total_steps() if kind == "fixed" else len(self.times)
+        intervals = self._intervals() if kind == "fixed" else []
+        total = sum(n for _, _, n in intervals) if kind == "fixed" else len(self.times)
         bar = tqdm(total=total, disable=not self.progress, unit=("step" if kind == "fixed" else "sample"),
                    file=sys.stderr, leave=False, dynamic_ncols=True, desc=self.method.name)
         start = time.process_time()
@@ -341,7 +342,7 @@ class _Loop:
             if kind == "exact":
                 self._run_exact(bar)
             elif kind == "fixed":
-                self._run_fixed(bar)
+                self._run_fixed(bar, intervals)
             else:
                 self._run_adaptive(bar)
         except _Stop as stop:
@@ -361,7 +362,8 @@ class _Loop:
         return self._solution(True)
 
     def _intervals(self) -> list[tuple[float, float, int]]:
-        """(start, end, steps) of each sampling interval (one for ``samples = 1``)."""
+        """(start, end, steps) of each sampling interval (one for ``samples = 1``); sets
+        ``self.dt`` to the step that divides the spacing."""
         starts = np.concatenate([[0.0], self.times[:-1]]) if self.times[0] != 0.0 else self.times[:-1]
         ends = self.times if self.times[0] != 0.0 else self.times[1:]
         spacing = float(ends[0] - starts[0])
@@ -369,11 +371,7 @@ class _Loop:
         self.dt = spacing / per_interval
         return [(float(a), float(b), per_interval) for a, b in zip(starts, ends)]
 
-    def _total_steps(self) -> int:
-        return sum(n for _, _, n in self._intervals())
-
-    def _run_fixed(self, bar) -> None:  # noqa: ANN001
-        intervals = self._intervals()
+    def _run_fixed(self, bar, intervals: list[tuple[float, float, int]]) -> None:  # noqa: ANN001
         if self.times[0] == 0.0:
             self._keep(0, self.stepper.observe())
         first = 1 if self.times[0] == 0.0 else 0
