@@ -37,7 +37,6 @@ from fractions import Fraction
 
 import numpy as np
 import sympy
-from scipy.optimize import linprog
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 from sympy.polys.rings import PolyRing
@@ -290,6 +289,8 @@ def _unit_denominator(
     ``points``; the coefficients are made rational and the constancy is checked again at
     the fresh points ``check``. ``None`` when there is no such combination.
     """
+    from scipy.optimize import linprog  # scipy.optimize costs ~0.3 s to import: only when needed
+
     m = len(solutions)
     if not m:
         return None
