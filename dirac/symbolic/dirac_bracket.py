@@ -127,28 +127,20 @@ class DiracBracket:
             values may be given too (else their defaults are used).
         """
         f, g = self._sympify(f), self._sympify(g)
-        key = (f, g)
-        entry = self._compiled.get(key)
-        if entry is None:
-            pb = self.space.poisson_bracket
-            exprs = [pb(f, g)] + [pb(f, c) for c in self.constraints] + [pb(c, g) for c in self.constraints]
-            needed = set().union(*[e.free_symbols for e in exprs]) if exprs else set()
-            fn = compile_expressions(self._args, exprs)
-            entry = (fn, needed)
-            self._compiled[key] = entry
-        fn, needed = entry
-        if "C" not in self._compiled:
-            self._compiled["C"] = (
-                compile_expressions(self._args, list(self.C)),
-                set().union(*[e.free_symbols for e in self.C]) if self.C.shape[0] else set(),
-            )
-        c_fn, c_needed = self._compiled["C"]
-        args = self._arguments(point, needed | c_needed)
-        values = np.asarray(fn(*args), dtype=float)
+        pb = self.space.poisson_bracket
+        plain_fn, plain_needed = self._compiled_once(("plain", f, g), lambda: [pb(f, g)])
+        # {f, Phi_a} is compiled once per function and reused for every partner:
+        # {Phi_a, g} = -{g, Phi_a}
+        f_fn, f_needed = self._compiled_once(("row", f), lambda: [pb(f, c) for c in self.constraints])
+        g_fn, g_needed = self._compiled_once(("row", g), lambda: [pb(g, c) for c in self.constraints])
+        c_fn, c_needed = self._compiled_once("C", lambda: list(self.C))
+        args = self._arguments(point, plain_needed | f_needed | g_needed | c_needed)
+        plain = float(np.asarray(plain_fn(*args), dtype=float)[0])
         m = len(self.constraints)
-        plain, alpha, beta = values[0], values[1 : 1 + m], values[1 + m :]
         if m == 0:
-            return float(plain)
+            return plain
+        alpha = np.asarray(f_fn(*args), dtype=float)
+        beta = -np.asarray(g_fn(*args), dtype=float)
         C = np.asarray(c_fn(*args), dtype=float).reshape(m, m)
         try:
             x = np.linalg.solve(C, beta)
@@ -158,6 +150,16 @@ class DiracBracket:
                 "is not defined there (use a point on the constraint surface, e.g. from surface_point())"
             ) from None
         return float(plain - alpha @ x)
+
+    def _compiled_once(self, key: object, build) -> tuple:  # noqa: ANN001
+        """``(compiled function, free symbols)`` of the expressions ``build()``, compiled on first use."""
+        entry = self._compiled.get(key)
+        if entry is None:
+            exprs = build()
+            needed = set().union(*[e.free_symbols for e in exprs]) if exprs else set()
+            entry = (compile_expressions(self._args, exprs) if exprs else (lambda *a: []), needed)
+            self._compiled[key] = entry
+        return entry
 
     def _sympify(self, f: object) -> sympy.Expr:
         if isinstance(f, str):
