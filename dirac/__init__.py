@@ -42,18 +42,18 @@ __all__ = [
 
 #: public name -> module that defines it (imported on first access)
 _LAZY: dict[str, str] = {
-    "Lagrangian": "dirac.lagrangian",
-    "load_system": "dirac.registry",
-    "builtin_systems": "dirac.registry",
-    "analyze": "dirac.symbolic.analysis",
+    "Lagrangian": "dirac.model.lagrangian",
+    "load_system": "dirac.model.systems",
+    "builtin_systems": "dirac.model.systems",
+    "analyze": "dirac.analysis.constraint_analysis",
     "integrate": "dirac.flows.integration",
-    "RigidBodyProblem": "dirac.flows.problem",
-    "HeavyTopProblem": "dirac.flows.problem",
-    "ConstrainedProblem": "dirac.flows.problem",
+    "RigidBodyProblem": "dirac.flows.problems",
+    "HeavyTopProblem": "dirac.flows.problems",
+    "ConstrainedProblem": "dirac.flows.problems",
     "Solution": "dirac.flows.solution",
-    "load_scene": "dirac.flows.scene",
-    "write_results": "dirac.flows.results",
-    "read_results": "dirac.flows.results",
+    "load_scene": "dirac.io.scene",
+    "write_results": "dirac.io.results",
+    "read_results": "dirac.io.results",
 }
 
 

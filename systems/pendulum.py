@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 
 
 def system() -> Lagrangian:

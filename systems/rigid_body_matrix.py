@@ -10,8 +10,8 @@ permutation of ``(1, 2, 3)``. ``R`` is first an arbitrary 3x3 matrix; the six co
 The module also holds the pieces shared with :mod:`dirac_systems.rigid_body_momentum`:
 the rotation-matrix symbols, the six constraints, the inertia check (the mass matrix
 ``g`` must be positive: PHYSICS.md §2), which the factories pass to
-:class:`~dirac.lagrangian.Lagrangian` as its ``validator`` so that it runs whenever
-:meth:`~dirac.lagrangian.Lagrangian.fix` makes the moments numbers.
+:class:`~dirac.model.lagrangian.Lagrangian` as its ``validator`` so that it runs whenever
+:meth:`~dirac.model.lagrangian.Lagrangian.fix` makes the moments numbers.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import InputError
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 
 __all__ = [
     "system",

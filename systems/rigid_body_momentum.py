@@ -19,7 +19,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import InputError, warn
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 from dirac_systems.rigid_body_matrix import (
     DEFAULT_INERTIA,
     _hat,

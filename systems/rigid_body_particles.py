@@ -22,7 +22,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import InputError
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["system", "body_data", "RigidBodyData", "DEFAULT_MASSES", "DEFAULT_POSITIONS"]
 

@@ -18,7 +18,7 @@ def test_every_package_folder_is_listed_in_pyproject():
 
 
 def test_every_builtin_entry_point_has_a_module_and_description():
-    from dirac.registry import builtin_systems
+    from dirac.model.systems import builtin_systems
 
     systems = builtin_systems()
     assert "pendulum" in systems

@@ -224,7 +224,7 @@ def long_run(method: str, steps: int, dt: float, samples: int = 1001) -> dict:
     ``max |R^T R - 1|`` over the samples; both must stay within ``2e-12``.
     """
     from dirac.flows.integration import integrate
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     problem = _quiet_problem(lambda: RigidBodyProblem(STANDARD_INERTIA, STANDARD_M0))
     start = time.perf_counter()
@@ -313,7 +313,7 @@ def _method_error(body: HardBody, method: str, times: np.ndarray, M_ref: np.ndar
                   step_radians: float) -> dict:
     from dirac.errors import IntegrationError
     from dirac.flows.integration import integrate
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     problem = _quiet_problem(lambda: RigidBodyProblem(body.inertia, body.M0))
     outputs = ["M", "R"] if R_ref is not None else ["M"]
@@ -375,7 +375,7 @@ def hard_body_rows(body: HardBody, methods: Sequence[str] = HARD_BODY_METHODS, s
 def _constrained_problem(system: str):  # noqa: ANN202
     import dirac
     from dirac.flows.mechanics import MechanicalSystem
-    from dirac.flows.problem import ConstrainedProblem
+    from dirac.flows.problems import ConstrainedProblem
 
     mechanics = MechanicalSystem.from_lagrangian(dirac.load_system(system))
     if system == "pendulum":

@@ -155,7 +155,7 @@ def run_rigid_body_case(case: RigidBodyCase, repeats: int, progress: Progress) -
 
 def _constrained_problem(case: ConstrainedCase):  # noqa: ANN202
     from dirac.flows import ConstrainedProblem, MechanicalSystem
-    from dirac.registry import load_system
+    from dirac.model.systems import load_system
 
     mechanics = MechanicalSystem.from_lagrangian(load_system(case.system))
     params = mechanics.parameter_values

@@ -2,7 +2,7 @@
 
 Text by default (stage by stage, with counts), ``--json`` (CONTRACTS §4) or ``--latex``.
 ``--param NAME=VALUE`` fixes parameters (the others stay symbolic); ``--compare SPEC``
-compares the result with a reference (see :mod:`dirac.symbolic.compare`).
+compares the result with a reference (see :mod:`dirac.analysis.compare`).
 """
 
 from __future__ import annotations
@@ -58,17 +58,17 @@ def parse_params(items: list[str]) -> dict[str, float]:
 
 
 def main(args: argparse.Namespace) -> int:
-    from dirac.registry import load_system
-    from dirac.symbolic.analysis import analyze
+    from dirac.model.systems import load_system
+    from dirac.analysis.constraint_analysis import analyze
 
     params = parse_params(args.param)
     lagrangian = load_system(args.system, **params)
     analysis = analyze(lagrangian)
     if args.compare is not None:
         try:
-            from dirac.symbolic.compare import cli_compare
+            from dirac.analysis.compare import cli_compare
         except ModuleNotFoundError as exc:
-            if exc.name != "dirac.symbolic.compare":
+            if exc.name != "dirac.analysis.compare":
                 raise
             raise InputError("--compare is not available in this version yet") from None
         print(cli_compare(analysis, args.compare, as_json=args.json))

@@ -35,7 +35,7 @@ def main(args: argparse.Namespace) -> int:
     import numpy as np
 
     from dirac.flows.integration import integrate
-    from dirac.flows.scene import FLAGSHIP_SCENE, scene_from_dict
+    from dirac.io.scene import FLAGSHIP_SCENE, scene_from_dict
 
     plot_path = None
     if args.plot:  # checked before the run, so that a bad name fails fast
@@ -54,7 +54,7 @@ def main(args: argparse.Namespace) -> int:
     progress = (not args.no_progress) and sys.stderr.isatty()
     solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]
     if args.out:
-        from dirac.flows.results import write_results
+        from dirac.io.results import write_results
 
         write_results(solution, args.out, extra_meta=scene.meta)
     M, R = solution["M"], solution["R"]

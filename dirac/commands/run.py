@@ -67,8 +67,8 @@ def _partial_path(out: Path) -> Path:
 def main(args: argparse.Namespace) -> int:
     from dirac.errors import InputError, IntegrationError
     from dirac.flows.integration import IntegrationInterrupted, integrate
-    from dirac.flows.results import write_results
-    from dirac.flows.scene import load_scene
+    from dirac.io.results import write_results
+    from dirac.io.scene import load_scene
 
     scene_path = Path(args.scene)
     out = Path(args.out) if args.out else scene_path.with_suffix(".npz")

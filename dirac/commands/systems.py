@@ -14,11 +14,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def main(args: argparse.Namespace) -> int:
-    from dirac.registry import builtin_systems
+    from dirac.model.systems import builtin_systems
 
     systems = builtin_systems()
     try:
-        from dirac.flows.scene import SCENE_SYSTEMS  # numerical systems of scene files
+        from dirac.io.scene import SCENE_SYSTEMS  # numerical systems of scene files
     except ModuleNotFoundError:
         SCENE_SYSTEMS = {}
     width = max(map(len, [*systems, *SCENE_SYSTEMS]), default=0)

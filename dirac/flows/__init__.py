@@ -17,19 +17,19 @@ _LAZY = {
     "integrate": "dirac.flows.integration",
     "IntegrationInterrupted": "dirac.flows.integration",
     "Solution": "dirac.flows.solution",
-    "RigidBodyProblem": "dirac.flows.problem",
-    "HeavyTopProblem": "dirac.flows.problem",
-    "ConstrainedProblem": "dirac.flows.problem",
+    "RigidBodyProblem": "dirac.flows.problems",
+    "HeavyTopProblem": "dirac.flows.problems",
+    "ConstrainedProblem": "dirac.flows.problems",
     "MechanicalSystem": "dirac.flows.mechanics",
     "AnalysedSystem": "dirac.flows.analysed",
     "AnalysedProblem": "dirac.flows.analysed",
-    "load_scene": "dirac.flows.scene",
-    "scene_from_dict": "dirac.flows.scene",
-    "write_results": "dirac.flows.results",
-    "read_results": "dirac.flows.results",
-    "get_method": "dirac.flows.methods",
-    "method_names": "dirac.flows.methods",
-    "METHODS": "dirac.flows.methods",
+    "load_scene": "dirac.io.scene",
+    "scene_from_dict": "dirac.io.scene",
+    "write_results": "dirac.io.results",
+    "read_results": "dirac.io.results",
+    "get_method": "dirac.flows.methods.base",
+    "method_names": "dirac.flows.methods.base",
+    "METHODS": "dirac.flows.methods.base",
 }
 
 __all__ = sorted(_LAZY)
@@ -41,7 +41,7 @@ def __getattr__(name: str) -> Any:
         raise AttributeError(f"module 'dirac.flows' has no attribute {name!r}")
     value = getattr(import_module(module), name)
     if name == "METHODS":
-        import_module("dirac.flows.methods")._load_all()
+        import_module("dirac.flows.methods.base")._load_all()
     globals()[name] = value
     return value
 

@@ -1,13 +1,13 @@
 """Flows on the full phase space of a Dirac–Bergmann analysis (any analysed system).
 
-From a :class:`dirac.symbolic.analysis.ConstraintAnalysis` (phase space ``z``: the
+From a :class:`dirac.analysis.constraint_analysis.ConstraintAnalysis` (phase space ``z``: the
 coordinates and multipliers, then their momenta), the numerical Hamiltonian vector field
 
     z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H),
     C_ab = {Phi_a, Phi_b}  (240),
 
 over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
-``grad Phi`` are generated from sympy (:mod:`dirac.flows.codegen`), ``C`` is evaluated and
+``grad Phi`` are generated from sympy (:mod:`dirac.codegen.generate`), ``C`` is evaluated and
 solved numerically at each point (:func:`dirac.flows.constrained_kernels.analysed_field`).
 ``H`` is the canonical Hamiltonian; with first-class constraints the gauge ``u = 0`` is
 taken (their multipliers stay arbitrary in ``H_T``). This path takes every Lagrangian the
@@ -23,7 +23,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import InputError
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["AnalysedSystem", "AnalysedProblem"]
 
@@ -52,8 +52,8 @@ class AnalysedSystem:
         InputError
             Unknown parameters or parameters without a value.
         """
-        from dirac.flows.codegen import GeneratedFunction, generate_module
-        from dirac.symbolic.analysis import analyze
+        from dirac.codegen.generate import GeneratedFunction, generate_module
+        from dirac.analysis.constraint_analysis import analyze
 
         values = dict(lagrangian.parameter_values)
         for key, value in (parameters or {}).items():

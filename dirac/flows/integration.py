@@ -1,7 +1,7 @@
 """The one integration loop: sampling, counters, CPU time, progress and guard rails.
 
 :func:`integrate` is the only place that loops over output times. Methods
-(:mod:`dirac.flows.methods`) only know how to advance a state; here the loop
+(:mod:`dirac.flows.methods.base`) only know how to advance a state; here the loop
 
 * samples the requested outputs at ``samples`` uniformly spaced times in ``[0, t_end]``
   (both ends included; ``samples = 1`` means the final time only), computing only the
@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from dirac.errors import InputError, IntegrationError
-from dirac.flows.methods import Method, Stepper, StepFailure, get_method
+from dirac.flows.methods.base import Method, Stepper, StepFailure, get_method
 from dirac.flows.solution import Solution
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS"]
@@ -55,7 +55,7 @@ class IntegrationInterrupted(IntegrationError):
 
 def problem_kind(problem: object) -> str:
     """``"rigid_body"``, ``"heavy_top"``, ``"constrained"`` or ``"analysed"``."""
-    from dirac.flows.problem import ConstrainedProblem, HeavyTopProblem, RigidBodyProblem
+    from dirac.flows.problems import ConstrainedProblem, HeavyTopProblem, RigidBodyProblem
 
     if isinstance(problem, HeavyTopProblem):
         return "heavy_top"
@@ -169,8 +169,8 @@ def integrate(
         A :class:`RigidBodyProblem`, :class:`HeavyTopProblem` or :class:`ConstrainedProblem`
         (initial states may be batched along a leading axis).
     method
-        A name from :data:`dirac.flows.methods.METHODS` (``dirac run --help`` lists them)
-        or ``"auto"`` (:func:`dirac.flows.auto.choose_method`).
+        A name from :data:`dirac.flows.methods.base.METHODS` (``dirac run --help`` lists them)
+        or ``"auto"`` (:func:`dirac.flows.methods.auto.choose_method`).
     t_end
         Final time (> 0).
     dt
@@ -212,7 +212,7 @@ def integrate(
     chosen_outputs = _validate_outputs(outputs, kind, problem.outputs)  # type: ignore[attr-defined]
     extra: dict[str, object] = {}
     if (isinstance(method, str) and method == "auto"):
-        from dirac.flows.auto import choose_method
+        from dirac.flows.methods.auto import choose_method
 
         choice = choose_method(problem, kind, t_end=t_end, samples=samples, tolerance=tolerance, dt=dt,
                                outputs=chosen_outputs)
@@ -247,7 +247,7 @@ def integrate(
 
 
 def _names_for(kind: str) -> list[str]:
-    from dirac.flows.methods import METHODS, method_names
+    from dirac.flows.methods.base import METHODS, method_names
 
     return ["auto"] + [n for n in method_names() if n in METHODS and METHODS[n].accepts(kind)]
 

@@ -66,7 +66,7 @@ class Solution:
 
     def meta(self) -> dict[str, object]:
         """The ``meta`` record of the result file (CONTRACTS §7)."""
-        from dirac.flows.results import versions
+        from dirac.io.results import versions
 
         record: dict[str, object] = {
             "system": self.system,

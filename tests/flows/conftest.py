@@ -19,7 +19,7 @@ STANDARD_ENERGY = 0.64712527931383642713
 @pytest.fixture(scope="session")
 def pendulum_system():
     from dirac.flows.mechanics import MechanicalSystem
-    from dirac.registry import load_system
+    from dirac.model.systems import load_system
 
     return MechanicalSystem.from_lagrangian(load_system("pendulum"))
 
@@ -27,14 +27,14 @@ def pendulum_system():
 @pytest.fixture(scope="session")
 def double_pendulum_system():
     from dirac.flows.mechanics import MechanicalSystem
-    from dirac.registry import load_system
+    from dirac.model.systems import load_system
 
     return MechanicalSystem.from_lagrangian(load_system("double_pendulum"))
 
 
 @pytest.fixture
 def standard_problem():
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DiracWarning)  # I = (2, 1, 2/3) is not physical: it warns

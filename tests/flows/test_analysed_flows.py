@@ -10,8 +10,8 @@ import pytest
 from dirac.errors import InputError
 from dirac.flows import integrate
 from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
-from dirac.lagrangian import Lagrangian
-from dirac.registry import load_system
+from dirac.model.lagrangian import Lagrangian
+from dirac.model.systems import load_system
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +47,7 @@ def test_velocity_linear_lagrangian_runs_from_a_scene():
     """A charged bead on a vertical ring in a magnetic field: L has B/2 (x y_dot - y x_dot),
     which RATTLE refuses; the scene falls back to the analysed Dirac flow. The magnetic
     term does no work, so the energy is m/2 |v|^2 + m g y."""
-    from dirac.flows.scene import scene_from_dict
+    from dirac.io.scene import scene_from_dict
 
     scene = scene_from_dict({
         "system": {"name": "charged_ring", "coordinates": ["x", "y"],

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from dirac.flows import RigidBodyProblem, integrate
-from dirac.flows.methods import METHODS, method_names
+from dirac.flows.methods.base import METHODS, method_names
 
 
 def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:

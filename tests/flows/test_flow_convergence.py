@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from dirac.flows import HeavyTopProblem, RigidBodyProblem, integrate
-from dirac.flows.lie_poisson import exact_flow
-from dirac.flows.methods import METHODS, get_method, method_names
+from dirac.flows.methods.lie_poisson import exact_flow
+from dirac.flows.methods.base import METHODS, get_method, method_names
 
 
 def _slope(dts, errors) -> float:

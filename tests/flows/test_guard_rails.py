@@ -10,7 +10,7 @@ import pytest
 from dirac.errors import IntegrationError
 from dirac.flows import ConstrainedProblem, MechanicalSystem, RigidBodyProblem, integrate
 from dirac.flows.integration import IntegrationInterrupted
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 
 
 def _pendulum(system, theta=1.0):  # noqa: ANN001, ANN202
@@ -54,7 +54,7 @@ def test_constraint_drift_beyond_the_limit_stops_the_run(pendulum_system):
 
 
 def test_interruption_keeps_the_samples_computed_so_far(monkeypatch):
-    from dirac.flows.lie_poisson import LiePoissonStepper
+    from dirac.flows.methods.lie_poisson import LiePoissonStepper
 
     calls = {"n": 0}
     original = LiePoissonStepper.step

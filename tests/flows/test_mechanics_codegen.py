@@ -8,9 +8,9 @@ import sympy
 
 from dirac.errors import InputError
 from dirac.flows import ConstrainedProblem, MechanicalSystem, integrate
-from dirac.flows.codegen import GeneratedFunction, generate_module, numpy_function
+from dirac.codegen.generate import GeneratedFunction, generate_module, numpy_function
 from dirac.flows.constrained_kernels import evaluate, quiet
-from dirac.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian
 
 
 def test_numba_and_numpy_backends_agree():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from dirac.errors import DiracWarning, InputError
-from dirac.flows.scene import load_scene, scene_from_dict
+from dirac.io.scene import load_scene, scene_from_dict
 
 RIGID = {"system": {"name": "rigid_body", "inertia": [1.0, 2.0, 3.0]}, "initial": {"M": [0.6, 0.8, 0.5]},
          "run": {"t_end": 1.0}}

@@ -218,7 +218,7 @@ def test_malformed_toml_exits_2_with_one_error_line(text, run_scene):
 @SETTINGS
 @given(scene=good_rigid_scene())
 def test_good_scene_runs_and_writes_a_complete_file(scene, run_scene):
-    from dirac.flows.results import read_results
+    from dirac.io.results import read_results
 
     status, err, out = run_scene(toml_document(scene))
     assert status == 0, err
@@ -325,7 +325,7 @@ def test_random_command_lines_never_crash(argv, cli, tmp_path, monkeypatch):
        M=st.lists(st.one_of(finite, non_finite), min_size=0, max_size=4))
 def test_rigid_body_problem_refuses_bad_numbers_with_input_error(inertia, M):
     from dirac.errors import InputError
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     bad = (len(inertia) != 3 or len(M) != 3 or not all(math.isfinite(v) and v > 0 for v in inertia)
            or not all(math.isfinite(v) for v in M))
@@ -343,7 +343,7 @@ def test_integrate_refuses_bad_arguments_with_input_error_and_runs_good_ones(t_e
 
     from dirac.errors import InputError
     from dirac.flows.integration import integrate
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     problem = RigidBodyProblem([1.0, 2.0, 2.5], [1.0, 0.2, 0.1])
     good = (math.isfinite(t_end) and 0 < t_end <= 5 and isinstance(samples, int) and samples >= 1

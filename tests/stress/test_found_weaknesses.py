@@ -39,7 +39,7 @@ def _scene(tmp_path, **fields) -> str:  # noqa: ANN001
 
 def test_f5_momentum_whose_square_overflows_is_an_input_error():
     from dirac.errors import InputError
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     with pytest.raises(InputError):
         RigidBodyProblem([1.0, 2.0, 3.0], [1e308, 1e308, 0.0])
@@ -68,7 +68,7 @@ def test_f6_tiny_moments_give_the_time_scaled_flow():
 
 def test_f6_moments_whose_reciprocal_overflows_are_an_input_error():
     from dirac.errors import InputError
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     with pytest.raises(InputError, match="overflows"):
         RigidBodyProblem([1e-310, 1.0, 1.0], [1.0, 0.0, 0.0])
@@ -175,7 +175,7 @@ def test_f10_auto_on_a_long_constrained_run_chooses_a_working_step(tmp_path, run
 def test_f12_integrate_validates_its_guard_rail_options(options):
     from dirac.errors import InputError
     from dirac.flows.integration import integrate
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     problem = RigidBodyProblem([1.0, 2.0, 3.0], [1.0, 0.2, 0.1])
     with pytest.raises(InputError):
@@ -185,7 +185,7 @@ def test_f12_integrate_validates_its_guard_rail_options(options):
 @pytest.mark.parametrize("M", [[False, 0.2, 0.1], np.array([True, False, True])])
 def test_f14_booleans_are_not_numbers_in_rigid_body_problem(M):
     from dirac.errors import InputError
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     with pytest.raises(InputError):
         RigidBodyProblem([1.0, 2.0, 3.0], M)

@@ -96,7 +96,7 @@ def _interrupt_run(tmp_path: Path, out: Path, signum: int) -> tuple[int, str]:
 
 
 def _assert_partial(path: Path) -> None:
-    from dirac.flows.results import read_results
+    from dirac.io.results import read_results
 
     arrays, meta = read_results(path)
     assert meta["complete"] is False

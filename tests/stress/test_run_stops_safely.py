@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cli_output import one_error_line
-from dirac.flows.results import read_results
+from dirac.io.results import read_results
 
 RUNAWAY = """
 [system]

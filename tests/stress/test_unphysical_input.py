@@ -34,7 +34,7 @@ samples = 3
 
 def test_standard_body_warns_once_and_integrates():
     from dirac.flows.integration import integrate
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -58,7 +58,7 @@ def test_standard_scene_prints_one_warning_line_and_exits_0(tmp_path, run_cli):
 
 @pytest.mark.parametrize("inertia", [(1.0, 2.0, 3.0), (2.0, 2.0, 2.0), (1.0, 1.0, 1.9)])
 def test_physical_and_plane_bodies_are_not_warned_about(inertia):
-    from dirac.flows.problem import RigidBodyProblem
+    from dirac.flows.problems import RigidBodyProblem
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", DiracWarning)

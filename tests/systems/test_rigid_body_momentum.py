@@ -12,7 +12,7 @@ import pytest
 import sympy
 
 import dirac
-from dirac.symbolic.legendre import legendre_transform
+from dirac.analysis.legendre import legendre_transform
 from dirac.errors import DiracWarning, InputError
 from dirac_systems import rigid_body_momentum
 from rigid_body_analyses import cached_analysis, eps, hat

@@ -1,0 +1,315 @@
+"""``analyze(lagrangian) -> ConstraintAnalysis``: the whole Dirac–Bergmann algorithm.
+
+Legendre transform (primary constraints, ``H_c``, ``H_T``), the constraint chain, the
+first/second-class split, the physical degrees of freedom and the Dirac bracket (240),
+for a Lagrangian with holonomic constraints whose multipliers are coordinates (the
+paper's (1); Sect. X for the rigid body (78), Sect. XI for (228)).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import sympy
+
+from dirac.errors import AnalysisError, InputError
+from dirac.model.lagrangian import Lagrangian
+from dirac.analysis.classification import bracket_matrix, classify
+from dirac.analysis.constraint_chain import ConstraintChain
+from dirac.analysis.dirac_bracket import DiracBracket
+from dirac.analysis.legendre import legendre_transform
+from dirac.analysis.linear_solve import SolveTooLarge
+from dirac.analysis.numeric import Numerics
+
+__all__ = ["ConstraintAnalysis", "analyze"]
+
+#: largest second-class set whose bracket matrix counts as small
+SMALL_SECOND_CLASS = 8
+
+#: seconds allowed for the exact solve of one component of equations_of_motion()
+EXACT_BRACKET_SECONDS = 60.0
+
+
+def _generic_parameter_values(lagrangian: Lagrangian, rng: np.random.Generator) -> dict:
+    """Random positive values (0.7-1.9) for the parameters: decisions hold generically."""
+    return {p: float(rng.uniform(0.7, 1.9)) for p in lagrangian.parameters}
+
+
+class ConstraintAnalysis:
+    """Result of the Dirac–Bergmann algorithm on one Lagrangian (use :func:`analyze`).
+
+    Attributes
+    ----------
+    lagrangian, name
+        The input and its name.
+    coordinates, momenta, phase_space
+        ``q`` then ``lambda_1, ...``; ``p_q`` then ``p_lambda_...``; both concatenated.
+    symbols
+        Name -> symbol of every phase-space variable (CONTRACTS §5).
+    parameters
+        Parameter symbols that are still symbolic.
+    canonical_hamiltonian, total_hamiltonian
+        ``H_c`` and ``H_T = H_c + u_k phi_k`` ((207), (234)).
+    primary_multipliers
+        The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``.
+    multipliers
+        ``u_k`` name -> solved expression, for those the algorithm determines.
+    stages, constraints
+        The chain stage by stage (stage 1 = primary) and flat.
+    first_class, second_class
+        The classes; ``physical_degrees_of_freedom = (2n - 2 #first - #second) / 2``.
+    bracket_strategy
+        How Dirac brackets are computed ("symbolic", "block" or "numeric", and why).
+    notes
+        How the decisions were made (for the report).
+    """
+
+    def __init__(self, lagrangian: Lagrangian, seed: int = 20240607) -> None:
+        start = time.perf_counter()
+        self.lagrangian = lagrangian
+        self.name = lagrangian.name
+        rng = np.random.default_rng(seed)
+        self._generic = _generic_parameter_values(lagrangian, rng)
+        legendre = legendre_transform(lagrangian, rng, self._generic)
+        self._legendre = legendre
+        space = legendre.phase_space
+        self._space = space
+        self.coordinates = space.coordinates
+        self.momenta = space.momenta
+        self.phase_space = space.variables
+        self.symbols = space.symbols
+        self.parameters = tuple(lagrangian.parameters)
+        self.hessian = legendre.hessian
+        self.hessian_rank = legendre.rank
+        self.canonical_hamiltonian = legendre.canonical_hamiltonian
+        K = len(legendre.primary)
+        self.primary_multipliers = tuple(sympy.Symbol(f"u_{k + 1}", real=True) for k in range(K))
+        self._numerics = Numerics(space, self._generic, seed=seed)
+        chain = ConstraintChain(space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers)
+        chain.run()
+        self._chain = chain
+        self.primary_constraints = list(chain.primary)
+        self.total_hamiltonian = chain.total_hamiltonian
+        self.stages = chain.stages
+        self.constraints = chain.constraints
+        self.multipliers = dict(chain.solved_multipliers)
+        self.undetermined_multipliers = list(chain.undetermined)
+        self._points = chain.points
+        C = bracket_matrix(space, self.constraints)
+        cls = classify(space, self._numerics, self.constraints, self._points, C)
+        self.first_class = cls.first_class
+        self.second_class = cls.second_class
+        self.bracket_matrix_rank = cls.rank
+        dim = space.dimension
+        self.physical_degrees_of_freedom = (dim - 2 * len(self.first_class) - len(self.second_class)) // 2
+        if (dim - 2 * len(self.first_class) - len(self.second_class)) % 2:
+            raise AnalysisError("odd number of physical phase-space dimensions: the classification is inconsistent")
+        C2 = C[cls.second_indices, cls.second_indices] if cls.second_indices else sympy.zeros(0, 0)
+        self._bracket = DiracBracket(space, self.second_class, C2, self._numerics, self._points, lagrangian.parameters)
+        self._defaults_numerics: Numerics | None = None
+        s = len(self.second_class)
+        if s == 0:
+            self.bracket_strategy = "symbolic: no second-class constraints, the Dirac bracket is the Poisson bracket"
+        elif s <= SMALL_SECOND_CLASS:
+            self.bracket_strategy = (
+                f"symbolic: C is {s}x{s}; exact brackets solve C x = {{Phi, B}} exactly after dropping weakly "
+                "zero entries; numeric brackets (at=) solve C at the point"
+            )
+        else:
+            self.bracket_strategy = (
+                f"block: C is {s}x{s}, too large to invert symbolically; exact brackets drop weakly zero terms, "
+                "skip corrections that vanish weakly ((246) with (239)) and otherwise solve only the "
+                "block-triangular pieces of C they need; numeric brackets (at=) solve C at the point"
+            )
+        self.notes = [
+            f"Legendre transform: {legendre.method}",
+            "weak zeros, independence and ranks decided numerically at "
+            f"{len(self._points)} random points of each constraint surface"
+            + (" (symbolic parameters at generic random values)" if self.parameters else ""),
+        ]
+        self.seconds = time.perf_counter() - start
+
+    # ------------------------------------------------------------------ brackets
+    def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:
+        """Canonical Poisson bracket ``{f, g}`` (``{q, p} = 1``; Sect. X)."""
+        return self._space.poisson_bracket(self._bracket._sympify(f), self._bracket._sympify(g))
+
+    def dirac_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str, at: Mapping[str, float] | None = None):
+        """Dirac bracket (240) over the second-class constraints.
+
+        Parameters
+        ----------
+        f, g
+            Phase-space functions (sympy expressions in :attr:`symbols`, or names).
+        at
+            Optional numeric point ``{name: value}``; then a float is returned, computed
+            without any symbolic inverse of ``C`` (compiled once per pair ``f, g``).
+
+        Returns
+        -------
+        sympy.Expr or float
+            Exact bracket, weakly simplified on the constraint surface; or its value.
+        """
+        if at is not None:
+            return self._bracket.at(f, g, at)
+        return self._bracket.exact(self._bracket._sympify(f), self._bracket._sympify(g))
+
+    def equations_of_motion(
+        self,
+        variables: Sequence[sympy.Expr | str] | None = None,
+        at: Mapping[str, float] | None = None,
+        time_limit: float = EXACT_BRACKET_SECONDS,
+    ) -> dict:
+        """Reduced Hamiltonian vector field ``z_dot = {z, H}_D`` on the constraint surface.
+
+        ``H = H_c + u_k phi_k`` over the primary constraints whose multipliers stay free
+        (first class); those ``u_k`` stay as symbols. Second-class terms of ``H_T`` drop
+        out of Dirac brackets ((240); for the rigid body (250)-(251) follow).
+
+        Parameters
+        ----------
+        variables
+            The phase-space functions ``z`` to compute ``z_dot`` of: symbols, names of
+            phase-space variables, or expressions (e.g. ``M_k = -eps_kij (R^T p)_ij``,
+            (233)). Default: every phase-space variable.
+        at
+            Optional numeric point ``{name: value}``: then each ``z_dot`` is a float
+            computed there (no symbolic solve).
+        time_limit
+            Seconds allowed for the exact solve of each component.
+
+        Returns
+        -------
+        dict
+            ``z -> z_dot`` (keys are the sympy expressions of ``variables``).
+
+        Raises
+        ------
+        AnalysisError
+            If a component's exact Dirac bracket is too large to solve symbolically
+            (bracket matrix block or time over its limit); the message names it.
+        InputError
+            For a name that is not a phase-space variable.
+        """
+        free = set(self.undetermined_multipliers)
+        H = self.canonical_hamiltonian + sum(
+            (u * phi for u, phi in zip(self.primary_multipliers, self.primary_constraints) if u in free), sympy.S.Zero
+        )
+        items = list(self.phase_space) if variables is None else [self._bracket._sympify(z) for z in variables]
+        result: dict = {}
+        for z in items:
+            if at is not None:
+                result[z] = self._bracket.at(z, H, at)
+                continue
+            try:
+                result[z] = self._bracket.exact(z, H, time_limit=time_limit)
+            except SolveTooLarge as exc:
+                raise AnalysisError(
+                    f"the exact Dirac bracket {{{z}, H}}_D of {self.name!r} cannot be found symbolically: {exc}; "
+                    "evaluate it at a point with equations_of_motion(..., at=point), or ask only for the "
+                    "components you need with equations_of_motion(variables=[...])"
+                ) from None
+        return result
+
+    # ------------------------------------------------------------------ points
+    def surface_point(self, values: Mapping[str, float] | None = None, seed: int | None = None) -> dict[str, float]:
+        """A numeric point on the full constraint surface, completing the given values.
+
+        Parameters are at their defaults (symbolic parameters without a default make this
+        fail). Variables given in ``values`` are held fixed; the others are solved for
+        (Gauss–Newton from a random start), e.g. given ``q`` and ``p`` this finds the
+        multipliers ``lambda`` (the fourth stage) and ``p_lambda = 0``.
+
+        Raises
+        ------
+        InputError
+            Unknown names, parameters without default, or values that no point of the
+            surface has.
+        """
+        values = dict(values or {})
+        self._space.check_names(values, "surface_point")
+        missing = [p.name for p, v in self.lagrangian.parameters.items() if v is None]
+        if missing:
+            raise InputError(f"parameters {', '.join(missing)} have no default value: fix them (Lagrangian.fix) first")
+        if self._defaults_numerics is None:
+            self._defaults_numerics = Numerics(self._space, dict(self.lagrangian.parameters))
+        numerics = self._defaults_numerics
+        numerics.rng = np.random.default_rng(seed)
+        index = {s.name: i for i, s in enumerate(self.phase_space)}
+        fixed = {index[k]: float(v) for k, v in values.items()}
+        try:
+            point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
+        except AnalysisError:
+            if fixed:
+                raise InputError(
+                    f"no point of the constraint surface of {self.name!r} has the given values "
+                    f"({', '.join(f'{k}={v}' for k, v in values.items())}): give values that satisfy the constraints"
+                ) from None
+            raise
+        return {s.name: float(x) for s, x in zip(self.phase_space, point)}
+
+    # ------------------------------------------------------------------ reports
+    def to_json(self) -> dict:
+        """The CONTRACTS §4 object (plus extra keys)."""
+        from dirac.analysis.report import to_json
+
+        return to_json(self)
+
+    def to_text(self) -> str:
+        """The chain stage by stage, classes, multipliers, counts: readable text."""
+        from dirac.analysis.report import to_text
+
+        return to_text(self)
+
+    def to_latex(self) -> str:
+        """The analysis as a LaTeX fragment (align environments)."""
+        from dirac.analysis.report import to_latex
+
+        return to_latex(self)
+
+    def _repr_latex_(self) -> str:
+        from dirac.analysis.report import to_latex
+
+        return to_latex(self, display=True)
+
+    def __repr__(self) -> str:
+        counts = "+".join(str(len(s)) for s in self.stages) or "0"
+        return (
+            f"<ConstraintAnalysis {self.name!r}: stages {counts}, {len(self.first_class)} first class, "
+            f"{len(self.second_class)} second class, {self.physical_degrees_of_freedom} degrees of freedom>"
+        )
+
+
+def analyze(lagrangian: Lagrangian) -> ConstraintAnalysis:
+    """Run the Dirac–Bergmann algorithm on ``lagrangian``.
+
+    Parameters
+    ----------
+    lagrangian
+        A :class:`~dirac.model.lagrangian.Lagrangian` (quadratic in the velocities) with
+        holonomic constraints; their multipliers become coordinates (the paper's (1)).
+
+    Returns
+    -------
+    ConstraintAnalysis
+
+    Raises
+    ------
+    InconsistentSystemError
+        If the consistency conditions demand something like ``1 = 0``.
+    AnalysisError
+        If the Lagrangian is not quadratic in the velocities, or the chain cannot be
+        carried out.
+
+    Examples
+    --------
+    >>> import dirac
+    >>> analysis = dirac.analyze(dirac.load_system("pendulum"))
+    >>> [len(stage) for stage in analysis.stages], analysis.physical_degrees_of_freedom
+    ([1, 1, 1, 1], 1)
+    """
+    if not isinstance(lagrangian, Lagrangian):
+        raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
+    return ConstraintAnalysis(lagrangian)

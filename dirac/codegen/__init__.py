@@ -1,0 +1,1 @@
+"""The one boundary from sympy expressions to numbers (numpy and numba functions)."""

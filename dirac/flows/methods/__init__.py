@@ -1,0 +1,1 @@
+"""Integration methods: the base classes, one module per family, and the registry."""

@@ -1,0 +1,153 @@
+"""scipy's explicit Runge–Kutta pairs (``RK45``, ``DOP853``) as baselines.
+
+They integrate the same vector fields as the geometric methods: the Euler–Poisson
+equations (250)–(251) (the 3-component Euler equations alone when no output needs
+``R``), the heavy-top equations, and the constrained flow of a general system (the Dirac
+vector field, :mod:`dirac.flows.dirac_field`). Step control is scipy's, with
+``rtol = atol = tolerance``; output times are met by scipy's dense output, so sampling
+does not shorten the steps. Neither method preserves any invariant.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dirac.flows.methods.base import Method, Stepper, StepFailure, register_method
+
+__all__ = ["ScipyStepper"]
+
+
+class ScipyStepper(Stepper):
+    """One scipy ``OdeSolver`` per initial state, stepped to each output time."""
+
+    kind = "adaptive"
+
+    def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+        super().__init__()
+        self.method = method
+        self.problem = problem
+        self.outputs = outputs
+        # scipy refuses rtol below 100 machine epsilons (it warns and clamps): clamp here
+        self.tolerance = max(float(options.get("tolerance", 1e-8)), 2.3e-14)
+        self.t_end = float(options["t_end"])
+        self.t = 0.0
+        kind = getattr(problem, "system", "")
+        if kind in ("rigid_body", "heavy_top"):
+            from dirac.flows.methods.lie_poisson import needs_attitude
+
+            self.with_R = needs_attitude(outputs) or kind == "heavy_top"
+            self._fun, self._args = _rigid_body_rhs(problem, self.with_R)
+            states = [np.concatenate([M, R.ravel()]) if self.with_R else M.copy() for M, R in zip(problem.M0, problem.R0)]
+        elif hasattr(problem, "analysed"):
+            self.analysed = problem.analysed
+            self._fun, self._args = (lambda t, y: self.analysed.field(y)), ()
+            states = [z.copy() for z in problem.z0]
+        else:
+            from dirac.flows.dirac_field import ConstrainedField
+
+            self.field = ConstrainedField(problem.mechanics)
+            self._fun, self._args = self.field.scipy_rhs, ()
+            states = [np.concatenate([q, p]) for q, p in zip(problem.q0, problem.p0)]
+        self.y = np.array(states)
+        self._solvers: list[object] | None = None
+
+    def _make_solvers(self) -> list[object]:
+        from scipy import integrate
+
+        solver_class = {"scipy-RK45": integrate.RK45, "scipy-DOP853": integrate.DOP853}[self.method.name]
+        args = self._args
+
+        def fun(t, y):  # noqa: ANN001, ANN202
+            return self._fun(t, y, *args)
+
+        return [
+            solver_class(fun, self.t, y.copy(), self.t_end, rtol=self.tolerance, atol=self.tolerance)
+            for y in self.y
+        ]
+
+    def warm_up(self) -> None:
+        self._fun(0.0, self.y[0].copy(), *self._args)
+        self._solvers = self._make_solvers()  # imports scipy and picks the first step outside the timing
+
+    def advance_to(self, t: float) -> None:
+        if self._solvers is None:
+            self._solvers = self._make_solvers()
+        for b, solver in enumerate(self._solvers):
+            while solver.t < t and solver.status == "running":  # type: ignore[attr-defined]
+                message = solver.step()  # type: ignore[attr-defined]
+                self.steps += 1
+                if solver.status == "failed":  # type: ignore[attr-defined]
+                    raise StepFailure(f"scipy {self.method.name} failed: {message}")
+            if solver.t == t:  # type: ignore[attr-defined]
+                self.y[b] = solver.y  # type: ignore[attr-defined]
+            else:
+                self.y[b] = solver.dense_output()(t)  # type: ignore[attr-defined]
+        self.evaluations = sum(s.nfev for s in self._solvers)  # type: ignore[attr-defined]
+        self.t = t
+
+    def finite(self) -> bool:
+        return bool(np.all(np.isfinite(self.y)))
+
+    def observe(self) -> dict[str, np.ndarray]:
+        if hasattr(self, "analysed"):
+            from dirac.flows.analysed import analysed_outputs
+
+            return analysed_outputs(self.analysed, self.outputs, self.y)
+        if hasattr(self, "field"):
+            n = self.problem.mechanics.dimension
+            return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:])
+        from dirac.flows.methods.lie_poisson import rigid_body_outputs
+
+        M = self.y[:, :3]
+        R = self.y[:, 3:].reshape(-1, 3, 3) if self.with_R else None
+        return rigid_body_outputs(self.outputs, M, R, np.asarray(self.problem.inertia), self.problem)
+
+    def drift(self) -> float:
+        if hasattr(self, "analysed"):
+            return max(self.analysed.constraint_residual(y) for y in self.y)
+        if hasattr(self, "field"):
+            n = self.problem.mechanics.dimension
+            return max(self.problem.mechanics.constraint_residual(y[:n], y[n:]) for y in self.y)
+        return 0.0  # RK methods do not preserve R^T R = 1; that is what the baseline shows
+
+
+def _rigid_body_rhs(problem, with_R: bool):  # noqa: ANN001, ANN202
+    from dirac.rigidbody.euler_poisson import lean_rhs_full, lean_rhs_M
+
+    i1, i2, i3 = (float(x) for x in problem.inertia)
+    if getattr(problem, "system", "") == "heavy_top":
+        w = problem.weight_vector
+
+        def heavy(t, y, i1, i2, i3):  # noqa: ANN001, ANN202
+            dy = lean_rhs_full(t, y, i1, i2, i3)
+            g0, g1, g2 = y[9], y[10], y[11]  # gamma = R^T e_z = third row of R
+            dy[0] += g1 * w[2] - g2 * w[1]
+            dy[1] += g2 * w[0] - g0 * w[2]
+            dy[2] += g0 * w[1] - g1 * w[0]
+            return dy
+
+        return heavy, (i1, i2, i3)
+    return (lean_rhs_full if with_R else lean_rhs_M), (i1, i2, i3)
+
+
+def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+    return ScipyStepper(method, problem, outputs, options)
+
+
+for _name, _order, _ref in (
+    ("scipy-RK45", 5, "Dormand & Prince (1980), scipy.integrate.RK45"),
+    ("scipy-DOP853", 8, "Hairer, Norsett & Wanner, DOP853; scipy.integrate.DOP853"),
+):
+    register_method(
+        Method(
+            name=_name,
+            order=_order,
+            kind="adaptive",
+            problems=("rigid_body", "heavy_top", "constrained", "analysed"),
+            symplectic=False,
+            preserves_casimirs=False,
+            description=f"baseline: scipy {_name[6:]} with rtol = atol = tolerance (adaptive steps)",
+            reference=_ref,
+            factory=_factory,
+        )
+    )

@@ -1,0 +1,240 @@
+"""Problems: a system with validated numbers and initial states, ready to integrate.
+
+A problem holds everything about *what* is integrated (equations, parameters, initial
+states); *how* (method, step, sampling, outputs) is given to :func:`dirac.flows.integrate`.
+Initial states may carry a leading batch axis: many bodies or initial conditions are
+integrated with the same method in one call.
+
+* :class:`RigidBodyProblem` -- the free rigid body, Euler–Poisson equations (250)–(251).
+* :class:`HeavyTopProblem` -- the rigid body in a uniform gravity field,
+  ``H = H_0(M) + m g <chi, R^T e_z>``.
+* :class:`ConstrainedProblem` -- a mechanical system ``L = 1/2 q_dot^T M(q) q_dot - V(q)``
+  with holonomic constraints (a :class:`dirac.flows.mechanics.MechanicalSystem`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from dirac.errors import InputError
+
+__all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
+
+
+def _refuse_booleans(value: object, name: str) -> None:
+    """``True``/``False`` are not numbers here (numpy would read them as 1.0 and 0.0)."""
+
+    def has_boolean(item: object) -> bool:
+        if isinstance(item, (bool, np.bool_)):
+            return True
+        if isinstance(item, np.ndarray):
+            return item.dtype == bool or (item.dtype == object and any(has_boolean(v) for v in item.flat))
+        if isinstance(item, (list, tuple)):
+            return any(has_boolean(v) for v in item)
+        return False
+
+    if has_boolean(value):
+        raise InputError(f"{name} = {value!r} contains true/false; give numbers")
+
+
+def _batched(array: np.ndarray, single_ndim: int, name: str) -> tuple[np.ndarray, bool]:
+    """Return ``(array with a leading batch axis, whether the input had one)``."""
+    if array.ndim == single_ndim:
+        return array[None, ...].copy(), False
+    if array.ndim == single_ndim + 1:
+        if array.shape[0] == 0:
+            raise InputError(f"{name} has an empty batch axis: give at least one state")
+        return array.copy(), True
+    raise InputError(f"{name} has {array.ndim} axes; give one state or a batch of states (one more leading axis)")
+
+
+@dataclass
+class RigidBodyProblem:
+    """The free rigid body: ``dM/dt = M x Omega``, ``dR/dt = R hat(Omega)`` (250)–(251).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3,)
+        Principal moments ``I_i`` (validated; triangle-inequality violations warn).
+    M0 : array_like, shape (3,) or (B, 3)
+        Initial body angular momentum.
+    R0 : array_like, shape (3, 3) or (B, 3, 3), optional
+        Initial attitude (body to lab), default the identity (43).
+
+    Examples
+    --------
+    >>> problem = RigidBodyProblem([2.0, 1.0, 2 / 3], [0.4536, 0.0, 0.8912])  # doctest: +SKIP
+    """
+
+    inertia: np.ndarray
+    M0: np.ndarray
+    R0: np.ndarray | None = None
+    batched: bool = field(init=False, default=False)
+
+    system = "rigid_body"
+    outputs = ("M", "R", "energy", "casimir", "lab_momentum")
+
+    def __post_init__(self) -> None:
+        from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
+
+        self.inertia = validate_inertia(self.inertia)
+        _refuse_booleans(self.M0, "M0")
+        _refuse_booleans(self.R0, "R0")
+        moments = np.asarray(self.M0, dtype=float)
+        self.M0, self.batched = _batched(moments, 1, "M0")
+        for body in self.M0:
+            validate_momentum(body)
+        batch = self.M0.shape[0]
+        if self.R0 is None:
+            self.R0 = np.repeat(np.eye(3)[None], batch, axis=0)
+        else:
+            rotations = np.asarray(self.R0, dtype=float)
+            rotations, _ = _batched(rotations, 2, "R0")
+            if rotations.shape[0] == 1 and batch > 1:
+                rotations = np.repeat(rotations, batch, axis=0)
+            if rotations.shape[0] != batch:
+                raise InputError(f"R0 has {rotations.shape[0]} states but M0 has {batch}: give one R0 per M0")
+            self.R0 = np.stack([validate_rotation(r) for r in rotations])
+
+    @property
+    def batch(self) -> int:
+        """Number of initial states."""
+        return int(self.M0.shape[0])
+
+    def parameters(self) -> dict[str, object]:
+        """Numerical parameters for the result file's ``meta``."""
+        return {"inertia": self.inertia.tolist()}
+
+
+@dataclass
+class HeavyTopProblem(RigidBodyProblem):
+    """A rigid body with a fixed point in a uniform gravity field (heavy top).
+
+    ``H = sum_i M_i^2 / (2 I_i) + m g <chi, gamma>``, ``gamma = R^T e_z`` (the lab vertical
+    seen from the body), ``chi`` the centre of mass in body coordinates relative to the
+    fixed point. With the bracket (248)–(249) the equations are
+    ``dM/dt = M x Omega + m g gamma x chi``, ``dR/dt = R hat(Omega)``.
+    The Lagrange top has ``I_1 = I_2`` and ``chi`` on the third axis.
+
+    Parameters
+    ----------
+    inertia, M0, R0
+        As for :class:`RigidBodyProblem` (moments about the fixed point).
+    mass_gravity : float
+        ``m g`` (>= 0).
+    center_of_mass : array_like, shape (3,)
+        ``chi`` in body coordinates.
+    """
+
+    mass_gravity: float = 1.0
+    center_of_mass: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+    system = "heavy_top"
+    outputs = ("M", "R", "energy", "lab_momentum_z")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        value = self.mass_gravity
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+            raise InputError(f"mass_gravity = {value!r} must be a finite number >= 0 (the product m g)")
+        self.mass_gravity = float(value)
+        chi = np.asarray(self.center_of_mass, dtype=float)
+        if chi.shape != (3,) or not np.all(np.isfinite(chi)):
+            raise InputError(f"center_of_mass = {self.center_of_mass!r} must be 3 finite numbers (body frame)")
+        self.center_of_mass = chi
+
+    @property
+    def weight_vector(self) -> np.ndarray:
+        """``m g chi`` (body frame)."""
+        return self.mass_gravity * self.center_of_mass
+
+    def parameters(self) -> dict[str, object]:
+        return {
+            "inertia": self.inertia.tolist(),
+            "mass_gravity": self.mass_gravity,
+            "center_of_mass": self.center_of_mass.tolist(),
+        }
+
+
+@dataclass
+class ConstrainedProblem:
+    """A holonomically constrained mechanical system with initial positions and momenta.
+
+    Parameters
+    ----------
+    mechanics : dirac.Lagrangian or dirac.flows.mechanics.MechanicalSystem
+        The system: a :class:`~dirac.model.lagrangian.Lagrangian` (compiled here with its
+        default parameter values) or an already compiled ``MechanicalSystem``.
+    q0 : array_like, shape (n,) or (B, n)
+        Initial coordinates, on the constraint surface ``chi(q) = 0``.
+    p0 : array_like, shape (n,) or (B, n)
+        Initial momenta, tangent: ``G(q) M(q)^{-1} p = 0`` (the third-stage constraints).
+    surface_tolerance : float
+        Largest accepted constraint residual of the initial data (absolute, scaled by
+        ``1 + |q|^2``); use :meth:`MechanicalSystem.project` to put data on the surface.
+
+    Raises
+    ------
+    InputError
+        Wrong shapes, non-finite values, or initial data off the constraint surface.
+    """
+
+    mechanics: object
+    q0: np.ndarray
+    p0: np.ndarray
+    surface_tolerance: float = 1e-9
+    batched: bool = field(init=False, default=False)
+
+    outputs = ("q", "p", "q_dot", "energy", "constraint_residual")
+
+    def __post_init__(self) -> None:
+        from dirac.model.lagrangian import Lagrangian
+
+        if isinstance(self.mechanics, Lagrangian):
+            from dirac.flows.mechanics import MechanicalSystem
+
+            self.mechanics = MechanicalSystem.from_lagrangian(self.mechanics)
+        n = self.mechanics.dimension  # type: ignore[attr-defined]
+        q0, self.batched = _batched(np.asarray(self.q0, dtype=float), 1, "q")
+        p0, _ = _batched(np.asarray(self.p0, dtype=float), 1, "p")
+        for name, value in (("q", q0), ("p", p0)):
+            if value.shape[1] != n:
+                raise InputError(f"initial {name} has {value.shape[1]} entries; the system has {n} coordinates")
+            if not np.all(np.isfinite(value)):
+                raise InputError(f"initial {name} has non-finite entries; give finite numbers")
+        if q0.shape[0] != p0.shape[0]:
+            raise InputError(f"{q0.shape[0]} initial q but {p0.shape[0]} initial p: give one p per q")
+        names = self.mechanics.coordinate_names  # type: ignore[attr-defined]
+        for b in range(q0.shape[0]):
+            position, velocity = self.mechanics.residuals(q0[b], p0[b])  # type: ignore[attr-defined]
+            scale = 1.0 + float(q0[b] @ q0[b])
+            if np.any(np.abs(position) > self.surface_tolerance * scale):
+                worst = int(np.argmax(np.abs(position)))
+                raise InputError(
+                    f"initial q {dict(zip(names, q0[b].tolist()))} is off the constraint surface: constraint "
+                    f"{worst + 1} = {position[worst]:.3g}; give q with chi(q) = 0, or set project = true in [initial]"
+                )
+            pscale = scale * (1.0 + float(p0[b] @ p0[b]))
+            if np.any(np.abs(velocity) > self.surface_tolerance * np.sqrt(pscale)):
+                worst = int(np.argmax(np.abs(velocity)))
+                raise InputError(
+                    f"initial velocity is not tangent to the constraint surface: d(constraint {worst + 1})/dt = "
+                    f"{velocity[worst]:.3g}; give q_dot (or p) with d chi/dt = 0, or set project = true in [initial]"
+                )
+        self.q0, self.p0 = q0, p0
+
+    @property
+    def system(self) -> str:
+        return self.mechanics.name  # type: ignore[attr-defined]
+
+    @property
+    def batch(self) -> int:
+        return int(self.q0.shape[0])
+
+    def parameters(self) -> dict[str, object]:
+        return dict(self.mechanics.parameter_values)  # type: ignore[attr-defined]
+
+
+Problem = RigidBodyProblem | HeavyTopProblem | ConstrainedProblem

@@ -1,0 +1,1 @@
+"""Files users write and read: scene files and result files."""

@@ -1,0 +1,304 @@
+"""Scene files (CONTRACTS §6): a system, its initial state and how to run it.
+
+```toml
+[system]
+name = "rigid_body"            # or "heavy_top", a built-in Lagrangian ("pendulum"), or
+# file = "path/to/system.toml" # a system file (relative to the scene), or the system
+                               # itself inline (coordinates, lagrangian, constraints, ...)
+inertia = [2.0, 1.0, 0.6666666666666666]
+
+[initial]
+M = [0.4535961214255773, 0.0, 0.8912073600614354]   # or omega = [...] or m = [...] (lab)
+R = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+
+[run]
+t_end = 100.0
+method = "auto"
+dt = 0.01
+tolerance = 1e-8
+samples = 101
+outputs = ["M", "R", "energy"]
+```
+
+A rigid-body scene gives exactly one of ``M`` (body angular momentum), ``omega`` (body
+angular velocity, ``M = I omega``) or ``m`` (lab angular momentum, ``M = R^T m``). A
+heavy top adds ``mass_gravity`` (``m g``) and ``center_of_mass`` (body frame) under
+``[system]``. A general system gives ``q = { x = ..., ... }`` and ``q_dot = {...}`` or
+``p = {...}`` (omitted velocities mean rest); initial data off the constraint surface
+are refused unless ``project = true`` in ``[initial]``. A Lagrangian that is not of the
+form ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the velocities, singular) is
+integrated on the full phase space of its Dirac–Bergmann analysis (``midpoint`` or the
+scipy baselines; the multipliers are completed on the constraint surface, outputs ``z``,
+``q``, ``p``, ``energy``, ``constraint_residual``). Parameters of a Lagrangian are
+overridden under ``[system] parameters``. Optional ``[run]`` keys: ``drift_limit``,
+``newton_tolerance``, ``max_newton_iterations``. Unknown keys are warned about and ignored.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from dirac.errors import InputError, warn
+from dirac.rigidbody.inertia import as_float_array
+
+__all__ = ["Scene", "load_scene", "scene_from_dict", "SCENE_SYSTEMS", "FLAGSHIP_SCENE"]
+
+#: Numerical systems a scene can name besides the Lagrangian systems (``dirac systems``).
+SCENE_SYSTEMS: dict[str, str] = {
+    "rigid_body": "free asymmetric rigid body (Euler-Poisson (250)-(251)); inertia = [I1, I2, I3]; initial M, omega or m, and R",
+    "heavy_top": "rigid body with a fixed point in uniform gravity; adds mass_gravity (m g) and center_of_mass (body frame)",
+}
+
+#: The flagship scene of ``dirac demo``: the standard body of PHYSICS.md §4.
+FLAGSHIP_SCENE: dict[str, object] = {
+    "system": {"name": "rigid_body", "inertia": [2.0, 1.0, 2.0 / 3.0]},
+    "initial": {"M": [math.cos(1.1), 0.0, math.sin(1.1)]},
+    "run": {
+        "t_end": 1000.0,
+        "method": "auto",
+        "tolerance": 1e-10,
+        "samples": 1001,
+        "outputs": ["M", "R", "energy", "casimir", "lab_momentum"],
+    },
+}
+
+_TOP_KEYS = {"system", "initial", "run", "description"}
+_RUN_KEYS = {"t_end", "method", "dt", "tolerance", "samples", "outputs", "drift_limit", "newton_tolerance",
+             "max_newton_iterations"}
+_RIGID_KEYS = {"name", "inertia", "description"}
+_HEAVY_KEYS = _RIGID_KEYS | {"mass_gravity", "center_of_mass"}
+_LAGRANGIAN_KEYS = {"name", "file", "parameters", "coordinates", "lagrangian", "constraints", "description"}
+_RIGID_INITIAL = {"M", "omega", "m", "R"}
+_GENERAL_INITIAL = {"q", "q_dot", "p", "project"}
+
+
+@dataclass
+class Scene:
+    """A parsed scene: the problem and the arguments of :func:`dirac.flows.integrate`."""
+
+    problem: object
+    run: dict[str, object]
+    source: str
+    system: str
+    meta: dict[str, object] = field(default_factory=dict)
+
+
+def _warn_unknown(table: dict, known: set[str], where: str, source: str) -> None:
+    unknown = sorted(set(table) - known)
+    if unknown:
+        warn(f"{source}: unknown key(s) in {where} ignored: {', '.join(unknown)}")
+
+
+def _table(data: dict, key: str, source: str, required: bool = True) -> dict:
+    value = data.get(key)
+    if value is None:
+        if required:
+            raise InputError(f"{source}: missing [{key}] table (see CONTRACTS §6 for the scene format)")
+        return {}
+    if not isinstance(value, dict):
+        raise InputError(f"{source}: [{key}] must be a table")
+    return value
+
+
+def _number(value: object, name: str, source: str, positive: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise InputError(f"{source}: {name} = {value!r} must be a finite number")
+    if positive and value <= 0:
+        raise InputError(f"{source}: {name} = {value!r} must be > 0")
+    return float(value)
+
+
+def _vector(value: object, name: str, source: str, shape: tuple[int, ...]) -> np.ndarray:
+    return as_float_array(value, name, shape, prefix=f"{source}: ")
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file.
+
+    Raises
+    ------
+    InputError
+        Missing file, invalid TOML, missing or malformed keys, bad initial data; the
+        message names the file and the key.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"scene file {str(path)!r} does not exist")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
+    return scene_from_dict(data, source=str(path), base=path.parent)
+
+
+def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None) -> Scene:
+    """Build a :class:`Scene` from the parsed TOML tables (see the module docstring)."""
+    _warn_unknown(data, _TOP_KEYS, "the scene", source)
+    system = _table(data, "system", source)
+    initial = _table(data, "initial", source)
+    run_table = _table(data, "run", source)
+    run = _run_options(run_table, source)
+    name = system.get("name")
+    if name in SCENE_SYSTEMS:
+        problem = _rigid_problem(str(name), system, initial, source)
+    else:
+        problem = _general_problem(system, initial, source, base or Path("."))
+    meta = {"scene": source}
+    return Scene(problem=problem, run=run, source=source, system=str(problem.system), meta=meta)  # type: ignore[attr-defined]
+
+
+def _run_options(table: dict, source: str) -> dict[str, object]:
+    _warn_unknown(table, _RUN_KEYS, "[run]", source)
+    if "t_end" not in table:
+        raise InputError(f"{source}: [run] lacks the required key 't_end' (the final time)")
+    run: dict[str, object] = {"t_end": _number(table["t_end"], "[run] t_end", source, positive=True)}
+    method = table.get("method", "auto")
+    if not isinstance(method, str):
+        raise InputError(f"{source}: [run] method must be a name (a string), e.g. \"auto\"")
+    run["method"] = method
+    if "dt" in table:
+        run["dt"] = _number(table["dt"], "[run] dt", source, positive=True)
+    for key in ("tolerance", "drift_limit", "newton_tolerance"):
+        if key in table:
+            run[key] = _number(table[key], f"[run] {key}", source, positive=True)
+    for key in ("samples", "max_newton_iterations"):
+        if key in table:
+            value = table[key]
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise InputError(f"{source}: [run] {key} = {value!r} must be an integer >= 1")
+            run[key] = value
+    if "outputs" in table:
+        outputs = table["outputs"]
+        if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
+            raise InputError(f"{source}: [run] outputs must be a list of names, e.g. [\"M\", \"energy\"]")
+        run["outputs"] = outputs
+    return run
+
+
+def _rigid_problem(name: str, system: dict, initial: dict, source: str):  # noqa: ANN202
+    from dirac.flows.problems import HeavyTopProblem, RigidBodyProblem
+
+    _warn_unknown(system, _HEAVY_KEYS if name == "heavy_top" else _RIGID_KEYS, "[system]", source)
+    _warn_unknown(initial, _RIGID_INITIAL, "[initial]", source)
+    if "inertia" not in system:
+        raise InputError(f"{source}: [system] lacks 'inertia' (the principal moments [I1, I2, I3])")
+    inertia = _vector(system["inertia"], "[system] inertia", source, (3,))
+    R = _vector(initial["R"], "[initial] R", source, (3, 3)) if "R" in initial else np.eye(3)
+    given = [key for key in ("M", "omega", "m") if key in initial]
+    if len(given) != 1:
+        raise InputError(
+            f"{source}: [initial] must give exactly one of M (body angular momentum), omega (body angular "
+            f"velocity) or m (lab angular momentum); it gives {', '.join(given) or 'none'}"
+        )
+    key = given[0]
+    vector = _vector(initial[key], f"[initial] {key}", source, (3,))
+    if key == "omega":
+        M = inertia * vector
+    elif key == "m":
+        from dirac.rigidbody.inertia import validate_rotation
+
+        M = validate_rotation(R).T @ vector
+    else:
+        M = vector
+    if name == "heavy_top":
+        weight = _number(system.get("mass_gravity", 1.0), "[system] mass_gravity", source)
+        chi = _vector(system.get("center_of_mass", [0.0, 0.0, 1.0]), "[system] center_of_mass", source, (3,))
+        return HeavyTopProblem(inertia, M, R, mass_gravity=weight, center_of_mass=chi)
+    return RigidBodyProblem(inertia, M, R)
+
+
+def _general_problem(system: dict, initial: dict, source: str, base: Path):  # noqa: ANN202
+    from dirac.flows.mechanics import MechanicalSystem
+    from dirac.flows.problems import ConstrainedProblem
+    from dirac.model.lagrangian import lagrangian_from_table
+    from dirac.model.systems import load_system
+
+    _warn_unknown(system, _LAGRANGIAN_KEYS, "[system]", source)
+    _warn_unknown(initial, _GENERAL_INITIAL, "[initial]", source)
+    if "file" in system:
+        file = Path(str(system["file"]))
+        if not file.is_absolute():
+            file = base / file
+        lagrangian = load_system(file)
+    elif "lagrangian" in system:
+        table = {k: v for k, v in system.items() if k not in ("file",)}
+        lagrangian = lagrangian_from_table(table, source=f"{source} [system]")
+        system = {k: v for k, v in system.items() if k != "parameters"}  # values already in the table
+    elif isinstance(system.get("name"), str):
+        lagrangian = load_system(system["name"])
+    else:
+        raise InputError(
+            f"{source}: [system] needs name (rigid_body, heavy_top or a built-in system; 'dirac systems' lists "
+            "them), file (a system file) or an inline system (coordinates, lagrangian, constraints)"
+        )
+    overrides = system.get("parameters", {})
+    if not isinstance(overrides, dict):
+        raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ l = 2.0 }}")
+    try:
+        mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides)
+    except InputError as exc:
+        if "velocities" not in str(exc):
+            raise
+        return _analysed_problem(lagrangian, overrides, initial, source)
+    names = mechanics.coordinate_names
+    if "q" not in initial:
+        raise InputError(f"{source}: [initial] lacks q (the coordinates {', '.join(names)})")
+    q = _coordinates(initial["q"], "q", names, source, required=True)
+    if "q_dot" in initial and "p" in initial:
+        raise InputError(f"{source}: [initial] gives both q_dot and p; give one of them")
+    if "p" in initial:
+        p = _coordinates(initial["p"], "p", names, source, required=False)
+    else:
+        velocity = _coordinates(initial.get("q_dot", {}), "q_dot", names, source, required=False)
+        p = mechanics.mass_matrix(q) @ velocity
+    project = initial.get("project", False)
+    if not isinstance(project, bool):
+        raise InputError(f"{source}: [initial] project must be true or false")
+    if project:
+        q, p = mechanics.project(q, p)
+    try:
+        return ConstrainedProblem(mechanics, q, p)
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def _analysed_problem(lagrangian, overrides: dict, initial: dict, source: str):  # noqa: ANN001, ANN202
+    """A Lagrangian that is not of the form 1/2 q_dot^T M q_dot - V (velocity-linear or
+    singular): integrate the Dirac vector field of its analysis (``midpoint``, scipy)."""
+    from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
+
+    analysed = AnalysedSystem.from_lagrangian(lagrangian, overrides)
+    names = tuple(s.name for s in lagrangian.coordinates)
+    if "q" not in initial:
+        raise InputError(f"{source}: [initial] lacks q (the coordinates {', '.join(names)})")
+    q = dict(zip(names, _coordinates(initial["q"], "q", names, source, required=True).tolist()))
+    if "p" in initial:
+        p = dict(zip(names, _coordinates(initial["p"], "p", names, source, required=False).tolist()))
+        z0 = analysed.initial_state(q, p=p)
+    else:
+        velocity = dict(zip(names, _coordinates(initial.get("q_dot", {}), "q_dot", names, source, required=False).tolist()))
+        z0 = analysed.initial_state(q, q_dot=velocity)
+    try:
+        return AnalysedProblem(analysed, z0)
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def _coordinates(value: object, key: str, names: tuple[str, ...], source: str, required: bool) -> np.ndarray:
+    if isinstance(value, list):
+        array = _vector(value, f"[initial] {key}", source, (len(names),))
+        return array
+    if not isinstance(value, dict):
+        raise InputError(f"{source}: [initial] {key} must be a table {{ {names[0]} = ... }} or a list")
+    unknown = sorted(set(value) - set(names))
+    if unknown:
+        raise InputError(f"{source}: [initial] {key} names unknown coordinates {', '.join(unknown)}; the coordinates are {', '.join(names)}")
+    missing = [n for n in names if n not in value]
+    if missing and required:
+        raise InputError(f"{source}: [initial] {key} lacks {', '.join(missing)}")
+    return np.array([_number(value.get(n, 0.0), f"[initial] {key}.{n}", source) for n in names])

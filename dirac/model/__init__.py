@@ -1,0 +1,1 @@
+"""The symbolic input: safe expressions, the :class:`Lagrangian`, and the built-in systems."""

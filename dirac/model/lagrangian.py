@@ -1,0 +1,397 @@
+"""The symbolic input of the engine: a Lagrangian with holonomic constraints.
+
+A :class:`Lagrangian` holds coordinates ``q``, their velocities ``q_dot``, parameters,
+the expression ``L(q, q_dot)`` and holonomic constraints ``chi_a(q) = 0``. The Dirac
+analysis (:func:`dirac.analyze`) treats the multipliers of the constraints as
+dynamical variables, as in the paper's extended Lagrangian (1):
+
+    L_ext = L(q, q_dot) - sum_a lambda_a chi_a(q).
+
+Lagrangians come from the Python API (:meth:`Lagrangian.from_strings` or sympy
+expressions directly), from a system file (CONTRACTS §3, :func:`read_system_file`), or
+from a built-in factory (:func:`dirac.load_system`).
+"""
+
+from __future__ import annotations
+
+import keyword
+import math
+import re
+import tomllib
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import sympy
+
+from dirac.errors import DiracError, InputError, warn
+from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
+
+__all__ = ["Lagrangian", "read_system_file", "velocity_name", "momentum_name", "multiplier_name"]
+
+_IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_SYSTEM_KEYS = {"name", "coordinates", "parameters", "lagrangian", "constraints", "description"}
+
+
+def velocity_name(coordinate: str) -> str:
+    """Name of the velocity of ``coordinate``: ``x`` -> ``x_dot`` (CONTRACTS §3)."""
+    return f"{coordinate}_dot"
+
+
+def momentum_name(coordinate: str) -> str:
+    """Name of the momentum of ``coordinate``: ``x`` -> ``p_x`` (CONTRACTS §3)."""
+    return f"p_{coordinate}"
+
+
+def multiplier_name(index: int) -> str:
+    """Name of the multiplier of constraint ``index`` (1-based): ``lambda_1``, …"""
+    return f"lambda_{index}"
+
+
+def _as_rational(value: float | int) -> sympy.Rational:
+    """Exact rational of a parameter value as written (``0.1`` -> ``1/10``)."""
+    if isinstance(value, int):
+        return sympy.Integer(value)
+    return sympy.Rational(repr(float(value)))
+
+
+@dataclass(frozen=True)
+class Lagrangian:
+    """A Lagrangian ``L(q, q_dot)`` with holonomic constraints ``chi(q) = 0``.
+
+    Parameters
+    ----------
+    name
+        Short name of the system (used in reports and result files).
+    coordinates
+        The generalized coordinates ``q`` as sympy symbols, in order.
+    velocities
+        The velocities ``q_dot``, one per coordinate, in the same order.
+    expression
+        ``L(q, q_dot)``; may contain the parameter symbols.
+    constraints
+        Holonomic constraint functions ``chi_a(q)``, "expressions that should be zero";
+        they must not contain velocities.
+    parameters
+        Parameter symbol -> default numerical value (``None`` if it has none). Parameters
+        stay symbolic in the analysis until fixed with :meth:`fix`; numerical flows use
+        the defaults.
+    description
+        One line saying what the system is.
+    validator
+        Optional check of parameter values: called by :meth:`fix` with every parameter
+        fixed so far (name -> number); raises :class:`~dirac.errors.InputError` for values
+        the system cannot take (e.g. an inertia whose mass matrix (66) is not positive).
+    fixed_values
+        The parameters fixed so far (name -> number); kept for ``validator``.
+
+    Notes
+    -----
+    Construction validates the input: coordinates are distinct identifiers, no name is
+    used twice or clashes with the generated names (``<q>_dot``, ``p_<q>``,
+    ``lambda_<k>``), ``L`` is not empty, constraints are holonomic and not identically
+    zero, and parameter values are finite.
+    """
+
+    name: str
+    coordinates: tuple[sympy.Symbol, ...]
+    velocities: tuple[sympy.Symbol, ...]
+    expression: sympy.Expr
+    constraints: tuple[sympy.Expr, ...] = ()
+    parameters: Mapping[sympy.Symbol, float | None] = field(default_factory=dict)
+    description: str = ""
+    validator: Callable[[Mapping[str, float]], None] | None = field(default=None, compare=False, repr=False)
+    fixed_values: Mapping[str, float] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "coordinates", tuple(self.coordinates))
+        object.__setattr__(self, "velocities", tuple(self.velocities))
+        object.__setattr__(self, "constraints", tuple(sympy.sympify(c) for c in self.constraints))
+        object.__setattr__(self, "expression", sympy.sympify(self.expression))
+        object.__setattr__(self, "parameters", dict(self.parameters))
+        object.__setattr__(self, "fixed_values", dict(self.fixed_values))
+        self._validate()
+
+    # ----------------------------------------------------------------- validation
+    def _validate(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise InputError("system name is empty: give the system a name")
+        if not self.coordinates:
+            raise InputError(f"system {self.name!r} has no coordinates: list at least one")
+        if len(self.velocities) != len(self.coordinates):
+            raise InputError(
+                f"system {self.name!r} has {len(self.coordinates)} coordinates but "
+                f"{len(self.velocities)} velocities: give one velocity per coordinate"
+            )
+        _check_names(self.coordinates, self.velocities, tuple(self.parameters), len(self.constraints))
+        for p, value in self.parameters.items():
+            if value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise InputError(f"parameter {p.name!r} = {value!r} is not a number")
+            if not math.isfinite(value):
+                raise InputError(f"parameter {p.name!r} = {value!r} is not finite: give a finite number")
+
+        allowed = set(self.coordinates) | set(self.velocities) | set(self.parameters)
+        if self.expression == 0:
+            raise InputError(f"the Lagrangian of {self.name!r} is empty (zero): give L(q, q_dot)")
+        unknown = self.expression.free_symbols - allowed
+        if unknown:
+            names = ", ".join(sorted(s.name for s in unknown))
+            raise InputError(f"the Lagrangian of {self.name!r} uses unknown names: {names}")
+        velocity_set = set(self.velocities)
+        for index, chi in enumerate(self.constraints, start=1):
+            label = f"constraint {index} ({chi})"
+            extra = chi.free_symbols - allowed
+            if extra:
+                names = ", ".join(sorted(s.name for s in extra))
+                raise InputError(f"{label} uses unknown names: {names}")
+            in_velocity = sorted(s.name for s in chi.free_symbols & velocity_set)
+            if in_velocity:
+                raise InputError(
+                    f"{label} contains the velocities {', '.join(in_velocity)}: only holonomic "
+                    "constraints chi(q) = 0 are supported; write it in the coordinates alone"
+                )
+            if chi == 0:
+                raise InputError(f"{label} is identically zero: remove it")
+            if not (chi.free_symbols & set(self.coordinates)):
+                raise InputError(
+                    f"{label} does not depend on any coordinate: a constraint chi(q) = 0 must restrict q"
+                )
+
+    # ----------------------------------------------------------------- construction
+    @classmethod
+    def from_strings(
+        cls,
+        name: str,
+        coordinates: Sequence[str],
+        lagrangian: str,
+        constraints: Iterable[str] = (),
+        parameters: Mapping[str, float | None] | None = None,
+        description: str = "",
+    ) -> "Lagrangian":
+        """Build a Lagrangian from expressions written as text (CONTRACTS §3).
+
+        Examples
+        --------
+        >>> pendulum = Lagrangian.from_strings(
+        ...     "pendulum", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",
+        ...     constraints=["x**2 + y**2 - l**2"], parameters={"m": 1.0, "g": 9.81, "l": 1.0})
+        >>> pendulum.constraints
+        (x**2 + y**2 - l**2,)
+        """
+        if isinstance(coordinates, str) or not isinstance(coordinates, Sequence):
+            raise InputError("coordinates must be a list of names, e.g. ['x', 'y']")
+        if isinstance(constraints, str):
+            raise InputError("constraints must be a list of expressions, e.g. ['x**2 + y**2 - l**2']")
+        parameters = dict(parameters or {})
+        labels = [str(c) for c in coordinates]
+        for label in [*labels, *parameters]:
+            if not isinstance(label, str) or not _IDENTIFIER.match(label) or keyword.iskeyword(label):
+                raise InputError(f"name {label!r} is not a valid name: use letters, digits and '_', starting with a letter")
+        duplicates = sorted({x for x in labels if labels.count(x) > 1} | (set(labels) & set(parameters)))
+        if duplicates:
+            raise InputError(f"name(s) {', '.join(duplicates)} used twice among coordinates and parameters")
+        q = tuple(sympy.Symbol(c, real=True) for c in labels)
+        v = tuple(sympy.Symbol(velocity_name(c), real=True) for c in labels)
+        psyms = {label: sympy.Symbol(label, real=True) for label in parameters}
+        constraints = list(constraints)
+        _check_names(q, v, tuple(psyms.values()), len(constraints))
+        names = {s.name: s for s in (*q, *v, *psyms.values())}
+        expr = parse_expression(lagrangian, names, what="lagrangian")
+        chis = tuple(
+            parse_expression(text, names, what=f"constraint {k}") for k, text in enumerate(constraints, start=1)
+        )
+        values = {psyms[label]: (None if value is None else value) for label, value in parameters.items()}
+        for label, value in parameters.items():
+            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+                raise InputError(f"parameter {label!r} = {value!r} is not a number")
+        return cls(name, q, v, expr, chis, values, description)
+
+    # ----------------------------------------------------------------- derived views
+    @property
+    def parameter_symbols(self) -> dict[str, sympy.Symbol]:
+        """Parameter name -> symbol."""
+        return {p.name: p for p in self.parameters}
+
+    @property
+    def parameter_values(self) -> dict[str, float | None]:
+        """Parameter name -> default value (``None`` if none)."""
+        return {p.name: value for p, value in self.parameters.items()}
+
+    @property
+    def symbols(self) -> dict[str, sympy.Symbol]:
+        """Every symbol of the input by name: coordinates, velocities, parameters."""
+        return {s.name: s for s in (*self.coordinates, *self.velocities, *self.parameters)}
+
+    def velocity_of(self, coordinate: sympy.Symbol) -> sympy.Symbol:
+        """The velocity symbol that belongs to ``coordinate``."""
+        return self.velocities[self.coordinates.index(coordinate)]
+
+    def fix(self, **values: float) -> "Lagrangian":
+        """Substitute numbers for some parameters; the others stay symbolic.
+
+        Values are substituted as exact rationals of the numbers as written, so the
+        symbolic analysis stays exact.
+
+        Raises
+        ------
+        InputError
+            For a name that is not a parameter, a value that is not a finite number, or
+            values the system's ``validator`` refuses.
+        """
+        symbols = self.parameter_symbols
+        substitution: dict[sympy.Symbol, sympy.Expr] = {}
+        remaining = dict(self.parameters)
+        for label, value in values.items():
+            if label not in symbols:
+                known = ", ".join(sorted(symbols)) or "(none)"
+                raise InputError(f"{self.name!r} has no parameter {label!r}; its parameters are: {known}")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise InputError(f"parameter {label!r} = {value!r} must be a finite number")
+            substitution[symbols[label]] = _as_rational(value)
+            remaining.pop(symbols[label])
+        merged = {**self.fixed_values, **{k: float(v) for k, v in values.items()}}
+        if self.validator is not None:
+            self.validator(merged)
+        return Lagrangian(
+            self.name,
+            self.coordinates,
+            self.velocities,
+            self.expression.subs(substitution),
+            tuple(c.subs(substitution) for c in self.constraints),
+            remaining,
+            self.description,
+            self.validator,
+            merged,
+        )
+
+    def with_defaults(self) -> "Lagrangian":
+        """All parameters that have a default value fixed to it (for numerical work)."""
+        return self.fix(**{p.name: v for p, v in self.parameters.items() if v is not None})
+
+    def __str__(self) -> str:
+        lines = [f"{self.name}: L = {self.expression}"]
+        lines += [f"  constraint {k}: {c} = 0" for k, c in enumerate(self.constraints, start=1)]
+        return "\n".join(lines)
+
+
+def _check_names(
+    coordinates: Sequence[sympy.Symbol],
+    velocities: Sequence[sympy.Symbol],
+    parameters: Sequence[sympy.Symbol],
+    n_constraints: int,
+) -> None:
+    """Every name is a valid identifier, used once, and clashes with no generated name."""
+    seen: dict[str, str] = {}
+
+    def claim(sym: object, role: str) -> None:
+        if not isinstance(sym, sympy.Symbol):
+            raise InputError(f"{role} {sym!r} must be a sympy Symbol")
+        label = sym.name
+        if not _IDENTIFIER.match(label) or keyword.iskeyword(label):
+            raise InputError(
+                f"{role} name {label!r} is not a valid name: use letters, digits and '_', starting with a letter"
+            )
+        if label in ALLOWED_FUNCTIONS or label in ALLOWED_CONSTANTS:
+            raise InputError(f"{role} name {label!r} is reserved for a function or constant: rename it")
+        if label in seen:
+            raise InputError(f"name {label!r} is used twice (as {seen[label]} and as {role}): names must be distinct")
+        seen[label] = role
+
+    for q in coordinates:
+        claim(q, "coordinate")
+    for v in velocities:
+        claim(v, "velocity")
+    for p in parameters:
+        claim(p, "parameter")
+    generated = {momentum_name(q.name) for q in coordinates}
+    generated |= {multiplier_name(k + 1) for k in range(n_constraints)}
+    generated |= {momentum_name(multiplier_name(k + 1)) for k in range(n_constraints)}
+    for label, role in seen.items():
+        if label in generated:
+            raise InputError(
+                f"{role} name {label!r} clashes with a name the engine generates "
+                "(momenta p_<q>, multipliers lambda_<k>): rename it"
+            )
+
+
+def read_system_file(path: str | Path) -> Lagrangian:
+    """Read a system file: TOML as in CONTRACTS §3, or a ``.py`` file defining ``system()``.
+
+    Unknown keys in ``[system]`` are warned about (by name) and ignored.
+
+    Raises
+    ------
+    InputError
+        If the file is missing, malformed, lacks a required key, or describes an invalid
+        Lagrangian; the message names the file and the item.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"system file {str(path)!r} does not exist")
+    if path.suffix == ".py":
+        return _read_python_system(path)
+    if path.suffix != ".toml":
+        raise InputError(f"system file {str(path)!r} must end in .toml or .py")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"system file {str(path)!r} is not valid TOML: {exc}") from None
+    return lagrangian_from_table(data.get("system"), source=str(path))
+
+
+def lagrangian_from_table(table: object, source: str = "system table") -> Lagrangian:
+    """Build a :class:`Lagrangian` from the ``[system]`` table of a system file."""
+    if not isinstance(table, dict):
+        raise InputError(f"{source}: missing [system] table (see CONTRACTS §3 for the format)")
+    unknown = sorted(set(table) - _SYSTEM_KEYS)
+    if unknown:
+        warn(f"{source}: unknown key(s) in [system] ignored: {', '.join(unknown)}")
+    for key in ("name", "coordinates", "lagrangian"):
+        if key not in table:
+            raise InputError(f"{source}: [system] lacks the required key {key!r}")
+    name, coordinates, lagrangian = table["name"], table["coordinates"], table["lagrangian"]
+    constraints = table.get("constraints", [])
+    parameters = table.get("parameters", {})
+    if not isinstance(name, str):
+        raise InputError(f"{source}: [system] name must be a string")
+    if not isinstance(coordinates, list) or not all(isinstance(c, str) for c in coordinates):
+        raise InputError(f"{source}: [system] coordinates must be a list of names, e.g. [\"x\", \"y\"]")
+    if not isinstance(lagrangian, str):
+        raise InputError(f"{source}: [system] lagrangian must be a string expression")
+    if not isinstance(constraints, list) or not all(isinstance(c, str) for c in constraints):
+        raise InputError(f"{source}: [system] constraints must be a list of string expressions")
+    if not isinstance(parameters, dict):
+        raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ m = 1.0 }}")
+    try:
+        return Lagrangian.from_strings(
+            name, coordinates, lagrangian, constraints, parameters, str(table.get("description", ""))
+        )
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def _read_python_system(path: Path) -> Lagrangian:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(f"_dirac_user_system_{abs(hash(path))}", path)
+    if spec is None or spec.loader is None:
+        raise InputError(f"system file {str(path)!r} cannot be imported")
+    module = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:  # the user's own code failed: report it, do not crash
+        raise InputError(f"system file {str(path)!r} failed to import: {type(exc).__name__}: {exc}") from exc
+    factory = getattr(module, "system", None)
+    if not callable(factory):
+        raise InputError(f"system file {str(path)!r} must define a function system() returning a dirac.Lagrangian")
+    try:
+        result = factory()
+    except DiracError:
+        raise
+    except Exception as exc:  # the user's own code failed: report it, do not crash
+        raise InputError(f"system() in {str(path)!r} failed: {type(exc).__name__}: {exc}") from exc
+    if not isinstance(result, Lagrangian):
+        raise InputError(f"system() in {str(path)!r} returned {type(result).__name__}, not a dirac.Lagrangian")
+    return result
