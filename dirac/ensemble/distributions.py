@@ -9,7 +9,7 @@ is cut into chunks.
 
 Quantities and their distributions:
 
-``M`` (body angular momentum, PHYSICS.md §2)
+``M`` (body angular momentum, docs/conventions.md)
     ``fixed`` (``value``), ``sphere`` (uniform on the sphere ``|M| = norm``: a standard
     normal 3-vector scaled to length ``norm``, Muller 1959), ``gaussian`` (``mean`` +
     ``std`` times a standard normal 3-vector; ``std`` a number or one per component;
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dirac.errors import InputError, warn
-from dirac.rigidbody.inertia import as_float_array
+from dirac.validate import validate_array, validate_positive
 
 __all__ = [
     "Distribution",
@@ -179,14 +179,11 @@ _KEYS = {
 def _vector(table: dict, key: str, where: str, shape: tuple[int, ...] = (3,)) -> np.ndarray:
     if key not in table:
         raise InputError(f"{where} needs '{key}' ({shape[0]} numbers)")
-    return as_float_array(table[key], f"{where}.{key}", shape)
+    return validate_array(table[key], f"{where}.{key}", shape)
 
 
 def _positive(table: dict, key: str, where: str) -> float:
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
-        raise InputError(f"{where}.{key} = {value!r} must be a finite number > 0")
-    return float(value)
+    return validate_positive(table[key], f"{where}.{key}")
 
 
 def parse_distribution(

@@ -1,4 +1,4 @@
-"""Scene files (CONTRACTS §6): a system, its initial state and how to run it.
+"""Scene files (docs/file_formats.md): a system, its initial state and how to run it.
 
 ```toml
 [system]
@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from dirac.errors import InputError, warn
-from dirac.rigidbody.inertia import as_float_array
+from dirac.validate import validate_array
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "SCENE_SYSTEMS", "FLAGSHIP_SCENE"]
 
@@ -54,7 +54,7 @@ SCENE_SYSTEMS: dict[str, str] = {
     "heavy_top": "rigid body with a fixed point in uniform gravity; adds mass_gravity (m g) and center_of_mass (body frame)",
 }
 
-#: The flagship scene of ``dirac demo``: the standard body of PHYSICS.md §4.
+#: The flagship scene of ``dirac demo``: the standard test case of docs/conventions.md.
 FLAGSHIP_SCENE: dict[str, object] = {
     "system": {"name": "rigid_body", "inertia": [2.0, 1.0, 2.0 / 3.0]},
     "initial": {"M": [math.cos(1.1), 0.0, math.sin(1.1)]},
@@ -98,7 +98,7 @@ def _table(data: dict, key: str, source: str, required: bool = True) -> dict:
     value = data.get(key)
     if value is None:
         if required:
-            raise InputError(f"{source}: missing [{key}] table (see CONTRACTS §6 for the scene format)")
+            raise InputError(f"{source}: missing [{key}] table (a scene needs [system], [initial] and [run]; see docs/file_formats.md)")
         return {}
     if not isinstance(value, dict):
         raise InputError(f"{source}: [{key}] must be a table")
@@ -114,7 +114,7 @@ def _number(value: object, name: str, source: str, positive: bool = False) -> fl
 
 
 def _vector(value: object, name: str, source: str, shape: tuple[int, ...]) -> np.ndarray:
-    return as_float_array(value, name, shape, prefix=f"{source}: ")
+    return validate_array(value, f"{source}: {name}", shape)
 
 
 def load_scene(path: str | Path) -> Scene:

@@ -9,55 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 from dirac.errors import InputError, warn
+from dirac.validate import validate_array
 
 __all__ = ["validate_inertia", "validate_rotation", "validate_momentum"]
-
-
-def _has_boolean(value: object) -> bool:
-    """Whether ``value`` is or contains a boolean (``True`` would silently become 1.0)."""
-    if isinstance(value, (bool, np.bool_)):
-        return True
-    if isinstance(value, np.ndarray):
-        return value.dtype == bool or (value.dtype == object and any(_has_boolean(v) for v in value.flat))
-    if isinstance(value, (list, tuple)):
-        return any(_has_boolean(v) for v in value)
-    return False
-
-
-def as_float_array(value: object, name: str, shape: tuple[int, ...], prefix: str = "") -> np.ndarray:
-    """Read ``value`` as a finite float64 array of the given shape (scene and API inputs).
-
-    Parameters
-    ----------
-    value : object
-        A number, list or array; booleans are refused (``True`` would become 1.0).
-    name : str
-        How messages name the value, e.g. ``"inertia"`` or ``"[initial] M"``.
-    shape : tuple of int
-        Required shape.
-    prefix : str
-        Prepended to every message (e.g. ``"scene.toml: "``).
-
-    Returns
-    -------
-    numpy.ndarray
-
-    Raises
-    ------
-    InputError
-        Booleans, non-numeric entries, wrong shape or non-finite entries.
-    """
-    if _has_boolean(value):
-        raise InputError(f"{prefix}{name} = {value!r} contains true/false; give {shape} real numbers")
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{prefix}{name} = {value!r} is not numeric; give {shape} real numbers") from exc
-    if array.shape != shape:
-        raise InputError(f"{prefix}{name} has shape {array.shape}; it must have shape {shape}")
-    if not np.all(np.isfinite(array)):
-        raise InputError(f"{prefix}{name} = {array.tolist()} has non-finite entries; give finite numbers")
-    return array
 
 
 def validate_inertia(inertia: object) -> np.ndarray:
@@ -65,9 +19,10 @@ def validate_inertia(inertia: object) -> np.ndarray:
 
     The moments are ``I_1 = g_2 + g_3`` etc. (72) with ``g_i >= 0`` the principal values
     of the mass matrix (66); hence ``I_i > 0`` and the triangle inequality
-    ``I_i + I_j >= I_k`` (PHYSICS.md §2). A violation of the triangle inequality is legal
-    for the Euler–Poisson equations (250)–(251) (e.g. the standard test case
-    ``I = (2, 1, 2/3)``), so it only warns, once per call, and goes on.
+    ``I_i + I_j >= I_k`` (docs/conventions.md, "Principal moments and the triangle
+    inequality"). A violation of the triangle inequality is legal for the Euler–Poisson
+    equations (250)–(251) (e.g. the standard test case ``I = (2, 1, 2/3)``), so it only
+    warns, once per call, and goes on.
 
     Parameters
     ----------
@@ -84,7 +39,7 @@ def validate_inertia(inertia: object) -> np.ndarray:
     InputError
         Wrong shape, non-finite or non-positive entries.
     """
-    moments = as_float_array(inertia, "inertia", (3,))
+    moments = validate_array(inertia, "inertia", (3,))
     if np.any(moments <= 0.0):
         raise InputError(
             f"inertia = {moments.tolist()} has a non-positive moment; every principal "
@@ -129,7 +84,7 @@ def validate_rotation(rotation: object, tol: float = 1e-10) -> np.ndarray:
     InputError
         Wrong shape, non-finite entries, not orthogonal, or left-handed (``det R = -1``).
     """
-    matrix = as_float_array(rotation, "R", (3, 3))
+    matrix = validate_array(rotation, "R", (3, 3))
     defect = float(np.max(np.abs(matrix.T @ matrix - np.eye(3))))
     if defect > tol:
         raise InputError(
@@ -156,7 +111,7 @@ def validate_momentum(momentum: object) -> np.ndarray:
     Parameters
     ----------
     momentum : array_like, shape (3,)
-        Body angular momentum ``M = I Omega`` (PHYSICS.md §2).
+        Body angular momentum ``M = I Omega`` (docs/conventions.md).
 
     Returns
     -------
@@ -168,7 +123,7 @@ def validate_momentum(momentum: object) -> np.ndarray:
         Wrong shape, non-finite entries, or so large that ``|M|^2`` overflows (then no
         invariant of (247)-(249) can be evaluated).
     """
-    array = as_float_array(momentum, "M", (3,))
+    array = validate_array(momentum, "M", (3,))
     with np.errstate(over="ignore"):
         square = float(array @ array)
     if not np.isfinite(square):

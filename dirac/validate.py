@@ -1,0 +1,203 @@
+"""Checks of the numbers, flags and arrays a user hands to `dirac`.
+
+Each ``validate_*`` helper returns the cleaned value (a ``float``, ``int``, ``bool`` or
+float64 array) or raises :class:`dirac.errors.InputError` with one line that names the
+input and says what to give instead. ``name`` is how the message names the input, with
+any location in front of it, e.g. ``"scene.toml: [run] dt"``.
+
+``True`` and ``False`` are never numbers here: Python and numpy would silently read them
+as 1 and 0, so a scene with ``M = [false, 0.2, 0.1]`` would run a body nobody asked for.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TypeGuard
+
+import numpy as np
+
+from dirac.errors import InputError
+
+__all__ = [
+    "contains_boolean",
+    "validate_finite",
+    "validate_positive",
+    "validate_non_negative",
+    "validate_integer",
+    "validate_boolean",
+    "validate_array",
+]
+
+
+def contains_boolean(value: object) -> bool:
+    """Whether ``value`` is, or (as a list, tuple or array) contains, ``True`` or ``False``."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype == bool or (value.dtype == object and any(contains_boolean(v) for v in value.flat))
+    if isinstance(value, (list, tuple)):
+        return any(contains_boolean(v) for v in value)
+    return False
+
+
+def _is_real_number(value: object) -> TypeGuard[float]:
+    """A Python or numpy integer or float, not a boolean."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_integer(value: object) -> TypeGuard[int]:
+    """A Python or numpy integer, not a boolean."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _with_hint(message: str, hint: str) -> str:
+    return f"{message} ({hint})" if hint else message
+
+
+def validate_finite(value: object, name: str, hint: str = "") -> float:
+    """A finite real number.
+
+    Parameters
+    ----------
+    value : object
+        The input.
+    name : str
+        How the message names the input.
+    hint : str
+        What the number means, added to the message in parentheses.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    InputError
+        ``"<name> = <value> must be a finite number"`` for booleans, non-numbers, NaN and
+        infinities.
+    """
+    if not _is_real_number(value) or not math.isfinite(value):
+        raise InputError(_with_hint(f"{name} = {value!r} must be a finite number", hint))
+    return float(value)
+
+
+def validate_positive(value: object, name: str, hint: str = "") -> float:
+    """A finite real number ``> 0`` (a time, a step, a tolerance, a radius).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    InputError
+        ``"<name> = <value> must be a finite number > 0"``.
+    """
+    if not _is_real_number(value) or not math.isfinite(value) or value <= 0:
+        raise InputError(_with_hint(f"{name} = {value!r} must be a finite number > 0", hint))
+    return float(value)
+
+
+def validate_non_negative(value: object, name: str, hint: str = "") -> float:
+    """A finite real number ``>= 0`` (a weight, a spread).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    InputError
+        ``"<name> = <value> must be a finite number >= 0"``.
+    """
+    if not _is_real_number(value) or not math.isfinite(value) or value < 0:
+        raise InputError(_with_hint(f"{name} = {value!r} must be a finite number >= 0", hint))
+    return float(value)
+
+
+def validate_integer(value: object, name: str, minimum: int = 1, maximum: int | None = None, hint: str = "") -> int:
+    """An integer in ``[minimum, maximum]`` (a count, a number of samples or iterations).
+
+    A float such as ``2.0`` is refused: a count written with a decimal point is a typo
+    more often than not.
+
+    Parameters
+    ----------
+    value : object
+        The input.
+    name : str
+        How the message names the input.
+    minimum : int
+        Smallest value accepted (1: a positive integer).
+    maximum : int, optional
+        Largest value accepted; none by default.
+    hint : str
+        What the number means, added to the message in parentheses.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    InputError
+        ``"<name> = <value> must be an integer >= <minimum>"`` (or ``in [minimum, maximum]``).
+    """
+    if not _is_integer(value) or value < minimum or (maximum is not None and value > maximum):
+        bound = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
+        raise InputError(_with_hint(f"{name} = {value!r} must be an integer {bound}", hint))
+    return int(value)
+
+
+def validate_boolean(value: object, name: str) -> bool:
+    """``True`` or ``False`` (not 0, 1 or a string).
+
+    Raises
+    ------
+    InputError
+        ``"<name> must be true or false"``.
+    """
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{name} must be true or false")
+    return bool(value)
+
+
+def validate_array(value: object, name: str, shape: Sequence[int] | None = None, finite: bool = True) -> np.ndarray:
+    """An array of real numbers: a number, list or array read as float64.
+
+    Parameters
+    ----------
+    value : object
+        The input; booleans anywhere in it are refused.
+    name : str
+        How the message names the input, e.g. ``"inertia"`` or ``"scene.toml: [initial] M"``.
+    shape : sequence of int, optional
+        The required shape; any shape when omitted.
+    finite : bool
+        Whether NaN and infinities are refused.
+
+    Returns
+    -------
+    numpy.ndarray
+        A new float64 array.
+
+    Raises
+    ------
+    InputError
+        Booleans (``contains true/false``), entries that are not numbers (``is not
+        numeric``), another shape (``has shape``), NaN or infinities (``has non-finite
+        entries``).
+    """
+    wanted = f"{tuple(shape)} real numbers" if shape is not None else "real numbers"
+    if contains_boolean(value):
+        raise InputError(f"{name} = {value!r} contains true/false; give {wanted}")
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} = {value!r} is not numeric; give {wanted}") from exc
+    if shape is not None and array.shape != tuple(shape):
+        raise InputError(f"{name} has shape {array.shape}; it must have shape {tuple(shape)}")
+    if finite and not np.all(np.isfinite(array)):
+        raise InputError(f"{name} = {array.tolist()} has non-finite entries; give finite numbers")
+    return array
