@@ -6,7 +6,7 @@ Each sub-command lives in ``dirac/commands/<name>.py`` and provides
   no sympy, numba or scipy imports at module level, so ``dirac --help`` stays fast);
 * ``main(args: argparse.Namespace) -> int`` — do the work and return the exit status.
 
-Exit status (CONTRACTS §2): 0 success; 2 bad input, with one ``error:`` line on stderr;
+Exit status (docs/cli.md): 0 success; 2 bad input, with one ``error:`` line on stderr;
 1 an internal failure.
 """
 

@@ -9,7 +9,7 @@ permutation of ``(1, 2, 3)``. ``R`` is first an arbitrary 3x3 matrix; the six co
 
 The module also holds the pieces shared with :mod:`dirac_systems.rigid_body_momentum`:
 the rotation-matrix symbols, the six constraints, the inertia check (the mass matrix
-``g`` must be positive: PHYSICS.md §2), which the factories pass to
+``g`` must be positive: (72), docs/conventions.md), which the factories pass to
 :class:`~dirac.model.lagrangian.Lagrangian` as its ``validator`` so that it runs whenever
 :meth:`~dirac.model.lagrangian.Lagrangian.fix` makes the moments numbers.
 """
@@ -100,7 +100,7 @@ def check_inertia(I_1: float, I_2: float, I_3: float) -> tuple[float, float, flo
     """Refuse principal moments whose mass matrix ``g`` is not positive definite.
 
     The Lagrangians (19) and (78) need ``g_i = (I_j + I_k - I_i)/2 > 0`` (72): the
-    triangle inequality ``I_j + I_k > I_i`` (PHYSICS.md §2). Equality is a planar body,
+    triangle inequality ``I_j + I_k > I_i`` (docs/conventions.md). Equality is a planar body,
     whose ``g`` is singular (no inverse, so the chain (217) does not exist).
 
     Parameters
@@ -182,7 +182,7 @@ def system() -> Lagrangian:
 
 
 def _hat(w: np.ndarray) -> np.ndarray:
-    """``hat(w) v = w x v`` (PHYSICS.md §2)."""
+    """``hat(w) v = w x v`` (the transpose of the paper's hat (8); docs/conventions.md)."""
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 

@@ -119,7 +119,7 @@ def body_data(
     InputError
         For fewer than four particles, non-positive masses, a wrong shape, or a planar
         or collinear body: its ``g`` has a zero principal value, so the triangle
-        inequality ``I_i + I_j >= I_k`` (PHYSICS.md §2) holds with equality and the
+        inequality ``I_i + I_j >= I_k`` (docs/conventions.md) holds with equality and the
         rotation-matrix description (78) does not exist.
     """
     m = _clean_masses(masses)

@@ -1,7 +1,7 @@
 """First- and second-class constraints from the bracket matrix ``C_ab = {Phi_a, Phi_b}``.
 
 A constraint is first class when its bracket with every constraint vanishes weakly;
-the rank of ``C`` on the surface counts the second-class constraints (PHYSICS.md §1,
+the rank of ``C`` on the surface counts the second-class constraints (docs/conventions.md,
 the matrix Δ of (240)-(245)). When ``C`` is singular but no single constraint is first
 class, first-class *combinations* ``F_a = Phi_a + k_s Phi_s`` are built, with ``k``
 solving ``C_SS^T k = -C_aS^T`` for a set ``S`` of constraints whose principal block

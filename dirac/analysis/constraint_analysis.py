@@ -47,7 +47,7 @@ class ConstraintAnalysis:
     coordinates, momenta, phase_space
         ``q`` then ``lambda_1, ...``; ``p_q`` then ``p_lambda_...``; both concatenated.
     symbols
-        Name -> symbol of every phase-space variable (CONTRACTS §5).
+        Name -> symbol of every phase-space variable (names: docs/conventions.md).
     parameters
         Parameter symbols that are still symbolic.
     canonical_hamiltonian, total_hamiltonian
@@ -252,7 +252,7 @@ class ConstraintAnalysis:
 
     # ------------------------------------------------------------------ reports
     def to_json(self) -> dict:
-        """The CONTRACTS §4 object (plus extra keys)."""
+        """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys)."""
         from dirac.analysis.report import to_json
 
         return to_json(self)

@@ -72,7 +72,7 @@ def canonical_bracket(
 def canonical_pairs(symbols: Mapping[str, sympy.Symbol], coordinates: Sequence[str]) -> list[tuple[sympy.Symbol, sympy.Symbol]]:
     """The pairs ``(q, p_q)`` of the named coordinates, taking symbols from ``symbols``.
 
-    Momentum names follow CONTRACTS §3: the momentum of ``x`` is ``p_x``.
+    Momentum names follow docs/conventions.md: the momentum of ``x`` is ``p_x``.
 
     Raises
     ------

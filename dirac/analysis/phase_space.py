@@ -47,7 +47,7 @@ class PhaseSpace:
 
     @property
     def symbols(self) -> dict[str, sympy.Symbol]:
-        """Name -> symbol of every phase-space variable (CONTRACTS §5)."""
+        """Name -> symbol of every phase-space variable (names: docs/conventions.md)."""
         return {s.name: s for s in self.variables}
 
     def partials(self, expr: sympy.Expr) -> tuple[dict, dict]:

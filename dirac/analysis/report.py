@@ -1,4 +1,4 @@
-"""Text, JSON (CONTRACTS §4) and LaTeX renderings of a :class:`ConstraintAnalysis`."""
+"""Text, JSON (docs/file_formats.md, "Analysis JSON") and LaTeX renderings of a :class:`ConstraintAnalysis`."""
 
 from __future__ import annotations
 
@@ -89,7 +89,7 @@ def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
 
 
 def to_json(analysis: "ConstraintAnalysis") -> dict:
-    """The CONTRACTS §4 object; constraints are ``str()`` of sympy expressions.
+    """The analysis JSON object of docs/file_formats.md; constraints are ``str()`` of sympy expressions.
 
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,

@@ -7,8 +7,8 @@ digits). The vector field ``dM/dt = M x Omega``, ``dR/dt = R hat(Omega)``,
 products: ``y_{k+1} = B_k / (k+1)``, ``B_k = sum_{s<=k} B(y_s, y_{k-s})``. It shares no code
 with the package's methods (no splitting, no elliptic functions), so it checks all of
 them. The step ``h`` keeps the last two terms of the series below ``1e-28``; the result
-is accurate to about 1e-30 (the test suite checks it against PHYSICS.md §4's 40-digit
-values). The inertia and initial values are taken exactly as the double-precision
+is accurate to about 1e-30 (the test suite checks it against the 40-digit
+values of the standard test case in docs/conventions.md). The inertia and initial values are taken exactly as the double-precision
 numbers the methods receive.
 
 Pendulum: the period ``T = 4 K(sin^2(theta0/2)) / sqrt(g/l)`` with ``K`` the complete

@@ -97,7 +97,7 @@ def format_rows(rows: list[dict]) -> str:
 
 
 def format_targets(targets: list) -> str:  # noqa: ANN001
-    """The targets of issue #5: value, target, met or missed by how much."""
+    """The performance targets (docs/performance.md): value, target, met or missed by how much."""
     lines = ["\n== targets (each measured in this run; ratios against baselines of this run) =="]
     for t in targets:
         if t.value is None:

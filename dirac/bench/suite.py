@@ -1,9 +1,9 @@
 """The benchmark suite: problems, methods and the step sizes / tolerances of each.
 
-Methods: the contract names (CONTRACTS §7a) plus ``lie-poisson-sym-*``, the compositions
+Methods: the documented names (docs/integrators.md) plus ``lie-poisson-sym-*``, the compositions
 of the symmetric-top splitting (Fassò 2003; registered package methods).
 
-Rigid bodies (PHYSICS.md §4 and two variants), integrated to ``T = 100`` with ``M`` and
+Rigid bodies (the standard test case of docs/conventions.md and two variants), integrated to ``T = 100`` with ``M`` and
 ``R``; the pendulum and the double pendulum (Cartesian coordinates, holonomic
 constraints) with RATTLE and the scipy baselines. ``quick`` selects a subset of the same
 grid so that ``dirac bench --quick`` stays under a minute.
@@ -93,7 +93,7 @@ def rigid_body_cases(quick: bool) -> list[RigidBodyCase]:
     cases = [
         RigidBodyCase(
             "standard",
-            "I = (2, 1, 2/3), M(0) = (cos 1.1, 0, sin 1.1), T = 100 (PHYSICS.md §4)",
+            "I = (2, 1, 2/3), M(0) = (cos 1.1, 0, sin 1.1), T = 100 (the standard test case of Hairer, Lubich & Wanner)",
             (2.0, 1.0, 2.0 / 3.0),
             (math.cos(1.1), 0.0, math.sin(1.1)),
             100.0,

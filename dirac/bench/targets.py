@@ -368,7 +368,7 @@ def startup_targets(repeats: int, cold: bool) -> list[Target]:
 
 
 def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], None]) -> tuple[list[Target], list[str]]:
-    """Every target of issue #5 (smaller sizes in ``quick`` mode, scaled where said)."""
+    """Every performance target of docs/performance.md (smaller sizes in ``quick`` mode, scaled where said)."""
     notes: list[str] = []
     targets: list[Target] = []
     repeats = 5 if quick else 9

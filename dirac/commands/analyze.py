@@ -1,6 +1,6 @@
 """``dirac analyze SYSTEM``: run the Dirac–Bergmann algorithm and print the chain.
 
-Text by default (stage by stage, with counts), ``--json`` (CONTRACTS §4) or ``--latex``.
+Text by default (stage by stage, with counts), ``--json`` (docs/file_formats.md) or ``--latex``.
 ``--param NAME=VALUE`` fixes parameters (the others stay symbolic); ``--compare SPEC``
 compares the result with a reference (see :mod:`dirac.analysis.compare`).
 """
@@ -31,7 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="fix a parameter to a number (repeatable); the others stay symbolic",
     )
     output = parser.add_mutually_exclusive_group()
-    output.add_argument("--json", action="store_true", help="print one JSON object (CONTRACTS §4)")
+    output.add_argument("--json", action="store_true", help="print one JSON object (stages, classes, multipliers, degrees of freedom)")
     output.add_argument("--latex", action="store_true", help="print the analysis as LaTeX")
     parser.add_argument("--compare", metavar="SPEC", default=None, help="compare with a reference (e.g. the paper's equations)")
     return parser

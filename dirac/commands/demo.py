@@ -1,4 +1,4 @@
-"""``dirac demo``: the flagship scene -- the free asymmetric rigid body of PHYSICS.md §4.
+"""``dirac demo``: the flagship scene -- the free asymmetric rigid body of the standard test case (docs/conventions.md).
 
 ``I = (2, 1, 2/3)``, ``M(0) = (cos 1.1, 0, sin 1.1)``, ``R(0) = 1`` (Hairer, Lubich &
 Wanner's rigid-body example), integrated to ``t = 1000`` with ``method = "auto"``; prints
@@ -64,7 +64,7 @@ def main(args: argparse.Namespace) -> int:
     orthogonality = np.max(np.abs(np.einsum("nki,nkj->nij", R, R) - np.eye(3)))
     inertia = scene.problem.inertia  # type: ignore[attr-defined]
     choice = solution.extra.get("auto", {})
-    print("dirac demo: free asymmetric rigid body (PHYSICS.md §4)")
+    print("dirac demo: free asymmetric rigid body (the standard test case of Hairer, Lubich & Wanner)")
     print(f"  inertia        I = ({', '.join(f'{x:.6g}' for x in inertia)})")
     print(f"  initial        M(0) = ({', '.join(f'{x + 0.0:.6g}' for x in M[0])}), R(0) = identity")
     method_line = f"  method         {solution.method} (order {solution.order})"

@@ -1,6 +1,6 @@
 """``dirac run SCENE.toml [--out FILE.npz] [--plot FILE.png] [--no-progress]``: run a scene, write its results.
 
-The results (CONTRACTS §7) are written atomically. When the integration stops early
+The results (docs/file_formats.md) are written atomically. When the integration stops early
 (non-finite state, Newton non-convergence, constraint drift, Ctrl-C or SIGTERM) the
 samples computed so far are saved with ``meta["complete"] = false``: to the output file
 when it does not exist yet, otherwise next to it as ``<name>.partial.npz``, so a failed
@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "run",
         help="run a scene file and write its results",
-        description="Run a scene file (CONTRACTS §6) and write t, the requested outputs and meta to an .npz file.",
+        description="Run a scene file (TOML: [system], [initial], [run]) and write t, the requested outputs and meta to an .npz file.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=_methods_epilog(),
     )

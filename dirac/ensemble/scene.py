@@ -1,4 +1,4 @@
-"""Ensemble scenes: the single-run sections of CONTRACTS §6 plus ``[ensemble]``.
+"""Ensemble scenes: the single-run sections of a scene file (docs/file_formats.md) plus ``[ensemble]``.
 
 ```toml
 [system]
@@ -310,7 +310,7 @@ def _check_member_file(file: str, count: int | None) -> tuple[int, str]:
 
 
 def _warn_triangle(distribution: object) -> None:
-    """Warn when drawn inertias can violate ``I_i + I_j >= I_k`` (PHYSICS.md §2)."""
+    """Warn when drawn inertias can violate ``I_i + I_j >= I_k`` (72); docs/conventions.md."""
     if isinstance(distribution, (Uniform, LogUniform)):
         low, high = distribution.low, distribution.high
         for k in range(3):

@@ -65,7 +65,7 @@ class Solution:
         return name == "t" or name in self.outputs
 
     def meta(self) -> dict[str, object]:
-        """The ``meta`` record of the result file (CONTRACTS §7)."""
+        """The ``meta`` record of the result file (docs/file_formats.md)."""
         from dirac.io.results import versions
 
         record: dict[str, object] = {

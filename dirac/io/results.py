@@ -1,4 +1,4 @@
-"""Result files (CONTRACTS §7): ``.npz`` with ``t``, the requested outputs and ``meta``.
+"""Result files (docs/file_formats.md): ``.npz`` with ``t``, the requested outputs and ``meta``.
 
 Files are written atomically: the data go to a temporary file in the destination's
 directory, are flushed to disk, and the temporary file is renamed over the destination
@@ -44,7 +44,7 @@ def _json_default(value: object) -> object:
 
 
 def write_results(solution, path: str | Path, extra_meta: dict[str, object] | None = None) -> Path:  # noqa: ANN001
-    """Write ``solution`` to ``path`` atomically (CONTRACTS §7).
+    """Write ``solution`` to ``path`` atomically (docs/file_formats.md).
 
     Parameters
     ----------

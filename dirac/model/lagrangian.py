@@ -8,7 +8,7 @@ dynamical variables, as in the paper's extended Lagrangian (1):
     L_ext = L(q, q_dot) - sum_a lambda_a chi_a(q).
 
 Lagrangians come from the Python API (:meth:`Lagrangian.from_strings` or sympy
-expressions directly), from a system file (CONTRACTS §3, :func:`read_system_file`), or
+expressions directly), from a system file (docs/file_formats.md, :func:`read_system_file`), or
 from a built-in factory (:func:`dirac.load_system`).
 """
 
@@ -34,12 +34,12 @@ _SYSTEM_KEYS = {"name", "coordinates", "parameters", "lagrangian", "constraints"
 
 
 def velocity_name(coordinate: str) -> str:
-    """Name of the velocity of ``coordinate``: ``x`` -> ``x_dot`` (CONTRACTS §3)."""
+    """Name of the velocity of ``coordinate``: ``x`` -> ``x_dot`` (docs/conventions.md)."""
     return f"{coordinate}_dot"
 
 
 def momentum_name(coordinate: str) -> str:
-    """Name of the momentum of ``coordinate``: ``x`` -> ``p_x`` (CONTRACTS §3)."""
+    """Name of the momentum of ``coordinate``: ``x`` -> ``p_x`` (docs/conventions.md)."""
     return f"p_{coordinate}"
 
 
@@ -170,7 +170,7 @@ class Lagrangian:
         parameters: Mapping[str, float | None] | None = None,
         description: str = "",
     ) -> "Lagrangian":
-        """Build a Lagrangian from expressions written as text (CONTRACTS §3).
+        """Build a Lagrangian from expressions written as text (docs/file_formats.md).
 
         Examples
         --------
@@ -317,7 +317,7 @@ def _check_names(
 
 
 def read_system_file(path: str | Path) -> Lagrangian:
-    """Read a system file: TOML as in CONTRACTS §3, or a ``.py`` file defining ``system()``.
+    """Read a system file: TOML as in docs/file_formats.md, or a ``.py`` file defining ``system()``.
 
     Unknown keys in ``[system]`` are warned about (by name) and ignored.
 
@@ -344,7 +344,7 @@ def read_system_file(path: str | Path) -> Lagrangian:
 def lagrangian_from_table(table: object, source: str = "system table") -> Lagrangian:
     """Build a :class:`Lagrangian` from the ``[system]`` table of a system file."""
     if not isinstance(table, dict):
-        raise InputError(f"{source}: missing [system] table (see CONTRACTS §3 for the format)")
+        raise InputError(f"{source}: missing [system] table (with name, coordinates and lagrangian; see docs/file_formats.md)")
     unknown = sorted(set(table) - _SYSTEM_KEYS)
     if unknown:
         warn(f"{source}: unknown key(s) in [system] ignored: {', '.join(unknown)}")

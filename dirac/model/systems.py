@@ -52,7 +52,7 @@ def load_system(name_or_path: str | Path, **options: object) -> Lagrangian:
     ----------
     name_or_path
         A built-in name (``dirac systems`` lists them) or a path to a ``.toml`` system
-        file (CONTRACTS §3) or a ``.py`` file defining ``system()``.
+        file (docs/file_formats.md) or a ``.py`` file defining ``system()``.
     **options
         Keywords naming a parameter fix it to a number (:meth:`Lagrangian.fix`); the
         parameters not named stay symbolic. Other keywords that the system's factory

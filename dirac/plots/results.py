@@ -1,7 +1,7 @@
 """Draw a run's result -- a :class:`dirac.flows.Solution` or a result file -- as one PNG.
 
 This is what ``dirac run SCENE --plot FILE.png`` and ``dirac demo --plot FILE.png`` call.
-The picture is chosen from the outputs present (CONTRACTS §7): ``M`` (and ``R``) give
+The picture is chosen from the outputs present (docs/file_formats.md): ``M`` (and ``R``) give
 the rigid-body picture (:func:`dirac.plots.rigid_body.rigid_body_figure`), ``q`` the
 constrained-system picture (:func:`dirac.plots.constrained.constrained_figure`).
 """
@@ -22,7 +22,7 @@ __all__ = ["result_figure", "plot_result", "load_result"]
 
 
 def load_result(path: str | Path) -> dict[str, Any]:
-    """Read a result file (``.npz``, CONTRACTS §7) into a dict; ``meta`` becomes a dict."""
+    """Read a result file (``.npz``, docs/file_formats.md) into a dict; ``meta`` becomes a dict."""
     target = Path(path)
     if not target.is_file():
         raise InputError(f"result file {str(path)!r} does not exist: give the --out file of 'dirac run'")
@@ -85,7 +85,7 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None) -> Any:
     Parameters
     ----------
     result : dirac.flows.Solution or mapping
-        Anything with the outputs of CONTRACTS §7 by name (``t`` and ``M``/``R`` or
+        Anything with the outputs of a result file by name (``t`` and ``M``/``R`` or
         ``q``/``energy``/``constraint_residual``) and a ``meta`` record (dict, JSON
         string, or a ``meta()`` method). A batched result is drawn for its first state.
     coordinates : sequence of str, optional

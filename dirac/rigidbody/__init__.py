@@ -1,4 +1,4 @@
-"""Numerical kernels of the free rigid body (PHYSICS.md §2, paper Sect. IX).
+"""Numerical kernels of the free rigid body (docs/conventions.md, paper Sect. IX).
 
 Modules, one job each:
 

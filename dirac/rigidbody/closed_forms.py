@@ -6,7 +6,7 @@
   ``R(t) = R_m(t) R_OZ(t)``, (197) and (202).
 
 Sign of ``phi`` in (183), (202): with this project's conventions (``dR/dt = R hat(Omega)``,
-``R`` body to lab, PHYSICS.md §2) the rotation about ``z`` is by ``+phi t`` with
+``R`` body to lab, docs/conventions.md) the rotation about ``z`` is by ``+phi t`` with
 ``phi = (I2 - I3) m3 / (I2 I3)``, exactly as printed in the paper. Derivation: ``H_0 =
 |M|^2/(2 I2) + (1/I3 - 1/I2) M_3^2/2``, two commuting flows; the first turns ``R`` on the
 left about ``m`` at rate ``|m|/I2`` (``R_m``), the second on the right about ``e_3`` at

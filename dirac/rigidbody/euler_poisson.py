@@ -1,7 +1,7 @@
 """The Euler–Poisson equations of the free rigid body and their invariants.
 
-Conventions (PHYSICS.md §2, CONTRACTS.md §8): ``Omega = I^{-1} M``,
-``dM/dt = M x Omega`` (250), ``dR/dt = R hat(Omega)`` (251) with ``hat(w) v = w x v``;
+Conventions (docs/conventions.md): ``Omega = I^{-1} M``,
+``dM/dt = M x Omega`` (251), ``dR/dt = R hat(Omega)`` (250) with ``hat(w) v = w x v``;
 ``R`` maps body to lab, ``m = R M`` is conserved, ``H_0 = sum_i M_i^2 / (2 I_i)`` (247)
 and the Casimir ``|M|^2``. A flat state is ``y = concatenate([M, R.ravel()])``
 (12 floats, ``R`` row-major).
@@ -59,7 +59,7 @@ def casimir(M: np.ndarray) -> np.ndarray | float:
 
 
 def lab_momentum(M: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """Lab-frame angular momentum ``m = R M`` (conserved; PHYSICS.md §2).
+    """Lab-frame angular momentum ``m = R M`` (conserved; docs/conventions.md).
 
     Parameters
     ----------

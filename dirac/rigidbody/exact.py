@@ -106,7 +106,7 @@ class ExactRigidBodyFlow:
 
     Examples
     --------
-    The standard case of PHYSICS.md §4 (its inertia triggers a triangle-inequality warning):
+    The standard test case of docs/conventions.md (its inertia triggers a triangle-inequality warning):
 
     >>> import numpy as np
     >>> flow = ExactRigidBodyFlow([2.0, 1.0, 2.0 / 3.0], [np.cos(1.1), 0.0, np.sin(1.1)])

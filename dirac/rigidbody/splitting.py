@@ -56,7 +56,7 @@ class CompositionScheme:
     Attributes
     ----------
     name : str
-        Method name (CONTRACTS.md §7a), e.g. ``"lie-poisson-4"``.
+        Method name (docs/integrators.md), e.g. ``"lie-poisson-4"``.
     order : int
         Classical order of the composed method.
     coefficients : tuple of float
