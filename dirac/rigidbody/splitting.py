@@ -22,25 +22,26 @@ Celledoni, Fassò, Säfström & Zanna 2008)
     base step is ``H_b(h/2) H_c(h) H_b(h/2)``, two rotations per step after merging.
 
 Higher order comes from symmetric compositions of the base step ``S(h)``:
-``S(gamma_s h) ... S(gamma_1 h)``; a :class:`CompositionScheme` holds the ``gamma`` as data,
-so a new scheme is a new table row. Adjacent half-steps of the same sub-flow are merged,
-also across steps (first-same-as-last).
+``S(gamma_s h) ... S(gamma_1 h)``; a :class:`CompositionScheme` holds the ``gamma`` as
+data, taken from the rows of :data:`dirac.compositions.COMPOSITIONS` (a new scheme is a
+new row there). Adjacent half-steps of the same sub-flow are merged, also across steps
+(first-same-as-last).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
-import math
 
 import numpy as np
 from numba import njit
 
+from dirac.compositions import COMPOSITIONS
 from dirac.errors import InputError
 
 __all__ = [
     "CompositionScheme",
-    "COMPOSITIONS",
     "SCHEMES",
     "build_sequence",
     "advance",
@@ -72,65 +73,6 @@ class CompositionScheme:
     coefficients: tuple[float, ...]
     splitting: str = "axes"
     reference: str = ""
-
-
-_CBRT2 = 2.0 ** (1.0 / 3.0)
-_YOSHIDA4 = (1.0 / (2.0 - _CBRT2), -_CBRT2 / (2.0 - _CBRT2), 1.0 / (2.0 - _CBRT2))
-_SUZUKI_G = 1.0 / (4.0 - 4.0 ** (1.0 / 3.0))
-_SUZUKI5 = (_SUZUKI_G, _SUZUKI_G, 1.0 - 4.0 * _SUZUKI_G, _SUZUKI_G, _SUZUKI_G)
-
-
-def _palindrome(half: tuple[float, ...]) -> tuple[float, ...]:
-    """Complete ``gamma_1..gamma_k`` to ``gamma_1..gamma_k, gamma_mid, gamma_k..gamma_1``."""
-    middle = 1.0 - 2.0 * math.fsum(half)
-    return tuple(half) + (middle,) + tuple(reversed(half))
-
-
-# Kahan & Li (1997), Math. Comp. 66, 1089; as printed in Hairer, Lubich & Wanner,
-# Geometric Numerical Integration (2nd ed.), Sect. V.3.2, methods p6 s9 and p8 s17.
-_KAHAN_LI_6_9 = _palindrome(
-    (
-        0.39216144400731413927925056,
-        0.33259913678935943859974864,
-        -0.70624617255763935980996482,
-        0.08221359629355080023149045,
-    )
-)
-_KAHAN_LI_8_17 = _palindrome(
-    (
-        0.13020248308889008087881763,
-        0.56116298177510838456196441,
-        -0.38947496264484728640807860,
-        0.15884190655515560089621075,
-        -0.39590389413323757733623154,
-        0.18453964097831570709183254,
-        0.25837438768632204729397911,
-        0.29501172360931029887096624,
-    )
-)
-# Suzuki & Umeno (1993) / McLachlan (1995), p8 s15, as printed in Hairer, Lubich & Wanner,
-# Sect. V.3.2.
-_SUZUKI_UMENO_8_15 = _palindrome(
-    (
-        0.74167036435061295344822780,
-        -0.40910082580003159399730010,
-        0.19075471029623837995387626,
-        -0.57386247111608226665638773,
-        0.29906418130365592384446354,
-        0.33462491824529818378495798,
-        0.31529309239676659663205666,
-    )
-)
-
-#: The composition table: ``(name suffix, order, coefficients, reference)``.
-COMPOSITIONS: tuple[tuple[str, int, tuple[float, ...], str], ...] = (
-    ("2", 2, (1.0,), "Strang (1968) symmetric splitting"),
-    ("4", 4, _YOSHIDA4, "Yoshida (1990) / Creutz & Gocksch triple jump"),
-    ("4-suzuki", 4, _SUZUKI5, "Suzuki (1990) 5-stage fractal composition"),
-    ("6", 6, _KAHAN_LI_6_9, "Kahan & Li (1997) p6 s9"),
-    ("8", 8, _KAHAN_LI_8_17, "Kahan & Li (1997) p8 s17"),
-    ("8-s15", 8, _SUZUKI_UMENO_8_15, "Suzuki & Umeno (1993), McLachlan (1995) p8 s15"),
-)
 
 
 def _make_schemes() -> dict[str, CompositionScheme]:
