@@ -4,8 +4,9 @@ result files.
 Public names (imported on first use, so ``import dirac.flows`` stays cheap):
 :func:`integrate`, :class:`Solution`, :class:`RigidBodyProblem`, :class:`HeavyTopProblem`,
 :class:`ConstrainedProblem`, :class:`MechanicalSystem`, :class:`AnalysedSystem`,
-:class:`AnalysedProblem`, :func:`load_scene`, :func:`scene_from_dict`,
-:func:`write_results`, :func:`read_results`, :func:`get_method`, :func:`method_names`.
+:class:`AnalysedProblem`, :class:`Problem` (what they have in common), :func:`load_scene`, :func:`scene_from_dict`,
+:func:`write_results`, :func:`read_results`, :func:`get_method`, :func:`method_names`,
+:data:`METHODS`.
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ _LAZY = {
     "scene_from_dict": "dirac.io.scene",
     "write_results": "dirac.io.results",
     "read_results": "dirac.io.results",
-    "get_method": "dirac.flows.methods.base",
-    "method_names": "dirac.flows.methods.base",
-    "METHODS": "dirac.flows.methods.base",
+    "get_method": "dirac.flows.methods.registry",
+    "method_names": "dirac.flows.methods.registry",
+    "METHODS": "dirac.flows.methods.registry",
+    "Problem": "dirac.flows.problems",
 }
 
 __all__ = sorted(_LAZY)
@@ -40,8 +42,6 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'dirac.flows' has no attribute {name!r}")
     value = getattr(import_module(module), name)
-    if name == "METHODS":
-        import_module("dirac.flows.methods.base")._load_all()
     globals()[name] = value
     return value
 

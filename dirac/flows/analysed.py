@@ -154,6 +154,7 @@ class AnalysedProblem:
     surface_tolerance: float = 1e-8
     batched: bool = field(init=False, default=False)
 
+    kind = "analysed"
     outputs = ("z", "q", "p", "energy", "constraint_residual")
 
     def __post_init__(self) -> None:

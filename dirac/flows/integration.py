@@ -1,7 +1,7 @@
 """The one integration loop: sampling, counters, CPU time, progress and guard rails.
 
 :func:`integrate` is the only place that loops over output times. Methods
-(:mod:`dirac.flows.methods.base`) only know how to advance a state; here the loop
+(:mod:`dirac.flows.methods`) only know how to advance a state; here the loop
 
 * samples the requested outputs at ``samples`` uniformly spaced times in ``[0, t_end]``
   (both ends included; ``samples = 1`` means the final time only), computing only the
@@ -26,7 +26,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from dirac.errors import InputError, IntegrationError
-from dirac.flows.methods.base import Method, Stepper, StepFailure, get_method
+from dirac.flows.methods.base import Method, StepFailure, Stepper
+from dirac.flows.methods.registry import METHODS, get_method, method_names
+from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS"]
@@ -54,19 +56,16 @@ class IntegrationInterrupted(IntegrationError):
 
 
 def problem_kind(problem: object) -> str:
-    """``"rigid_body"``, ``"heavy_top"``, ``"constrained"`` or ``"analysed"``."""
-    from dirac.flows.problems import ConstrainedProblem, HeavyTopProblem, RigidBodyProblem
+    """The kind the problem declares: ``"rigid_body"``, ``"heavy_top"``, ``"constrained"`` or
+    ``"analysed"``.
 
-    if isinstance(problem, HeavyTopProblem):
-        return "heavy_top"
-    if isinstance(problem, RigidBodyProblem):
-        return "rigid_body"
-    if isinstance(problem, ConstrainedProblem):
-        return "constrained"
-    from dirac.flows.analysed import AnalysedProblem
-
-    if isinstance(problem, AnalysedProblem):
-        return "analysed"
+    Raises
+    ------
+    InputError
+        ``problem`` is not a problem (:class:`dirac.flows.problems.Problem`).
+    """
+    if isinstance(problem, Problem) and problem.kind in DEFAULT_OUTPUTS:
+        return problem.kind
     raise InputError(
         f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem, ConstrainedProblem "
         "or AnalysedProblem"
@@ -169,7 +168,7 @@ def integrate(
         A :class:`RigidBodyProblem`, :class:`HeavyTopProblem` or :class:`ConstrainedProblem`
         (initial states may be batched along a leading axis).
     method
-        A name from :data:`dirac.flows.methods.base.METHODS` (``dirac run --help`` lists them)
+        A name from :data:`dirac.flows.methods.registry.METHODS` (``dirac run --help`` lists them)
         or ``"auto"`` (:func:`dirac.flows.methods.auto.choose_method`).
     t_end
         Final time (> 0).
@@ -247,8 +246,6 @@ def integrate(
 
 
 def _names_for(kind: str) -> list[str]:
-    from dirac.flows.methods.base import METHODS, method_names
-
     return ["auto"] + [n for n in method_names() if n in METHODS and METHODS[n].accepts(kind)]
 
 

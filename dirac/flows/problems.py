@@ -10,17 +10,57 @@ integrated with the same method in one call.
   ``H = H_0(M) + m g <chi, R^T e_z>``.
 * :class:`ConstrainedProblem` -- a mechanical system ``L = 1/2 q_dot^T M(q) q_dot - V(q)``
   with holonomic constraints (a :class:`dirac.flows.mechanics.MechanicalSystem`).
+
+Each declares its ``kind`` (``"rigid_body"``, ``"heavy_top"``, ``"constrained"``; the
+analysed systems of :mod:`dirac.flows.analysed` have ``"analysed"``): the methods choose
+their stepper by it. :class:`Problem` is what :func:`dirac.flows.integrate` needs of any
+problem.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
 from dirac.errors import InputError
 
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
+
+
+@runtime_checkable
+class Problem(Protocol):
+    """What :func:`dirac.flows.integrate` needs of a problem.
+
+    Attributes
+    ----------
+    kind : str
+        ``"rigid_body"``, ``"heavy_top"``, ``"constrained"`` or ``"analysed"``: which
+        steppers of a method apply (:attr:`dirac.flows.methods.base.Method.factories`).
+    outputs : tuple of str
+        The outputs that can be requested.
+    batched : bool
+        Whether the initial states were given with a leading batch axis.
+    """
+
+    kind: ClassVar[str]
+    outputs: ClassVar[tuple[str, ...]]
+    batched: bool
+
+    @property
+    def system(self) -> str:
+        """Name of the system, for the result file's ``meta``."""
+        ...
+
+    @property
+    def batch(self) -> int:
+        """Number of initial states."""
+        ...
+
+    def parameters(self) -> dict[str, object]:
+        """Numerical parameters, for the result file's ``meta``."""
+        ...
 
 
 def _refuse_booleans(value: object, name: str) -> None:
@@ -73,8 +113,9 @@ class RigidBodyProblem:
     R0: np.ndarray | None = None
     batched: bool = field(init=False, default=False)
 
-    system = "rigid_body"
-    outputs = ("M", "R", "energy", "casimir", "lab_momentum")
+    kind: ClassVar[str] = "rigid_body"
+    system: ClassVar[str] = "rigid_body"
+    outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "casimir", "lab_momentum")
 
     def __post_init__(self) -> None:
         from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
@@ -131,8 +172,9 @@ class HeavyTopProblem(RigidBodyProblem):
     mass_gravity: float = 1.0
     center_of_mass: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
 
-    system = "heavy_top"
-    outputs = ("M", "R", "energy", "lab_momentum_z")
+    kind: ClassVar[str] = "heavy_top"
+    system: ClassVar[str] = "heavy_top"
+    outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "lab_momentum_z")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -187,7 +229,8 @@ class ConstrainedProblem:
     surface_tolerance: float = 1e-9
     batched: bool = field(init=False, default=False)
 
-    outputs = ("q", "p", "q_dot", "energy", "constraint_residual")
+    kind: ClassVar[str] = "constrained"
+    outputs: ClassVar[tuple[str, ...]] = ("q", "p", "q_dot", "energy", "constraint_residual")
 
     def __post_init__(self) -> None:
         from dirac.model.lagrangian import Lagrangian
@@ -227,14 +270,15 @@ class ConstrainedProblem:
 
     @property
     def system(self) -> str:
-        return self.mechanics.name  # type: ignore[attr-defined]
+        """Name of the mechanical system."""
+        return self.mechanics.name  # type: ignore[attr-defined, no-any-return]
 
     @property
     def batch(self) -> int:
+        """Number of initial states."""
         return int(self.q0.shape[0])
 
     def parameters(self) -> dict[str, object]:
+        """Parameter values of the mechanical system, for the result file's ``meta``."""
         return dict(self.mechanics.parameter_values)  # type: ignore[attr-defined]
 
-
-Problem = RigidBodyProblem | HeavyTopProblem | ConstrainedProblem

@@ -1,5 +1,5 @@
 """Every rigid-body method reproduces the paper's closed forms (165), (183) and the
-elliptic solution (PHYSICS.md §3-4), through ``integrate``.
+elliptic solution (Sect. IX; the standard test case of docs/conventions.md), through ``integrate``.
 
 The expected values are derived by hand from the Euler–Poisson equations (250)–(251):
 
@@ -9,7 +9,7 @@ The expected values are derived by hand from the Euler–Poisson equations (250)
   give ``dR/dt = hat(m) R / I2 + (1/I3 - 1/I2) m3 R hat(e3)``, so
   ``R(t) = exp(t hat(m) / I2) exp(phi t hat(e3))`` with ``phi = (I2 - I3) m3 / (I2 I3)``:
   a rotation by ``k t``, ``k = |m| / I2``, about ``m / |m|``, times a rotation about z.
-* The standard body's ``M(10)`` to 17 digits (PHYSICS.md §4).
+* The standard body's ``M(10)`` to 17 digits (docs/conventions.md).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from dirac.flows import RigidBodyProblem, integrate
-from dirac.flows.methods.base import METHODS, method_names
+from dirac.flows.methods.registry import METHODS
 
 
 def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -28,7 +28,6 @@ def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 def _rigid_body_methods() -> list[str]:
-    method_names()
     return ["auto"] + sorted(n for n, m in METHODS.items() if m.accepts("rigid_body"))
 
 
@@ -79,7 +78,7 @@ def test_closed_form_183_free_symmetric_top(name):
 
 @pytest.mark.parametrize("name", _rigid_body_methods())
 def test_elliptic_solution_of_the_standard_body(name, standard_problem):
-    """PHYSICS.md §4: M(10) = (0.40706613658804081, 0.28300742681284408, 0.86844916766156164)."""
+    """Standard test case (docs/conventions.md): M(10) = (0.40706613658804081, 0.28300742681284408, 0.86844916766156164)."""
     reference = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])
     dt, allowed = _settings(name)
     solution = integrate(standard_problem, name, t_end=10.0, dt=dt, samples=2, outputs=["M", "energy"],

@@ -33,7 +33,7 @@ def test_only_requested_outputs_are_stored():
 
 @pytest.mark.parametrize("method", ["lie-poisson-4", "midpoint", "exact", "scipy-DOP853"])
 def test_a_scene_asking_only_for_M_never_advances_R(method, monkeypatch):
-    from dirac.flows.methods.base import get_method
+    from dirac.flows.methods.registry import get_method
 
     problem = RigidBodyProblem(INERTIA, M0)
     stepper = get_method(method).start(problem, ("M",), {"t_end": 1.0, "tolerance": 1e-8})

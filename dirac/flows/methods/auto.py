@@ -24,7 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dirac.flows.methods.base import get_method
+from dirac.errors import InputError
+from dirac.flows.methods.base import StepFailure
+from dirac.flows.methods.registry import get_method
+from dirac.flows.methods.rigid_body_stepper import exact_flow, needs_attitude
 
 __all__ = ["AutoChoice", "choose_method"]
 
@@ -74,9 +77,6 @@ def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float, 
     A first guess such as ``t_end / 1000`` can be far beyond the system's own time scale
     (a pendulum run to ``t = 1000``), where RATTLE's Newton iteration cannot converge.
     """
-    from dirac.errors import InputError
-    from dirac.flows.methods.base import StepFailure
-
     dt = dt0
     for _ in range(60):
         try:
@@ -140,8 +140,6 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
 
 
 def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, options) -> AutoChoice:  # noqa: ANN001
-    from dirac.flows.methods.lie_poisson import exact_flow, needs_attitude
-
     with_R = needs_attitude(outputs)
     batch = problem.M0.shape[0]
     exact_cost = batch * samples * (EXACT_SAMPLE_US if with_R else EXACT_SAMPLE_M_US)

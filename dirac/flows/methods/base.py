@@ -1,10 +1,11 @@
-"""Integration methods as small objects, and the registry of their names (CONTRACTS §7a).
+"""Integration methods as small objects: :class:`Method`, :class:`Stepper`, :class:`StepFailure`.
 
-A :class:`Method` is data plus one factory: its name, order, flags (``symplectic``,
-``preserves_casimirs``), the problems it accepts, and :meth:`Method.start`, which
+A :class:`Method` is data plus one stepper factory per problem kind it accepts: its name,
+order, flags (``symplectic``, ``preserves_casimirs``) and :meth:`Method.start`, which
 returns a :class:`Stepper` bound to one problem. Steppers hold the state and do the
 mathematics of a step (or of a direct evaluation); they never loop over output times,
 count CPU time or draw progress: :func:`dirac.flows.integrate` does that, once, for all.
+The methods themselves are listed in :mod:`dirac.flows.methods.registry`.
 
 Three kinds of stepper:
 
@@ -19,14 +20,19 @@ Three kinds of stepper:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from dirac.errors import InputError
 
-__all__ = ["Method", "Stepper", "StepFailure", "METHODS", "register_method", "get_method", "method_names"]
+if TYPE_CHECKING:
+    from dirac.flows.problems import Problem
+
+__all__ = ["Method", "Stepper", "StepFailure", "StepperFactory"]
 
 
 class StepFailure(Exception):
@@ -84,19 +90,21 @@ class Stepper:
         raise NotImplementedError
 
 
+#: ``factory(method, problem, outputs, options) -> Stepper`` for one problem kind.
+StepperFactory = Callable[["Method", Any, tuple[str, ...], dict[str, object]], Stepper]
+
+
 @dataclass(frozen=True)
 class Method:
-    """An integration method: data and a factory of steppers.
+    """An integration method: data and one stepper factory per accepted problem kind.
 
     Attributes
     ----------
     name : str
-        Registry name (CONTRACTS §7a), e.g. ``"lie-poisson-4"``.
+        Registry name, e.g. ``"lie-poisson-4"`` (``dirac run --help`` lists them).
     order : int
         Classical order (0 for ``exact``: no discretisation error).
     kind : {"fixed", "adaptive", "exact"}
-    problems : tuple of str
-        Problem kinds accepted: ``"rigid_body"``, ``"heavy_top"``, ``"constrained"``.
     symplectic : bool
         Symplectic (for constrained systems: on the constraint manifold), or Poisson for a
         Lie–Poisson system.
@@ -106,83 +114,55 @@ class Method:
         One line for ``dirac run --help``.
     reference : str
         Where the method comes from.
-    factory : callable
-        ``factory(method, problem, outputs, options) -> Stepper``.
+    factories : mapping of str to callable
+        Problem kind (``"rigid_body"``, ``"heavy_top"``, ``"constrained"``,
+        ``"analysed"``) -> ``factory(method, problem, outputs, options) -> Stepper``.
+    data : object
+        What the factories need besides the problem, e.g. composition coefficients.
     """
 
     name: str
     order: int
     kind: str
-    problems: tuple[str, ...]
     symplectic: bool
     preserves_casimirs: bool
     description: str
     reference: str
-    factory: Callable[..., Stepper] = field(repr=False, compare=False)
+    factories: Mapping[str, StepperFactory] = field(repr=False, compare=False)
     data: object = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self.factories:
+            raise ValueError(f"method {self.name!r} accepts no problem kind")
+        object.__setattr__(self, "factories", MappingProxyType(dict(self.factories)))
+
+    @property
+    def problems(self) -> tuple[str, ...]:
+        """The problem kinds accepted, in the order the factories were given."""
+        return tuple(self.factories)
 
     def accepts(self, problem_kind: str) -> bool:
         """Whether this method integrates problems of the given kind."""
-        return problem_kind in self.problems
+        return problem_kind in self.factories
 
-    def start(self, problem: object, outputs: Sequence[str], options: dict[str, object]) -> Stepper:
-        """A stepper of this method bound to ``problem`` (initial state copied)."""
-        return self.factory(self, problem, tuple(outputs), dict(options))
+    def with_factories(self, factories: Mapping[str, StepperFactory]) -> Method:
+        """This method, also accepting the kinds of ``factories`` (given after its own)."""
+        return replace(self, factories={**self.factories, **factories})
 
+    def start(self, problem: Problem, outputs: Sequence[str], options: Mapping[str, object]) -> Stepper:
+        """A stepper of this method bound to ``problem`` (initial state copied).
 
-#: name -> Method; filled by the method modules (see :func:`_load_all`).
-METHODS: dict[str, Method] = {}
-
-
-def register_method(method: Method) -> Method:
-    """Add ``method`` to :data:`METHODS` (names are unique)."""
-    if method.name in METHODS:
-        raise ValueError(f"method {method.name!r} registered twice")
-    METHODS[method.name] = method
-    return method
-
-
-_LOADED = False
-
-
-def _load_all() -> None:
-    global _LOADED
-    if _LOADED:
-        return
-    _LOADED = True
-    import dirac.flows.methods.exact  # noqa: F401
-    import dirac.flows.methods.heavy_top  # noqa: F401
-    import dirac.flows.methods.lie_poisson  # noqa: F401
-    import dirac.flows.methods.midpoint  # noqa: F401
-    import dirac.flows.methods.rattle  # noqa: F401
-    import dirac.flows.methods.scipy_rk  # noqa: F401
-
-
-#: The names every user sees first (CONTRACTS §7a); others are extras.
-CONTRACT_NAMES = (
-    "auto", "exact", "lie-poisson-2", "lie-poisson-4", "lie-poisson-6", "lie-poisson-8",
-    "rattle-2", "rattle-4", "midpoint", "scipy-RK45", "scipy-DOP853",
-)
-
-
-def method_names() -> list[str]:
-    """Every method name, ``auto`` and the contract names first."""
-    _load_all()
-    extras = sorted(n for n in METHODS if n not in CONTRACT_NAMES)
-    return [*CONTRACT_NAMES, *extras]
-
-
-def get_method(name: str) -> Method:
-    """The method called ``name``.
-
-    Raises
-    ------
-    InputError
-        Unknown name; the message lists the known names.
-    """
-    _load_all()
-    if isinstance(name, Method):
-        return name
-    if name not in METHODS:
-        raise InputError(f"unknown method {name!r}; choose one of: {', '.join(method_names())}")
-    return METHODS[name]
+        Raises
+        ------
+        InputError
+            The method does not accept the problem's kind; the message names both and the
+            kinds it accepts.
+        """
+        kind = problem.kind
+        factory = self.factories.get(kind)
+        if factory is None:
+            raise InputError(
+                f"method {self.name!r} cannot integrate a problem of kind {kind!r}; it accepts: "
+                f"{', '.join(self.problems)}"
+            )
+        return factory(self, problem, tuple(outputs), dict(options))

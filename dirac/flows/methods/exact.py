@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from dirac.flows.methods.lie_poisson import exact_flow, needs_attitude, rigid_body_outputs
-from dirac.flows.methods.base import Method, Stepper, register_method
+from dirac.flows.methods.base import Method, Stepper
+from dirac.flows.methods.rigid_body_stepper import exact_flow, needs_attitude, rigid_body_outputs
 
-__all__ = ["ExactStepper"]
+__all__ = ["ExactStepper", "METHODS"]
 
 
 class ExactStepper(Stepper):
@@ -54,16 +54,16 @@ def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN
     return ExactStepper(problem, outputs)
 
 
-register_method(
+#: The one method of this family.
+METHODS: tuple[Method, ...] = (
     Method(
         name="exact",
         order=0,
         kind="exact",
-        problems=("rigid_body",),
         symplectic=True,
         preserves_casimirs=True,
         description="free rigid body: exact flow (Jacobi elliptic functions, elliptic integral of the 3rd kind), no time steps",
         reference="Jacobi; Celledoni, Fasso, Safstrom & Zanna, SIAM J. Sci. Comput. 30 (2008)",
-        factory=_factory,
-    )
+        factories={"rigid_body": _factory},
+    ),
 )

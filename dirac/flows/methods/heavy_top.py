@@ -6,8 +6,8 @@ With the bracket (248)–(249) the flow of ``V`` alone is a *kick*: ``R`` stays 
 kick with a flow of ``H_0`` gives Poisson integrators that keep ``|gamma|^2 = 1``,
 ``R^T R = 1`` and the vertical lab momentum ``<m, e_z>`` (Celledoni, Fassò, Säfström &
 Zanna, SIAM J. Sci. Comput. 30 (2008); Touma & Wisdom 1994). The base step
-``K(h/2) F(h) K(h/2)`` is symmetric, so the composition table of
-:mod:`dirac.rigidbody.splitting` raises its order.
+``K(h/2) F(h) K(h/2)`` is symmetric, so a composition of :mod:`dirac.compositions` raises
+its order. The kernels are in :mod:`dirac.rigidbody.heavy_top`.
 
 Two families of ``F``:
 
@@ -18,51 +18,23 @@ Two families of ``F``:
 ``exact-kick-*``
     ``F`` is the exact free flow (:class:`dirac.rigidbody.exact.ExactRigidBodyFlow`,
     elliptic functions), as in Celledoni et al. (2008); one Python call per stage.
+
+This module gives the ``lie-poisson-*`` methods their heavy-top factory
+(:data:`LIE_POISSON_FACTORIES`, joined to them by :mod:`dirac.flows.methods.registry`);
+:mod:`dirac.flows.methods.lie_poisson` does not know about the heavy top.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from dirac.flows.methods.lie_poisson import RigidBodyStepper, exact_flow
-from dirac.flows.methods.base import Method, Stepper, register_method
-from dirac.rigidbody.splitting import advance_sequence
+from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
+from dirac.flows.methods.base import Method, Stepper, StepperFactory
+from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper, exact_flow
+from dirac.rigidbody.heavy_top import heavy_top_advance, kick
+from dirac.rigidbody.splitting import build_sequence
 
-__all__ = ["heavy_top_advance", "HeavyTopSplittingStepper", "ExactKickStepper"]
-
-
-@njit(cache=True, inline="always")
-def _kick(M, R, w, tau):  # noqa: ANN001, N803
-    g0 = R[2, 0]
-    g1 = R[2, 1]
-    g2 = R[2, 2]
-    M[0] += tau * (g1 * w[2] - g2 * w[1])
-    M[1] += tau * (g2 * w[0] - g0 * w[2])
-    M[2] += tau * (g0 * w[1] - g1 * w[0])
-
-
-@njit(cache=True)
-def heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n_steps):  # noqa: ANN001, N803, PLR0913
-    """``n_steps`` composed steps ``prod_i K(g_i dt/2) F(g_i dt) K(g_i dt/2)`` in place.
-
-    ``w = m g chi`` (body frame); ``F`` is the free-body Strang step given by the
-    sub-step sequence ``(axes, rates, fractions, casimir_rate)`` of
-    :func:`dirac.rigidbody.splitting.build_sequence`. Adjacent kicks are merged.
-    """
-    s = gammas.shape[0]
-    if n_steps <= 0:
-        return
-    _kick(M, R, w, 0.5 * gammas[0] * dt)
-    for step in range(n_steps):
-        for i in range(s):
-            advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[i] * dt, 1, True)
-            if i < s - 1:
-                _kick(M, R, w, 0.5 * (gammas[i] + gammas[i + 1]) * dt)
-            elif step < n_steps - 1:
-                _kick(M, R, w, 0.5 * (gammas[i] + gammas[0]) * dt)
-            else:
-                _kick(M, R, w, 0.5 * gammas[i] * dt)
+__all__ = ["HeavyTopSplittingStepper", "ExactKickStepper", "METHODS", "LIE_POISSON_FACTORIES"]
 
 
 class HeavyTopSplittingStepper(RigidBodyStepper):
@@ -70,8 +42,6 @@ class HeavyTopSplittingStepper(RigidBodyStepper):
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
         super().__init__(problem, outputs)
-        from dirac.rigidbody.splitting import build_sequence
-
         scheme = method.data
         self.gammas = np.asarray(scheme.coefficients, dtype=float)  # type: ignore[attr-defined]
         self.sequence = build_sequence(self.inv_inertia, (1.0,), scheme.splitting)  # type: ignore[attr-defined]
@@ -103,11 +73,11 @@ class ExactKickStepper(RigidBodyStepper):
         self.R[b] = R1[0]
 
     def _kick(self, b: int, tau: float) -> None:
-        _kick(self.M[b], self.R[b], self.w, tau)  # compiled: np.cross costs ~100x more per call
+        kick(self.M[b], self.R[b], self.w, tau)  # compiled: np.cross costs ~100x more per call
 
     def warm_up(self) -> None:
         exact_flow(self.inertia, self.M[0], self.R[0]).state(np.array([1e-3]))
-        _kick(self.M[0].copy(), self.R[0], self.w, 0.0)
+        kick(self.M[0].copy(), self.R[0], self.w, 0.0)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):
@@ -120,7 +90,7 @@ class ExactKickStepper(RigidBodyStepper):
         self.evaluations += n_steps * 3 * len(self.gammas) * self.M.shape[0]
 
 
-def heavy_top_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _splitting_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
     """Stepper of a ``lie-poisson-*`` method on a :class:`HeavyTopProblem`."""
     return HeavyTopSplittingStepper(method, problem, outputs)
 
@@ -129,26 +99,22 @@ def _exact_kick_factory(method: Method, problem, outputs, options) -> Stepper:  
     return ExactKickStepper(method, problem, outputs)
 
 
-def _register() -> None:
-    from dirac.rigidbody.splitting import COMPOSITIONS
+#: What the ``lie-poisson-*`` methods do on a heavy top: kick + their free step, composed.
+LIE_POISSON_FACTORIES: dict[str, StepperFactory] = {"heavy_top": _splitting_factory}
 
-    for suffix, order, coefficients, reference in COMPOSITIONS:
-        if suffix not in ("2", "4", "6", "8"):
-            continue
-        register_method(
-            Method(
-                name=f"exact-kick-{suffix}",
-                order=order,
-                kind="fixed",
-                problems=("heavy_top",),
-                symplectic=True,
-                preserves_casimirs=True,
-                description=f"heavy top: exact free flow + gravity kick (Celledoni et al. 2008), order {order}",
-                reference=f"Celledoni, Fasso, Safstrom & Zanna, SIAM J. Sci. Comput. 30 (2008); {reference}",
-                factory=_exact_kick_factory,
-                data=tuple(coefficients),
-            )
-        )
-
-
-_register()
+#: ``exact-kick-2/4/6/8``: kick + exact free flow, composed.
+METHODS: tuple[Method, ...] = tuple(
+    Method(
+        name=f"exact-kick-{composition.suffix}",
+        order=composition.order,
+        kind="fixed",
+        symplectic=True,
+        preserves_casimirs=True,
+        description=f"heavy top: exact free flow + gravity kick (Celledoni et al. 2008), order {composition.order}",
+        reference=f"Celledoni, Fasso, Safstrom & Zanna, SIAM J. Sci. Comput. 30 (2008); {composition.reference}",
+        factories={"heavy_top": _exact_kick_factory},
+        data=composition.coefficients,
+    )
+    for composition in COMPOSITIONS
+    if composition.suffix in MAIN_SUFFIXES
+)

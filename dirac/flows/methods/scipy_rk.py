@@ -12,9 +12,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from dirac.flows.methods.base import Method, Stepper, StepFailure, register_method
+from dirac.flows.dirac_field import ConstrainedField
+from dirac.flows.methods.base import Method, StepFailure, Stepper
+from dirac.flows.methods.rigid_body_stepper import needs_attitude, rigid_body_outputs
+from dirac.rigidbody.euler_poisson import lean_rhs_full, lean_rhs_M
 
-__all__ = ["ScipyStepper"]
+__all__ = ["ScipyStepper", "METHODS"]
 
 
 class ScipyStepper(Stepper):
@@ -31,20 +34,16 @@ class ScipyStepper(Stepper):
         self.tolerance = max(float(options.get("tolerance", 1e-8)), 2.3e-14)
         self.t_end = float(options["t_end"])
         self.t = 0.0
-        kind = getattr(problem, "system", "")
+        kind = problem.kind
         if kind in ("rigid_body", "heavy_top"):
-            from dirac.flows.methods.lie_poisson import needs_attitude
-
             self.with_R = needs_attitude(outputs) or kind == "heavy_top"
             self._fun, self._args = _rigid_body_rhs(problem, self.with_R)
             states = [np.concatenate([M, R.ravel()]) if self.with_R else M.copy() for M, R in zip(problem.M0, problem.R0)]
-        elif hasattr(problem, "analysed"):
+        elif kind == "analysed":
             self.analysed = problem.analysed
             self._fun, self._args = (lambda t, y: self.analysed.field(y)), ()
             states = [z.copy() for z in problem.z0]
         else:
-            from dirac.flows.dirac_field import ConstrainedField
-
             self.field = ConstrainedField(problem.mechanics)
             self._fun, self._args = self.field.scipy_rhs, ()
             states = [np.concatenate([q, p]) for q, p in zip(problem.q0, problem.p0)]
@@ -96,7 +95,6 @@ class ScipyStepper(Stepper):
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
             return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:])
-        from dirac.flows.methods.lie_poisson import rigid_body_outputs
 
         M = self.y[:, :3]
         R = self.y[:, 3:].reshape(-1, 3, 3) if self.with_R else None
@@ -112,10 +110,8 @@ class ScipyStepper(Stepper):
 
 
 def _rigid_body_rhs(problem, with_R: bool):  # noqa: ANN001, ANN202
-    from dirac.rigidbody.euler_poisson import lean_rhs_full, lean_rhs_M
-
     i1, i2, i3 = (float(x) for x in problem.inertia)
-    if getattr(problem, "system", "") == "heavy_top":
+    if problem.kind == "heavy_top":
         w = problem.weight_vector
 
         def heavy(t, y, i1, i2, i3):  # noqa: ANN001, ANN202
@@ -134,20 +130,20 @@ def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN
     return ScipyStepper(method, problem, outputs, options)
 
 
-for _name, _order, _ref in (
-    ("scipy-RK45", 5, "Dormand & Prince (1980), scipy.integrate.RK45"),
-    ("scipy-DOP853", 8, "Hairer, Norsett & Wanner, DOP853; scipy.integrate.DOP853"),
-):
-    register_method(
-        Method(
-            name=_name,
-            order=_order,
-            kind="adaptive",
-            problems=("rigid_body", "heavy_top", "constrained", "analysed"),
-            symplectic=False,
-            preserves_casimirs=False,
-            description=f"baseline: scipy {_name[6:]} with rtol = atol = tolerance (adaptive steps)",
-            reference=_ref,
-            factory=_factory,
-        )
+#: scipy's ``RK45`` and ``DOP853``, for every problem kind.
+METHODS: tuple[Method, ...] = tuple(
+    Method(
+        name=name,
+        order=order,
+        kind="adaptive",
+        symplectic=False,
+        preserves_casimirs=False,
+        description=f"baseline: scipy {name[6:]} with rtol = atol = tolerance (adaptive steps)",
+        reference=reference,
+        factories={kind: _factory for kind in ("rigid_body", "heavy_top", "constrained", "analysed")},
     )
+    for name, order, reference in (
+        ("scipy-RK45", 5, "Dormand & Prince (1980), scipy.integrate.RK45"),
+        ("scipy-DOP853", 8, "Hairer, Norsett & Wanner, DOP853; scipy.integrate.DOP853"),
+    )
+)

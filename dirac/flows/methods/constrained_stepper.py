@@ -1,0 +1,71 @@
+"""What the methods of constrained systems share: the batched state ``(q, p)``, its
+outputs, the Newton options and the translation of kernel failures into
+:class:`~dirac.flows.methods.base.StepFailure`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dirac.flows.dirac_field import constrained_outputs
+from dirac.flows.methods.base import StepFailure, Stepper
+
+__all__ = ["ConstrainedStepper", "newton_options", "singular_as_step_failure"]
+
+
+def newton_options(options: dict) -> tuple[float, int, np.ndarray]:
+    """``(tol, max_iter, info)`` of a stepper with a Newton iteration: the run's
+    ``newton_tolerance`` and ``max_newton_iterations`` and the ``info`` buffer its kernel fills."""
+    return float(options.get("newton_tolerance", 1e-12)), int(options.get("max_newton_iterations", 50)), np.zeros(4)
+
+
+class ConstrainedStepper(Stepper):
+    """Common state ``(q, p)`` (batched) and outputs of steppers of constrained systems."""
+
+    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+        super().__init__()
+        self.problem = problem
+        self.mechanics = problem.mechanics
+        self.outputs = outputs
+        self.q = np.ascontiguousarray(problem.q0, dtype=float).copy()
+        self.p = np.ascontiguousarray(problem.p0, dtype=float).copy()
+        self.tol, self.max_iter, self.info = newton_options(options)
+
+    def observe(self) -> dict[str, np.ndarray]:
+        return constrained_outputs(self.mechanics, self.outputs, self.q, self.p)
+
+    def finite(self) -> bool:
+        return bool(np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.p)))
+
+    def drift(self) -> float:
+        return max(self.mechanics.constraint_residual(q, p) for q, p in zip(self.q, self.p))
+
+    def _raise_if_failed(self, what: str) -> None:
+        if self.info[1] != 0.0:
+            raise StepFailure(
+                f"{what}: Newton iteration did not converge in {self.max_iter} iterations "
+                f"(residual {self.info[3]:.3g} > tolerance {self.tol:.1g}); reduce dt",
+                steps_done=int(self.info[0]),
+            )
+
+
+class singular_as_step_failure:  # noqa: N801 - used as a context manager
+    """Turn the kernels' division by a zero pivot into a :class:`StepFailure`.
+
+    The Newton matrix ``G M^{-1} G^T`` is singular where the constraints are not independent
+    (e.g. a pendulum of length 0 at the origin); the compiled solve then divides by zero.
+    """
+
+    def __init__(self, what: str) -> None:
+        self.what = what
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind, value, traceback) -> bool:  # noqa: ANN001
+        if kind is not None and issubclass(kind, ZeroDivisionError):
+            raise StepFailure(
+                f"{self.what}: the Newton matrix G M^-1 G^T is singular (the constraints are not independent "
+                "here); check the constraints and the state"
+            ) from None
+        return False

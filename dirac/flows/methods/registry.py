@@ -1,0 +1,69 @@
+"""The registry of integration methods: every name ``dirac run`` and a scene accept.
+
+Each family module exports its methods as data (a module-level tuple ``METHODS``); this
+module imports each family once and builds :data:`METHODS` from those tuples, so the
+registry is complete as soon as it is imported and no module registers anything as a
+side effect. The family modules never import this one.
+
+The ``lie-poisson-*`` methods integrate the free body (:mod:`~dirac.flows.methods.lie_poisson`)
+and, with gravity kicks, the heavy top (:mod:`~dirac.flows.methods.heavy_top`): the two
+factories are joined here, so neither of those modules imports the other.
+"""
+
+from __future__ import annotations
+
+from dirac.errors import InputError
+from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
+from dirac.flows.methods.base import Method
+
+__all__ = ["METHODS", "CONTRACT_NAMES", "get_method", "method_names"]
+
+#: The names every user sees first, ``auto`` included; the others are extras.
+CONTRACT_NAMES: tuple[str, ...] = (
+    "auto", "exact", "lie-poisson-2", "lie-poisson-4", "lie-poisson-6", "lie-poisson-8",
+    "rattle-2", "rattle-4", "midpoint", "scipy-RK45", "scipy-DOP853",
+)
+
+
+def _collect(*families: tuple[Method, ...]) -> dict[str, Method]:
+    """name -> Method over all families; a name given twice is a programming error."""
+    methods: dict[str, Method] = {}
+    for family in families:
+        for method in family:
+            if method.name in methods:
+                raise ValueError(f"method {method.name!r} defined twice")
+            methods[method.name] = method
+    return methods
+
+
+#: name -> Method, every method but ``auto`` (which chooses one of these:
+#: :mod:`dirac.flows.methods.auto`).
+METHODS: dict[str, Method] = _collect(
+    exact.METHODS,
+    tuple(method.with_factories(heavy_top.LIE_POISSON_FACTORIES) for method in lie_poisson.METHODS),
+    heavy_top.METHODS,
+    midpoint.METHODS,
+    rattle.METHODS,
+    scipy_rk.METHODS,
+)
+
+
+def method_names() -> list[str]:
+    """Every method name: :data:`CONTRACT_NAMES` first (``auto`` leading), then the extras sorted."""
+    extras = sorted(name for name in METHODS if name not in CONTRACT_NAMES)
+    return [*CONTRACT_NAMES, *extras]
+
+
+def get_method(name: str | Method) -> Method:
+    """The method called ``name`` (a :class:`Method` is returned as it is).
+
+    Raises
+    ------
+    InputError
+        Unknown name; the message lists the known names.
+    """
+    if isinstance(name, Method):
+        return name
+    if name not in METHODS:
+        raise InputError(f"unknown method {name!r}; choose one of: {', '.join(method_names())}")
+    return METHODS[name]
