@@ -26,5 +26,5 @@ def eps(i: int, j: int, k: int) -> int:
 
 
 def hat(w: np.ndarray) -> np.ndarray:
-    """``hat(w) v = w x v`` (PHYSICS.md §2)."""
+    """``hat(w) v = w x v`` (docs/conventions.md)."""
     return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)

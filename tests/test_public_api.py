@@ -1,4 +1,4 @@
-"""The lazy public names of `dirac` resolve to the objects CONTRACTS §5 promises."""
+"""The lazy public names of `dirac` resolve to the objects the public API (docs/api.md) promises."""
 
 from __future__ import annotations
 

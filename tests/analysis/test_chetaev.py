@@ -126,4 +126,4 @@ def test_H0_247_generates_the_euler_poisson_equations_250_251(analysis):
             for i in range(3)
         ]  # (250)
         np.testing.assert_allclose(R_dot, expected, atol=1e-10)
-        np.testing.assert_allclose(R_dot, R_ @ hat(omega), atol=1e-10)  # PHYSICS.md: R_dot = R hat(Omega)
+        np.testing.assert_allclose(R_dot, R_ @ hat(omega), atol=1e-10)  # R_dot = R hat(Omega), docs/conventions.md

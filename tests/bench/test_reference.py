@@ -1,4 +1,4 @@
-"""The benchmark's independent references, checked against closed forms and PHYSICS.md §4."""
+"""The benchmark's independent references, checked against closed forms and the standard test case (docs/conventions.md)."""
 
 from __future__ import annotations
 
@@ -22,10 +22,10 @@ def _standard_exact_inputs():
     return [Fraction(2), Fraction(1), Fraction(2, 3)], M0
 
 
-def test_taylor_reference_reproduces_the_40_digit_values_of_physics_md():
+def test_taylor_reference_reproduces_the_40_digit_values_of_the_standard_test_case():
     inertia, M0 = _standard_exact_inputs()
     M, R = taylor_rigid_body(inertia, M0, np.eye(3), [10.0])
-    expected = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])  # PHYSICS.md §4
+    expected = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])  # standard test case, docs/conventions.md
     np.testing.assert_allclose(M[0], expected, rtol=2e-16, atol=0)
     energy = 0.5 * (M[0, 0] ** 2 / 2.0 + M[0, 1] ** 2 + M[0, 2] ** 2 * 1.5)
     assert abs(energy - 0.64712527931383642713) < 2e-16
@@ -36,7 +36,7 @@ def test_taylor_reference_reproduces_the_40_digit_values_of_physics_md():
 
 def test_taylor_reference_returns_after_one_period_of_M():
     inertia, M0 = _standard_exact_inputs()
-    period = "10.73146523488280383381"  # PHYSICS.md §4
+    period = "10.73146523488280383381"  # standard test case, docs/conventions.md
     t = float(period)
     M, _ = taylor_rigid_body(inertia, M0, np.eye(3), [t])
     # t misses the period by delta = t - T (the double rounding of T), so

@@ -1,4 +1,4 @@
-"""`dirac analyze`: text, --json (CONTRACTS §4), --latex, --param, and error exits."""
+"""`dirac analyze`: text, --json (docs/file_formats.md), --latex, --param, and error exits."""
 
 from __future__ import annotations
 

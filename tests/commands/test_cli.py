@@ -1,4 +1,4 @@
-"""The dispatcher: help, exit statuses, one error line (CONTRACTS §2)."""
+"""The dispatcher: help, exit statuses, one error line (docs/cli.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""``dirac demo``: the flagship scene (PHYSICS.md §4) with a summary."""
+"""``dirac demo``: the flagship scene (the standard test case, docs/conventions.md) with a summary."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ def test_demo_prints_method_steps_time_and_conservation(run_cli):
     assert status == 0
     assert "warning: " in stderr and "triangle inequality" in stderr  # I = (2, 1, 2/3) is not physical
     assert "method         exact" in stdout
-    assert "H_0 = 0.647125279313836" in stdout  # PHYSICS.md §4: 0.64712527931383642713
+    assert "H_0 = 0.647125279313836" in stdout  # reference H_0 = 0.64712527931383642713 (docs/conventions.md)
     assert "t = 0 .. 1000" in stdout
     for label in ("energy H_0", "Casimir |M|^2", "lab momentum m = R M", "|R^T R - 1|"):
         assert _value(stdout, label) < 1e-12
@@ -40,7 +40,7 @@ def test_demo_with_a_splitting_method_and_output_file(run_cli, tmp_path):
         M = data["M"]
         t = data["t"]
     assert meta["method"] == "lie-poisson-6" and meta["complete"] is True
-    # PHYSICS.md §4: M(10) of the standard body
+    # M(10) of the standard test case (docs/conventions.md)
     ten = int(np.argmin(np.abs(t - 10.0)))
     assert t[ten] == 10.0
     assert np.abs(M[ten] - [0.40706613658804081, 0.28300742681284408, 0.86844916766156164]).max() < 1e-7

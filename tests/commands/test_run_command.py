@@ -1,4 +1,4 @@
-"""``dirac run SCENE.toml [--out FILE.npz] [--no-progress]`` (CONTRACTS §2, §6, §7)."""
+"""``dirac run SCENE.toml [--out FILE.npz] [--no-progress]`` (docs/cli.md, docs/file_formats.md)."""
 
 from __future__ import annotations
 

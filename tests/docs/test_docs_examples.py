@@ -31,7 +31,7 @@ def test_page_examples_run_as_shown(page: Path, tmp_path: Path, monkeypatch: pyt
 
 def test_readme_has_the_contract_commands_and_a_runnable_example() -> None:
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    # CONTRACTS §1: the two set-up commands, verbatim
+    # the two set-up commands of the quick start, verbatim (install + demo, install + tests)
     assert "pip install . && dirac demo" in text
     assert "pip install '.[test]' && pytest" in text
     python_blocks = [b for b in parse_blocks(ROOT / "README.md") if b.language == "python"]

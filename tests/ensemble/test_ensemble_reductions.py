@@ -1,4 +1,4 @@
-"""Per-member reductions against closed forms (PHYSICS.md §4) and independent code paths."""
+"""Per-member reductions against closed forms (the standard test case, docs/conventions.md) and independent code paths."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from dirac.ensemble.chunk import compute_chunk
 from dirac.ensemble.scene import parse_ensemble_scene
 
-#: PHYSICS.md §4: the standard body, its period of M and M(10) (40-digit references).
+#: The standard test case (docs/conventions.md): the body, its period of M and M(10) (40-digit references).
 INERTIA = [2.0, 1.0, 2.0 / 3.0]
 M0 = [math.cos(1.1), 0.0, math.sin(1.1)]
 PERIOD = 10.73146523488280383381

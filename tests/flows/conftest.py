@@ -9,7 +9,7 @@ import pytest
 
 from dirac.errors import DiracWarning
 
-#: PHYSICS.md §4: the standard body and its reference values.
+#: The standard test case and its reference values (docs/conventions.md).
 STANDARD_INERTIA = np.array([2.0, 1.0, 2.0 / 3.0])
 STANDARD_M0 = np.array([np.cos(1.1), 0.0, np.sin(1.1)])
 STANDARD_M10 = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])

@@ -1,4 +1,4 @@
-"""Result files (CONTRACTS §7): exactly ``t``, the requested outputs and ``meta``; written
+"""Result files (docs/file_formats.md): exactly ``t``, the requested outputs and ``meta``; written
 atomically, so a failed write never leaves a partial file nor destroys an existing one."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Scene parsing and validation (CONTRACTS §6)."""
+"""Scene parsing and validation (docs/file_formats.md)."""
 
 from __future__ import annotations
 

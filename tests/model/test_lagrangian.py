@@ -1,4 +1,5 @@
-"""Validation of the Lagrangian input (issue #2, point 2) and system files."""
+"""Validation of the Lagrangian input and of system files: bad names, expressions and
+constraints are refused with a message that names them."""
 
 from __future__ import annotations
 

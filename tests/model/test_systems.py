@@ -1,4 +1,4 @@
-"""Loading systems by built-in name or by path (CONTRACTS §5)."""
+"""Loading systems by built-in name or by path (docs/api.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The Euler–Poisson vector field (250)–(251) and its invariants (PHYSICS.md §2)."""
+"""The Euler–Poisson vector field (250)–(251) and its invariants (docs/conventions.md)."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ def _random_state(rng):
 
 
 def test_energy_of_standard_case_matches_reference():
-    # PHYSICS.md §4: H = 0.64712527931383642713
+    # standard test case (docs/conventions.md): H = 0.64712527931383642713
     M0 = np.array([np.cos(1.1), 0.0, np.sin(1.1)])
     assert abs(energy(M0, [2.0, 1.0, 2.0 / 3.0]) - 0.64712527931383642713) < 1e-15
 

@@ -1,4 +1,4 @@
-"""The exact elliptic flow (dirac.rigidbody.exact) against PHYSICS.md §4 reference values,
+"""The exact elliptic flow (dirac.rigidbody.exact) against the standard test case's reference values,
 a tight DOP853 integration of (250)–(251), and the paper's closed forms (165), (183)."""
 
 from __future__ import annotations
@@ -184,7 +184,7 @@ def test_symmetric_top_183_by_exact_flow(m2, m3):
 
 
 def test_symmetric_top_183_sign_of_phi_against_dop853():
-    # PHYSICS.md §3: the sign of phi is convention dependent; with dR/dt = R hat(Omega)
+    # (183), (202): the sign of phi is convention dependent; with dR/dt = R hat(Omega)
     # the paper's +phi = (I2 - I3) m3 / (I2 I3) is right, and -phi is not.
     inertia = np.array([1.3, 1.3, 0.7])
     m2, m3 = 0.6, -0.9

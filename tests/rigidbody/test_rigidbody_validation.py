@@ -1,5 +1,5 @@
 """Validation of rigid-body inputs (dirac.rigidbody.inertia): errors name the value and
-the fix; the triangle-inequality warning (PHYSICS.md §2) is issued once and is not fatal."""
+the fix; the triangle-inequality warning (docs/conventions.md) is issued once and is not fatal."""
 
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ def test_bad_inertia_raises_input_error_naming_it(bad, fragment):
 
 
 def test_triangle_inequality_violation_warns_once_and_continues():
-    # PHYSICS.md §4: I = (2, 1, 2/3) has 1 + 2/3 < 2 -- no physical body.
+    # the standard test case: I = (2, 1, 2/3) has 1 + 2/3 < 2 -- no physical body.
     with pytest.warns(DiracWarning, match="triangle inequality") as record:
         out = validate_inertia([2.0, 1.0, 2.0 / 3.0])
     assert len(record) == 1

@@ -1,5 +1,5 @@
 """Lie–Poisson splitting methods (dirac.rigidbody.splitting): observed order, invariants,
-the paper's closed forms (165), (183), and the PHYSICS.md §4 reference value."""
+the paper's closed forms (165), (183), and the reference value of the standard test case (docs/conventions.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Bad input everywhere (issue #6, item 4), by property-based tests.
+"""Bad input everywhere is refused cleanly (exit 2, one ``error:`` line), by property-based tests.
 
 Random bad scenes, system files and command lines must give exit status 2 and exactly one
 ``error:`` line on stderr (``warning:`` lines may precede it), never a traceback or a
@@ -294,7 +294,7 @@ def test_bad_system_file_exits_2_with_one_error_line(system, cli, tmp_path):
 
 
 def test_inconsistent_lagrangian_is_refused_by_analyze(cli, tmp_path):
-    """``L = x_dot^2/2 + y``: the consistency of ``p_y = 0`` demands ``1 = 0`` (CONTRACTS §4)."""
+    """``L = x_dot^2/2 + y``: the consistency of ``p_y = 0`` demands ``1 = 0``: exit 2, ``error:``."""
     path = tmp_path / "system.toml"
     path.write_text(toml_document({"system": {"name": "inconsistent", "coordinates": ["x", "y"],
                                               "lagrangian": "x_dot**2/2 + y"}}))

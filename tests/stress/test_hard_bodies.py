@@ -1,4 +1,4 @@
-"""Hard bodies (issue #6, item 2): exact stays accurate, no method returns NaN silently.
+"""Hard bodies: exact stays accurate, no method returns NaN silently.
 
 Near the separatrix (``M(0)`` within 1e-6, 1e-9, 1e-12 of the intermediate axis, and on
 it), near-symmetric, needle-like, flat bodies and a fast spin about the axis of smallest

@@ -1,4 +1,4 @@
-"""Interrupted runs lose no data (issue #6, item 6; CONTRACTS §7 ``complete``).
+"""Interrupted runs lose no data (the result file keeps its samples, ``meta["complete"] = false``).
 
 A real ``dirac run`` process is interrupted with SIGINT (Ctrl-C) or SIGTERM while it
 integrates. Its stderr is a pseudo-terminal, so the progress bar appears exactly when the

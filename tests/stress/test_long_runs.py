@@ -1,7 +1,7 @@
-"""Long runs (issue #6, item 1): invariants at round-off, no secular energy growth.
+"""Long runs: invariants at round-off, no secular energy growth.
 
 Full sizes (``DIRAC_FULL_STRESS=1``): ``1e7`` steps of ``lie-poisson-2``, ``1e6`` of
-``lie-poisson-4``/``-6`` on the standard body (PHYSICS.md §4), ``1e6`` steps of
+``lie-poisson-4``/``-6`` on the standard body (docs/conventions.md), ``1e6`` steps of
 ``rattle-2`` on the pendulum and the double pendulum. CI runs them shortened by
 :func:`stress_scale`. The criteria are those of :mod:`dirac.bench.stress`.
 """

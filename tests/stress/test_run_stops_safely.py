@@ -1,4 +1,4 @@
-"""Guard rails of ``dirac run`` end to end (issue #6, item 3).
+"""Guard rails of ``dirac run`` end to end: a failing run stops safely and keeps its data.
 
 A non-finite state, a Newton iteration that does not converge (RATTLE, midpoint) and
 constraint drift beyond ``drift_limit`` stop the run with exit status 2 and one ``error:``

@@ -1,8 +1,8 @@
-"""The high-precision reference of the stress suite against PHYSICS.md §4's 40-digit values.
+"""The high-precision reference of the stress suite against the standard test case's 40-digit values.
 
 The Taylor reference (:func:`dirac.bench.stress.taylor_reference`) judges every method on
 the hard bodies, so it is itself checked against values computed elsewhere: the energy,
-the period of ``M`` and ``M(10)`` of the standard body, to 40 digits in PHYSICS.md §4.
+the period of ``M`` and ``M(10)`` of the standard body, to 40 digits (docs/conventions.md).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ import numpy as np
 from dirac.bench.stress import taylor_reference
 
 INERTIA = (Fraction(2), Fraction(1), Fraction(2, 3))  # exact: 2/3 is not a float here
-M10 = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])  # PHYSICS.md §4
-PERIOD = 10.73146523488280383381  # PHYSICS.md §4
+M10 = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])  # docs/conventions.md
+PERIOD = 10.73146523488280383381  # docs/conventions.md
 
 
 def _exact_initial_momentum() -> list[Fraction]:
@@ -48,5 +48,5 @@ def test_reference_returns_to_the_start_after_one_period_and_keeps_the_attitude_
     assert np.max(np.abs(M[0] - start)) > 0.1  # half a period away it is elsewhere
     for rotation in R:
         assert np.max(np.abs(rotation.T @ rotation - np.eye(3))) <= 1e-15
-    # m = R M is conserved (PHYSICS.md §2)
+    # m = R M is conserved (docs/conventions.md)
     assert np.max(np.abs(R[1] @ M[1] - start)) <= 1e-15

@@ -1,8 +1,8 @@
-"""Unphysical but legal input is warned about, not refused (issue #6, item 5).
+"""Unphysical but legal input is warned about, not refused.
 
-``I_i + I_j < I_k`` belongs to no real body (PHYSICS.md §2: ``I_1 = g_2 + g_3`` etc. (72)
+``I_i + I_j < I_k`` belongs to no real body (docs/conventions.md: ``I_1 = g_2 + g_3`` etc. (72)
 with ``g_i >= 0``), yet the Euler–Poisson flow (250)–(251) is defined for any positive
-inertia and the standard body ``I = (2, 1, 2/3)`` of PHYSICS.md §4 is such a case: one
+inertia and the standard body ``I = (2, 1, 2/3)`` of the standard test case is such a case: one
 ``warning:`` line, and the run goes on. The Lagrangians (19) and (78) need a positive
 mass matrix ``g`` and refuse such moments with an ``error:``.
 """
@@ -42,7 +42,7 @@ def test_standard_body_warns_once_and_integrates():
         solution = integrate(problem, "exact", t_end=10.0, samples=2, outputs=["M"])
     dirac_warnings = [w for w in caught if issubclass(w.category, DiracWarning)]
     assert len(dirac_warnings) == 1 and "triangle" in str(dirac_warnings[0].message)
-    # PHYSICS.md §4: M(10) of the standard body
+    # M(10) of the standard test case (docs/conventions.md)
     assert np.allclose(solution["M"][-1], [0.40706613658804081, 0.28300742681284408, 0.86844916766156164],
                        rtol=0, atol=1e-13)
 

@@ -1,4 +1,4 @@
-"""Planar pendulum in Cartesian coordinates: the four-stage chain of PHYSICS.md §1.
+"""Planar pendulum in Cartesian coordinates: the four-stage chain of Sect. X, (205)-(217) (docs/conventions.md).
 
 Hand derivation (L_ext = m/2 |q_dot|^2 - m g y - lambda chi, chi = x^2 + y^2 - l^2):
 p = m q_dot, H_c = |p|^2/(2m) + m g y + lambda chi, H_T = H_c + u p_lambda.

@@ -1,6 +1,6 @@
 """Particle on a sphere and the Cartesian double pendulum: four stages, all second class.
 
-Hand derivation (PHYSICS.md §1, Sect. X (205)-(217)): with L = 1/2 q_dot^T M q_dot - V(q)
+Hand derivation (docs/conventions.md, Sect. X (205)-(217)): with L = 1/2 q_dot^T M q_dot - V(q)
 and holonomic chi_a, the chain is p_lambda_a = 0, chi_a = 0, grad chi_a . M^{-1} p = 0 and
 the fourth stage, which is linear in lambda:
 
