@@ -35,7 +35,13 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
     targets : bool
         Also measure the kernel/batch/start-up targets (the tests switch them off).
     """
-    from dirac.bench.report import format_rows, format_targets, machine_description, machine_line, write_json
+    from dirac.bench.report import (
+        format_rows,
+        format_targets,
+        machine_description,
+        machine_line,
+        write_json,
+    )
     from dirac.bench.suite import constrained_cases, rigid_body_cases
     from dirac.bench.workprecision import run_constrained_case, run_rigid_body_case
 

@@ -21,12 +21,13 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from dirac.bench.standard_body import STANDARD_INERTIA, STANDARD_M0
 from dirac.bench.timing import median_of, time_call
 
 __all__ = ["Target", "measure_targets", "work_precision_targets"]
 
-_STANDARD_INERTIA = np.array([2.0, 1.0, 2.0 / 3.0])
-_STANDARD_M0 = np.array([math.cos(1.1), 0.0, math.sin(1.1)])
+_STANDARD_INERTIA = np.array(STANDARD_INERTIA)
+_STANDARD_M0 = np.array(STANDARD_M0)
 
 
 @dataclass
@@ -310,7 +311,7 @@ def double_pendulum_target(repeats: int, n_steps: int) -> Target:
         quiet.__exit__(None, None, None)
     return Target(f"general: {n_steps:.0e} rattle-2 steps of the double pendulum (s)", cpu * 1e5 / n_steps, "s",
                   1.0, "<=", f"measured {cpu:.3f} s for {n_steps} steps (dt = 1e-3), scaled to 1e5 steps"
-                  if n_steps != 100_000 else f"dt = 1e-3, CPU of the integrate loop")
+                  if n_steps != 100_000 else "dt = 1e-3, CPU of the integrate loop")
 
 
 # --------------------------------------------------------------------------- start-up

@@ -3,7 +3,7 @@
 Near the separatrix (``M(0)`` within 1e-6, 1e-9, 1e-12 of the intermediate axis, and on
 it), near-symmetric, needle-like, flat bodies and a fast spin about the axis of smallest
 moment. The reference is the 50-digit Taylor integration of (250)-(251)
-(:func:`dirac.bench.stress.taylor_reference`, itself checked in test_stress_reference.py).
+(:func:`dirac.bench.taylor_reference.taylor_reference`, itself checked in test_stress_reference.py).
 """
 
 from __future__ import annotations
@@ -14,9 +14,15 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from stress_scaling import stress_scale
-from dirac.bench.stress import HARD_BODIES, HardBody, exact_tolerance, hard_body_rows, taylor_reference
+
+from dirac.bench.hard_bodies import (
+    HARD_BODIES,
+    HardBody,
+    exact_tolerance,
+    hard_body_rows,
+)
+from dirac.bench.taylor_reference import taylor_reference
 from dirac.errors import DiracWarning
 
 BODIES = {body.name: body for body in HARD_BODIES}

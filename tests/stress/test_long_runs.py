@@ -3,16 +3,17 @@
 Full sizes (``DIRAC_FULL_STRESS=1``): ``1e7`` steps of ``lie-poisson-2``, ``1e6`` of
 ``lie-poisson-4``/``-6`` on the standard body (docs/conventions.md), ``1e6`` steps of
 ``rattle-2`` on the pendulum and the double pendulum. CI runs them shortened by
-:func:`stress_scale`. The criteria are those of :mod:`dirac.bench.stress`.
+:func:`stress_scale`. The criteria are those of :mod:`dirac.bench.stress_criteria`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from stress_scaling import stress_scale
-from dirac.bench.stress import constrained_long_run, energy_drift_verdict, long_run
+
+from dirac.bench.long_runs import constrained_long_run, long_run
+from dirac.bench.stress_criteria import energy_drift_verdict
 
 
 @pytest.mark.slow

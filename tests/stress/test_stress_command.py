@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 
 import dirac.bench.stress as stress
+from dirac.bench.hard_bodies import HARD_BODY_METHODS
 
 
 def _tiny_plan(quick: bool) -> stress.StressPlan:
@@ -29,7 +30,7 @@ def test_stress_command_prints_the_tables_and_writes_json(tmp_path, run_cli, mon
     assert "all passed: yes" in out
     document = json.loads(target.read_text())
     assert document["passed"] is True
-    assert {row["method"] for row in document["hard_bodies"]} == set(stress.HARD_BODY_METHODS)
+    assert {row["method"] for row in document["hard_bodies"]} == set(HARD_BODY_METHODS)
     exact = next(row for row in document["hard_bodies"] if row["method"] == "exact")
     assert exact["error_M"] <= exact["bound"] and exact["error_R"] <= exact["bound"]
 

@@ -1,6 +1,6 @@
 """The high-precision reference of the stress suite against the standard test case's 40-digit values.
 
-The Taylor reference (:func:`dirac.bench.stress.taylor_reference`) judges every method on
+The Taylor reference (:func:`dirac.bench.taylor_reference.taylor_reference`) judges every method on
 the hard bodies, so it is itself checked against values computed elsewhere: the energy,
 the period of ``M`` and ``M(10)`` of the standard body, to 40 digits (docs/conventions.md).
 """
@@ -12,7 +12,7 @@ from fractions import Fraction
 import mpmath
 import numpy as np
 
-from dirac.bench.stress import taylor_reference
+from dirac.bench.taylor_reference import taylor_reference
 
 INERTIA = (Fraction(2), Fraction(1), Fraction(2, 3))  # exact: 2/3 is not a float here
 M10 = np.array([0.40706613658804081, 0.28300742681284408, 0.86844916766156164])  # docs/conventions.md
