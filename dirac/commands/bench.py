@@ -1,8 +1,8 @@
 """``dirac bench``: work–precision benchmark against scipy baselines, in one run.
 
-``dirac bench [--quick] [--json FILE] [--plot FILE.png]`` (CONTRACTS §2). The flags
-``--stress`` (issue #6) and ``--ensemble`` (issue #8) hand over to their own benchmark
-modules when those are installed.
+``dirac bench [--quick] [--json FILE] [--plot FILE.png]``. The flags ``--stress`` and
+``--ensemble`` hand over to their own commands, :mod:`dirac.commands.bench_stress` and
+:mod:`dirac.commands.bench_ensemble`, when those are installed.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser.add_argument("--json", metavar="FILE", help="write every run (one row each) and the targets as JSON")
     parser.add_argument("--plot", metavar="FILE.png", help="draw CPU time against error (log-log)")
     parser.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
-    parser.add_argument("--stress", action="store_true", help="run the stress benchmark instead (issue #6)")
-    parser.add_argument("--ensemble", action="store_true", help="run the ensemble benchmark instead (issue #8)")
+    parser.add_argument("--stress", action="store_true", help="run the stress benchmark instead (docs/stress.md)")
+    parser.add_argument("--ensemble", action="store_true", help="run the ensemble benchmark instead (docs/ensembles.md)")
     return parser
 
 
@@ -46,9 +46,9 @@ def main(args: argparse.Namespace) -> int:
     if args.stress and args.ensemble:
         raise InputError("give either --stress or --ensemble, not both")
     if args.stress:
-        return _delegate("stress", "dirac.bench.stress", args)
+        return _delegate("stress", "dirac.commands.bench_stress", args)
     if args.ensemble:
-        return _delegate("ensemble", "dirac.ensemble.bench", args)
+        return _delegate("ensemble", "dirac.commands.bench_ensemble", args)
     for flag, path in (("--json", args.json), ("--plot", args.plot)):
         if path and not Path(path).resolve().parent.is_dir():
             raise InputError(f"{flag} {path!r}: the folder {str(Path(path).resolve().parent)!r} does not exist; create it first")

@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from dirac.ensemble.engine import EnsembleReport
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -33,9 +37,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return parser
 
 
+def flag_spelling(name: str, value: object) -> str:
+    """An argument of :func:`~dirac.ensemble.engine.run_ensemble` as its flag: ``chunk_size, 10`` -> ``--chunk-size 10``."""
+    return f"--{name.replace('_', '-')} {value}"
+
+
 def main(args: argparse.Namespace) -> int:
     """Run or resume the ensemble; 0 when complete, 1 when chunks failed (listed on stderr)."""
-    from dirac.ensemble.engine import run_ensemble
     from dirac.errors import InputError
 
     if args.chunk_size is not None and args.chunk_size < 1:
@@ -44,21 +52,8 @@ def main(args: argparse.Namespace) -> int:
         raise InputError("--workers N needs --cluster local and N >= 1")
     if args.retries < 0:
         raise InputError(f"--retries {args.retries} must be >= 0")
-    report = run_ensemble(
-        args.scene,
-        args.out,
-        chunk_size=args.chunk_size,
-        scheduler=args.scheduler,
-        cluster=args.cluster,
-        n_workers=args.workers,
-        retries=args.retries,
-        progress=not args.no_progress,
-        notify=lambda message: print(message, file=sys.stderr, flush=True),
-    )
-    print(f"ensemble: {report.count} members in {report.chunks_total} chunks of {report.chunk_size} -> {report.out}")
-    print(f"  computed {report.chunks_computed} chunks, {report.chunks_skipped} already complete")
-    if report.member_steps:
-        print(f"  {report.member_steps:.3g} member-steps in {report.seconds:.2f} s: {report.throughput:.3g} member-steps/s")
+    report = _run(args)
+    _print_report(report)
     if report.failed:
         listed = ", ".join(f"{index} ({message})" for index, message in sorted(report.failed.items())[:3])
         print(
@@ -69,3 +64,33 @@ def main(args: argparse.Namespace) -> int:
         return 1
     print("  complete")
     return 0
+
+
+def _run(args: argparse.Namespace) -> EnsembleReport:
+    """:func:`~dirac.ensemble.engine.run_ensemble` with the flags; its argument errors name the flags."""
+    from dirac.ensemble.arguments import ArgumentError
+    from dirac.ensemble.engine import run_ensemble
+    from dirac.errors import InputError
+
+    try:
+        return run_ensemble(
+            args.scene,
+            args.out,
+            chunk_size=args.chunk_size,
+            scheduler=args.scheduler,
+            cluster=args.cluster,
+            n_workers=args.workers,
+            retries=args.retries,
+            progress=not args.no_progress,
+            notify=lambda message: print(message, file=sys.stderr, flush=True),
+        )
+    except ArgumentError as exc:
+        raise InputError(exc.spelled(flag_spelling)) from None
+
+
+def _print_report(report: EnsembleReport) -> None:
+    """The summary lines on stdout."""
+    print(f"ensemble: {report.count} members in {report.chunks_total} chunks of {report.chunk_size} -> {report.out}")
+    print(f"  computed {report.chunks_computed} chunks, {report.chunks_skipped} already complete")
+    if report.member_steps:
+        print(f"  {report.member_steps:.3g} member-steps in {report.seconds:.2f} s: {report.throughput:.3g} member-steps/s")

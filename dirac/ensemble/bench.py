@@ -1,4 +1,4 @@
-"""``dirac bench --ensemble``: ensemble throughput, plain batched vs local engine vs dask.
+"""Ensemble throughput (``dirac bench --ensemble``), plain batched vs local engine vs dask.
 
 Three ways to advance the same members (drawn from the same seed) by the same steps of
 ``lie-poisson-4`` with the attitude, reporting members x steps per second:
@@ -18,15 +18,13 @@ Each figure is the best of ``repeats`` runs (the machine may be shared).
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import time
 import warnings
 from pathlib import Path
+from typing import Any
 
-import numpy as np
-
-__all__ = ["measure", "main"]
+__all__ = ["measure", "format_table", "BENCH_SIZES"]
 
 
 def _scene(count: int, steps: int, dt: float):  # noqa: ANN202
@@ -50,13 +48,17 @@ def _scene(count: int, steps: int, dt: float):  # noqa: ANN202
         )
 
 
+#: ``quick -> (members, steps)`` of ``dirac bench --ensemble`` (full: 1e6 x 100; quick: 2e5 x 50).
+BENCH_SIZES: dict[bool, tuple[int, int]] = {False: (1_000_000, 100), True: (200_000, 50)}
+
+
 def _best(runs: list[tuple[float, float]]) -> dict[str, float]:
     """The run with the least wall time: ``seconds`` and ``cpu_seconds``."""
     wall, cpu = min(runs)
     return {"seconds": wall, "cpu_seconds": cpu}
 
 
-def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dict[str, object]:
+def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dict[str, Any]:
     """Time the three configurations (module docstring).
 
     Parameters
@@ -80,13 +82,15 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
         are not.
     """
     from dirac.ensemble.chunk import advance_members, warm_up
-    from dirac.ensemble.engine import dask_client, default_chunk_size, local_cluster, run_ensemble
+    from dirac.ensemble.chunk_plan import default_chunk_size
+    from dirac.ensemble.dask_executor import dask_client, local_cluster
+    from dirac.ensemble.engine import run_ensemble
 
     dt = 0.01
     scene = _scene(members, steps, dt)
     warm = _scene(4, 2, dt)
     work = members * steps
-    results: dict[str, object] = {"members": members, "steps": steps}
+    results: dict[str, Any] = {"members": members, "steps": steps}
 
     warm_up()
     plain_runs, kernel_runs = [], []
@@ -139,7 +143,7 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
     return results
 
 
-def format_table(results: dict[str, object]) -> str:
+def format_table(results: dict[str, Any]) -> str:
     """A readable table of :func:`measure`'s results."""
     lines = [
         f"ensemble throughput: {results['members']:.3g} members x {results['steps']} steps of lie-poisson-4 "
@@ -170,11 +174,3 @@ def format_table(results: dict[str, object]) -> str:
     )
     return "\n".join(lines)
 
-
-def main(args: argparse.Namespace) -> int:
-    """Entry of ``dirac bench --ensemble``: 1e6 members x 100 steps (``--quick``: 2e5 x 50)."""
-    quick = bool(getattr(args, "quick", False))
-    members, steps = (200_000, 50) if quick else (1_000_000, 100)
-    np.seterr(all="ignore")
-    print(format_table(measure(members, steps, workers=2, repeats=2)))
-    return 0

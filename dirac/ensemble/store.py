@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from dirac.ensemble.arguments import ArgumentError
 from dirac.ensemble.reductions import reduction_arrays
 from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
 from dirac.errors import InputError
@@ -92,11 +93,13 @@ class EnsembleStore:
 
         if self.root.exists():
             if not self.root.is_dir():
-                raise InputError(f"--out {self.root} is a file; give a folder")
+                raise ArgumentError("{out} is a file; give a folder", {"out": str(self.root)})
             foreign = sorted(p.name for p in self.root.iterdir() if p.name not in ("data.zarr", "chunks"))
             if foreign:
-                raise InputError(
-                    f"--out {self.root} is not empty and holds no ensemble ({foreign[:3]}); give a new or empty folder"
+                raise ArgumentError(
+                    "{out} is not empty and holds no ensemble ({found}); give a new or empty folder",
+                    {"out": str(self.root)},
+                    found=foreign[:3],
                 )
         self.marker_dir.mkdir(parents=True, exist_ok=True)
         for stale in self.marker_dir.glob("chunk-*.json"):  # from a creation that crashed

@@ -98,7 +98,7 @@ def test_missed_targets_are_reported_with_the_factor():
     assert "MISSED by 2.60x" in text and "MISSED by 2.00x" in text and "not measured" in text
 
 
-@pytest.mark.parametrize("flag,module", [("--stress", "dirac.bench.stress"), ("--ensemble", "dirac.ensemble.bench")])
+@pytest.mark.parametrize("flag,module", [("--stress", "dirac.commands.bench_stress"), ("--ensemble", "dirac.commands.bench_ensemble")])
 def test_stress_and_ensemble_flags_delegate_to_their_module(run_cli, monkeypatch, flag, module):
     import sys
     import types
@@ -112,7 +112,7 @@ def test_stress_and_ensemble_flags_delegate_to_their_module(run_cli, monkeypatch
     assert getattr(seen[0], flag.lstrip("-")) is True
 
 
-@pytest.mark.parametrize("flag,module", [("--stress", "dirac.bench.stress"), ("--ensemble", "dirac.ensemble.bench")])
+@pytest.mark.parametrize("flag,module", [("--stress", "dirac.commands.bench_stress"), ("--ensemble", "dirac.commands.bench_ensemble")])
 def test_stress_and_ensemble_flags_say_when_unavailable(run_cli, monkeypatch, flag, module):
     import sys
 

@@ -69,3 +69,18 @@ def test_cli_progress_bar_counts_members(write_scene, tmp_path, run_cli):
     status, _, stderr = run_cli("ensemble", str(scene), "--out", str(tmp_path / "out"), "--chunk-size", "10")
     assert status == 0, stderr
     assert "ensemble: 100%" in stderr and "30.0/30.0" in stderr and "member/s" in stderr
+
+
+def test_cli_names_its_flags_where_the_library_names_keyword_arguments(write_scene, tmp_path, run_cli):
+    scene = write_scene(count=30, outputs="[]", reductions='["final_state"]')
+    out = tmp_path / "out"
+    status, _, stderr = run_cli("ensemble", str(scene), "--out", str(out), "--chunk-size", "10", "--no-progress")
+    assert status == 0, stderr
+    status, _, stderr = run_cli("ensemble", str(scene), "--out", str(out), "--chunk-size", "15", "--no-progress")
+    lines = [line for line in stderr.splitlines() if line.startswith("error:")]
+    assert status == 2 and len(lines) == 1, stderr
+    assert f"--out {out} was started with chunk size 10; resume with --chunk-size 10" in lines[0]
+    assert "chunk_size=" not in lines[0] and "out=" not in lines[0]
+    other = write_scene("other.toml", count=30, seed=12, outputs="[]", reductions='["final_state"]')
+    status, _, stderr = run_cli("ensemble", str(other), "--out", str(out), "--no-progress")
+    assert status == 2 and f"error: --out {out} holds an ensemble of a different scene" in stderr

@@ -1,0 +1,84 @@
+"""The local executor of the ensemble engine: chunk after chunk on this machine.
+
+Each chunk is advanced by the batched kernel in parallel over all cores (numba); the
+members of the next chunk are drawn, and the previous chunk is written, while a chunk is
+integrated. A failing chunk is tried ``retries + 1`` times, then reported (never dropped).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+
+from dirac.ensemble.chunk import compute_chunk
+from dirac.ensemble.chunk_plan import chunk_bounds
+from dirac.ensemble.scene import EnsembleScene
+from dirac.ensemble.store import EnsembleStore
+
+__all__ = ["Recorder", "run_local"]
+
+#: ``record(marker, index, error)``: a finished chunk's marker (``error`` None) or its error.
+Recorder = Callable[[dict | None, int, str | None], None]
+
+
+def run_local(
+    scene: EnsembleScene,
+    store: EnsembleStore,
+    missing: list[int],
+    chunk_size: int,
+    run_id: str,
+    retries: int,
+    record: Recorder,
+) -> None:
+    """Compute and write the chunks ``missing`` one after the other, reporting each to ``record``."""
+
+    def write(index: int, start: int, stop: int, arrays: dict, info: dict) -> dict:
+        for attempt in range(retries + 1):
+            try:
+                return store.write_chunk(index, start, stop, arrays, info)
+            except OSError:
+                if attempt == retries:
+                    raise
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def finish(pending: tuple[int, Future[dict]]) -> None:
+        index, future = pending
+        try:
+            marker = future.result()
+        except Exception as exc:  # noqa: BLE001 -- reported, never dropped
+            record(None, index, f"write failed: {type(exc).__name__}: {exc}")
+        else:
+            record(marker, index, None)
+
+    pending: tuple[int, Future[dict]] | None = None
+    bounds = [chunk_bounds(scene.count, chunk_size, index) for index in missing]
+    with ThreadPoolExecutor(max_workers=1) as writer, ThreadPoolExecutor(max_workers=1) as drawer:
+        # draw the next chunk's members while this one is integrated (numpy's generators
+        # and array operations release the GIL)
+        upcoming = drawer.submit(scene.source.members, *bounds[0]) if bounds else None
+        for position, index in enumerate(missing):
+            start, stop = bounds[position]
+            try:
+                members = upcoming.result()
+            except Exception:  # noqa: BLE001 -- drawn again below, where errors are counted
+                members = None
+            upcoming = drawer.submit(scene.source.members, *bounds[position + 1]) if position + 1 < len(bounds) else None
+            error = None
+            for attempt in range(retries + 1):
+                try:
+                    wall, cpu = time.perf_counter(), time.process_time()
+                    arrays = compute_chunk(scene, start, stop, members if attempt == 0 else None)
+                    timing = {"seconds": time.perf_counter() - wall, "cpu_seconds": time.process_time() - cpu}
+                    break
+                except Exception as exc:  # noqa: BLE001 -- retried, then reported
+                    error = f"{type(exc).__name__}: {exc} (after {attempt + 1} attempts)"
+            else:
+                record(None, index, error)
+                continue
+            if pending is not None:
+                finish(pending)
+            info = {"run_id": run_id, "attempt": attempt + 1, "worker": None, **timing}
+            pending = (index, writer.submit(write, index, start, stop, arrays, info))
+        if pending is not None:
+            finish(pending)
