@@ -30,3 +30,9 @@ def test_distribution_name_is_not_dirac():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())
     assert config["project"]["name"] == "dirac-mechanics"
     assert config["project"]["scripts"]["dirac"] == "dirac.cli:main"
+
+
+def test_the_typed_marker_is_shipped():
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert (ROOT / "dirac" / "py.typed").is_file()
+    assert "py.typed" in config["tool"]["setuptools"]["package-data"]["dirac"]
