@@ -4,10 +4,14 @@ The Dirac–Bergmann algorithm on a Lagrangian with holonomic constraints (multi
 dynamical variables), Dirac brackets, and structure-preserving flows; the flagship is the
 free asymmetric rigid body, whose Dirac bracket is the Chetaev bracket.
 
-Heavy dependencies (sympy, numba, scipy) load on first use of the names that need them.
+Heavy dependencies (sympy, numba, scipy) load on first use of the names that need them,
+and so does ``__version__`` (the installed distribution's version, read from its metadata).
+Equation numbers such as (248) refer to A. A. Deriglazov, "Lagrangian and Hamiltonian
+formulations of asymmetric rigid body, considered as a constrained system" (2024); see
+docs/conventions.md and docs/references.md.
 """
 
-from __future__ import annotations
+from __future__ import annotations as _annotations
 
 from dirac.errors import (
     AnalysisError,
@@ -17,7 +21,10 @@ from dirac.errors import (
     InputError,
     IntegrationError,
 )
-from dirac.lazy_exports import lazy_exports
+from dirac.lazy_exports import lazy_exports as _lazy_exports
+
+#: Name of the distribution on the package index (the import name ``dirac`` is taken there).
+_DISTRIBUTION = "dirac-mechanics"
 
 __all__ = [
     "DiracError",
@@ -57,4 +64,14 @@ _LAZY: dict[str, str] = {
 }
 
 
-__getattr__, __dir__ = lazy_exports("dirac", globals(), _LAZY)
+def _installed_version() -> str:
+    """Version of the installed distribution, or ``"0+unknown"`` when it is not installed."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(_DISTRIBUTION)
+    except PackageNotFoundError:  # imported from a source tree that was never installed
+        return "0+unknown"
+
+
+__getattr__, __dir__ = _lazy_exports("dirac", globals(), _LAZY, computed={"__version__": _installed_version})

@@ -8,27 +8,54 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from importlib import import_module
+from types import ModuleType
 from typing import Any
 
 __all__ = ["lazy_exports"]
 
 
-def lazy_exports(package: str, namespace: dict, exports: Mapping[str, str]) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
-    """``(__getattr__, __dir__)`` for ``package`` that import ``exports[name]`` on first use.
+def lazy_exports(
+    package: str,
+    namespace: dict[str, Any],
+    exports: Mapping[str, str],
+    computed: Mapping[str, Callable[[], Any]] | None = None,
+) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
+    """``(__getattr__, __dir__)`` for ``package`` that resolve names on first use.
 
-    The value is stored in ``namespace`` (the package's ``globals()``), so the import
-    happens once.
+    Parameters
+    ----------
+    package
+        Dotted name of the package, for the error message of an unknown attribute.
+    namespace
+        The package's ``globals()``; a resolved value is stored there, so the work
+        happens once.
+    exports
+        Public name -> module that defines it (imported on first access).
+    computed
+        Name -> function computing its value on first access (e.g. ``__version__``
+        from the package metadata, which is slow to import).
+
+    Returns
+    -------
+    tuple
+        ``__getattr__`` and ``__dir__`` for the package module. ``__dir__`` lists the
+        package's own names and the lazy ones, not the submodules it happens to have
+        imported.
     """
+    computed = dict(computed or {})
 
     def __getattr__(name: str) -> Any:
-        module = exports.get(name)
-        if module is None:
+        if name in computed:
+            value = computed[name]()
+        elif name in exports:
+            value = getattr(import_module(exports[name]), name)
+        else:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
-        value = getattr(import_module(module), name)
         namespace[name] = value
         return value
 
     def __dir__() -> list[str]:
-        return sorted(set(namespace) | set(exports))
+        own = {name for name, value in namespace.items() if not isinstance(value, ModuleType)}
+        return sorted(own | set(exports) | set(computed))
 
     return __getattr__, __dir__

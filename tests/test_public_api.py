@@ -24,9 +24,22 @@ def test_unknown_attribute_is_an_attribute_error():
 
 
 def test_flows_integrate_is_the_function_whatever_was_imported_first():
-    # regression: robustness finding F9 (module and function shared the name `integrate`)
+    # regression: the module dirac.flows.integration and the function once shared the name `integrate`
     import dirac.flows.integration  # noqa: F401
     from dirac.flows import integrate
 
     assert callable(integrate) and not inspect.ismodule(integrate)
     assert integrate is dirac.integrate
+
+
+def test_version_comes_from_the_installed_distribution():
+    from importlib.metadata import version
+
+    assert dirac.__version__ == version("dirac-mechanics")
+    assert "__version__" in dir(dirac)
+
+
+def test_dir_lists_the_public_names_and_no_import_leftovers():
+    listed = set(dir(dirac))
+    assert set(dirac.__all__) <= listed
+    assert not {"annotations", "lazy_exports", "errors"} & listed

@@ -26,9 +26,9 @@ Examples
 >>> save_png(fig, "steady.png")                     # doctest: +SKIP
 """
 
-from __future__ import annotations
+from __future__ import annotations as _annotations
 
-from dirac.lazy_exports import lazy_exports
+from dirac.lazy_exports import lazy_exports as _lazy_exports
 
 __all__ = [
     "plot_result",
@@ -51,4 +51,4 @@ _LAZY: dict[str, str] = {
 }
 
 
-__getattr__, __dir__ = lazy_exports("dirac.plots", globals(), _LAZY)
+__getattr__, __dir__ = _lazy_exports("dirac.plots", globals(), _LAZY)
