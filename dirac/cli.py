@@ -19,14 +19,14 @@ from collections.abc import Sequence
 
 from dirac.errors import DiracError, install_warning_printer
 
-#: sub-command name -> (module, one-line help)
-COMMANDS: dict[str, tuple[str, str]] = {
-    "demo": ("dirac.commands.demo", "run the flagship free-rigid-body scene and print a summary"),
-    "systems": ("dirac.commands.systems", "list the built-in systems"),
-    "analyze": ("dirac.commands.analyze", "run the Dirac-Bergmann algorithm on a system"),
-    "run": ("dirac.commands.run", "run a scene file and write its results"),
-    "bench": ("dirac.commands.bench", "work-precision benchmark against scipy baselines"),
-    "ensemble": ("dirac.commands.ensemble", "run an ensemble scene (many bodies, chunked, resumable)"),
+#: sub-command name -> its module (which declares its arguments and help text)
+COMMANDS: dict[str, str] = {
+    "demo": "dirac.commands.demo",
+    "systems": "dirac.commands.systems",
+    "analyze": "dirac.commands.analyze",
+    "run": "dirac.commands.run",
+    "bench": "dirac.commands.bench",
+    "ensemble": "dirac.commands.ensemble",
 }
 
 
@@ -56,13 +56,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_ErrorExitParser)
-    for name, (module_name, help_text) in COMMANDS.items():
+    for name, module_name in COMMANDS.items():
         try:
             module = importlib.import_module(module_name)
         except ModuleNotFoundError as exc:
             if exc.name != module_name:
                 raise
-            sub = subparsers.add_parser(name, help=f"{help_text} (not available yet)")
+            sub = subparsers.add_parser(name, help="(not available in this version yet)")
             sub.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
             sub.set_defaults(handler=_not_available(name))
             continue

@@ -8,9 +8,17 @@ Modules, one job each:
 - :mod:`dirac.ensemble.reductions` -- streaming per-member summaries (flip time, ...);
 - :mod:`dirac.ensemble.chunk` -- one chunk: draw, advance (batched kernel), reduce;
 - :mod:`dirac.ensemble.store` -- zarr store, per-chunk markers, atomic ``meta.json``;
+- :mod:`dirac.ensemble.chunk_plan` -- the default chunk size and each chunk's members;
+- :mod:`dirac.ensemble.run_record` -- ``meta.json``: what the ensemble is, which chunks are done;
+- :mod:`dirac.ensemble.local_executor` -- the chunks one after the other on this machine;
+- :mod:`dirac.ensemble.dask_executor` -- one dask task per chunk on a cluster;
+- :mod:`dirac.ensemble.arguments` -- errors that name :func:`run_ensemble`'s arguments;
 - :mod:`dirac.ensemble.engine` -- :func:`run_ensemble`: plan, run locally or on dask, resume;
-- :mod:`dirac.ensemble.bench` -- ``dirac bench --ensemble``;
+- :mod:`dirac.ensemble.bench` -- the throughput measurement of ``dirac bench --ensemble``;
 - :mod:`dirac.ensemble.plot` -- the flip-time figure.
+
+The command lines are in :mod:`dirac.commands` (``ensemble``, ``bench_ensemble``,
+``ensemble_plot``).
 
 zarr and dask are imported only when a run needs them.
 """

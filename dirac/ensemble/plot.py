@@ -1,4 +1,4 @@
-"""Plot the flip times of an ensemble: ``python -m dirac.ensemble.plot DIR --out FILE.png``.
+"""Plot the flip times of an ensemble (``python -m dirac.commands.ensemble_plot DIR --out FILE.png``).
 
 Left: the distribution of the members' first flip times (``flip_time`` reduction).
 Right, when the store also holds ``initial_state`` and every member shares one inertia:
@@ -17,16 +17,14 @@ exact as ``|u_0| / |M| -> 0``.
 
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from dirac.errors import DiracError, InputError, install_warning_printer, warn
+from dirac.errors import InputError, warn
 
-__all__ = ["unstable_coordinate", "predicted_flip_time", "plot_flip_times", "main"]
+__all__ = ["unstable_coordinate", "predicted_flip_time", "plot_flip_times"]
 
 
 def unstable_coordinate(M: np.ndarray, inertia: np.ndarray) -> np.ndarray:
@@ -114,25 +112,3 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
     plt.close(fig)
     return summary
 
-
-def main(argv: list[str] | None = None) -> int:
-    """``python -m dirac.ensemble.plot DIR --out FILE.png``; prints a one-line summary.
-
-    Returns 0, or 2 with one ``error:`` line on stderr for bad input.
-    """
-    install_warning_printer()
-    parser = argparse.ArgumentParser(prog="python -m dirac.ensemble.plot", description=__doc__.splitlines()[0])
-    parser.add_argument("out", metavar="DIR", help="the ensemble's output folder")
-    parser.add_argument("--out", dest="image", metavar="FILE.png", required=True, help="image to write")
-    args = parser.parse_args(argv)
-    try:
-        summary = plot_flip_times(args.out, args.image)
-    except DiracError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    print(", ".join(f"{key} = {value:.6g}" for key, value in summary.items()), file=sys.stdout)
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from dirac.commands.ensemble_plot import main as plot_main
 from dirac.ensemble.chunk import compute_chunk
 from dirac.ensemble.engine import run_ensemble
-from dirac.ensemble.plot import main as plot_main
 from dirac.ensemble.plot import predicted_flip_time
 from dirac.ensemble.scene import parse_ensemble_scene
 
