@@ -79,7 +79,7 @@ def install_warning_printer() -> None:
     """
     previous = warnings.showwarning
 
-    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+    def show(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, DiracWarning):
             print(f"warning: {message}", file=sys.stderr)
         else:

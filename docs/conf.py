@@ -16,12 +16,13 @@ sys.path.insert(0, str(ROOT))
 
 project = "dirac"
 author = "The dirac developers"
-copyright = "2026, The dirac developers"  # noqa: A001 - Sphinx's name
+copyright = "2026, The dirac developers"  # Sphinx's name for the notice, shadowing a builtin
 try:
-    from importlib.metadata import version as _version
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as _installed_version  # `version` is a Sphinx setting
 
-    release = _version("dirac-mechanics")
-except Exception:  # noqa: BLE001 - not installed: the docs still build
+    release = _installed_version("dirac-mechanics")
+except PackageNotFoundError:  # not installed: the docs still build
     release = "0.1.0"
 
 extensions = [
@@ -56,7 +57,7 @@ html_theme_options = {
 }
 
 
-def _markdown_fences_to_rst(app, what, name, obj, options, lines):  # noqa: ANN001, ARG001
+def _markdown_fences_to_rst(app, what, name, obj, options, lines):
     """Let docstrings use Markdown code fences: turn them into ``code-block`` directives."""
     import re
 
@@ -79,5 +80,5 @@ def _markdown_fences_to_rst(app, what, name, obj, options, lines):  # noqa: ANN0
     lines[:] = out
 
 
-def setup(app):  # noqa: ANN001, ANN201
+def setup(app):
     app.connect("autodoc-process-docstring", _markdown_fences_to_rst)

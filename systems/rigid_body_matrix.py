@@ -65,7 +65,7 @@ def inertia_symbols() -> tuple[sympy.Symbol, sympy.Symbol, sympy.Symbol]:
     return tuple(sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3))  # type: ignore[return-value]
 
 
-def mass_matrix_from_inertia(I_1, I_2, I_3):  # noqa: ANN001, N803 - symbols or numbers
+def mass_matrix_from_inertia(I_1, I_2, I_3):
     """Principal values of the mass matrix from the principal moments, inverse of (72).
 
     ``I_1 = g_2 + g_3`` etc. (72) give ``g_i = (I_j + I_k - I_i)/2``.
@@ -96,7 +96,7 @@ def orthogonality_constraints(R: sympy.Matrix) -> tuple[sympy.Expr, ...]:
     return tuple(result)
 
 
-def check_inertia(I_1: float, I_2: float, I_3: float) -> tuple[float, float, float]:  # noqa: N803
+def check_inertia(I_1: float, I_2: float, I_3: float) -> tuple[float, float, float]:
     """Refuse principal moments whose mass matrix ``g`` is not positive definite.
 
     The Lagrangians (19) and (78) need ``g_i = (I_j + I_k - I_i)/2 > 0`` (72): the
@@ -164,7 +164,7 @@ def system() -> Lagrangian:
     some ``g_i <= 0``) raises :class:`~dirac.errors.InputError`.
     """
     R, R_dot = rotation_symbols()
-    I = inertia_symbols()  # noqa: E741
+    I = inertia_symbols()
     g = mass_matrix_from_inertia(*I)
     kinetic = sum(
         g[i] / 2 * sum((R_dot[k, i] ** 2 for k in range(3)), sympy.Integer(0)) for i in range(3)
@@ -221,7 +221,7 @@ def surface_point(rotation: np.ndarray, angular_velocity: np.ndarray, inertia: n
     return phase_point(R, p, multipliers_221(omega, inertia), inertia)
 
 
-def phase_point(R: np.ndarray, p: np.ndarray, lam: np.ndarray, inertia) -> dict[str, float]:  # noqa: ANN001, N803
+def phase_point(R: np.ndarray, p: np.ndarray, lam: np.ndarray, inertia) -> dict[str, float]:
     """Name -> value of a phase-space point of the rigid-body Lagrangians (78) and (228).
 
     ``R``, its momentum ``p`` and the symmetric multipliers ``lam`` (3x3, stored as

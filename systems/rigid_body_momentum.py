@@ -33,7 +33,7 @@ from dirac_systems.rigid_body_matrix import (
 __all__ = ["system", "body_angular_momentum", "surface_point", "multipliers_on_surface"]
 
 
-def body_angular_momentum(R: sympy.Matrix, R_dot: sympy.Matrix, inertia) -> sympy.Matrix:  # noqa: ANN001, N803
+def body_angular_momentum(R: sympy.Matrix, R_dot: sympy.Matrix, inertia) -> sympy.Matrix:
     """``M_i(R, R_dot) = -1/2 I_ik eps_knm (R^T R_dot)_nm`` (227), ``I`` diagonal.
 
     Parameters
@@ -90,7 +90,7 @@ def system() -> Lagrangian:
     non-positive moment raises :class:`~dirac.errors.InputError`.
     """
     R, R_dot = rotation_symbols()
-    I = inertia_symbols()  # noqa: E741
+    I = inertia_symbols()
     M = body_angular_momentum(R, R_dot, I)
     # written through Omega_k = M_k / I_k as in (227)-(228), not expanded: the engine sees the
     # three velocity combinations and finds the primary constraints from them
