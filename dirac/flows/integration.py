@@ -64,8 +64,13 @@ def problem_kind(problem: object) -> str:
     InputError
         ``problem`` is not a problem (:class:`dirac.flows.problems.Problem`).
     """
+    return _as_problem(problem).kind
+
+
+def _as_problem(problem: object) -> Problem:
+    """``problem``, checked to be a :class:`Problem` of a known kind."""
     if isinstance(problem, Problem) and problem.kind in DEFAULT_OUTPUTS:
-        return problem.kind
+        return problem
     raise InputError(
         f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem, ConstrainedProblem "
         "or AnalysedProblem"
@@ -207,13 +212,14 @@ def integrate(
     t_end, samples, dt, tolerance = _validate(t_end, samples, dt, tolerance)
     _validate_guard_rails(drift_limit, newton_tolerance, max_newton_iterations)
     _validate_size(samples, problem)
-    kind = problem_kind(problem)
-    chosen_outputs = _validate_outputs(outputs, kind, problem.outputs)  # type: ignore[attr-defined]
+    checked = _as_problem(problem)
+    kind = checked.kind
+    chosen_outputs = _validate_outputs(outputs, kind, checked.outputs)
     extra: dict[str, object] = {}
     if (isinstance(method, str) and method == "auto"):
         from dirac.flows.methods.auto import choose_method
 
-        choice = choose_method(problem, kind, t_end=t_end, samples=samples, tolerance=tolerance, dt=dt,
+        choice = choose_method(checked, kind, t_end=t_end, samples=samples, tolerance=tolerance, dt=dt,
                                outputs=chosen_outputs)
         method_object, dt = get_method(choice.method), choice.dt
         extra["auto"] = {"chosen": choice.method, "reason": choice.reason, "estimated_error": choice.estimated_error}
@@ -238,11 +244,11 @@ def integrate(
         "newton_tolerance": float(newton_tolerance),
         "max_newton_iterations": int(max_newton_iterations),
     }
-    stepper = method_object.start(problem, chosen_outputs, options)
+    stepper = method_object.start(checked, chosen_outputs, options)
     stepper.warm_up()
     if stepper.kind != "exact":
         stepper.observe()  # compiles what the outputs need before the timed loop
-    return _Loop(problem, method_object, stepper, chosen_outputs, t_end, samples, dt, progress, drift_limit, extra).run()
+    return _Loop(checked, method_object, stepper, chosen_outputs, t_end, samples, dt, progress, drift_limit, extra).run()
 
 
 def _names_for(kind: str) -> list[str]:

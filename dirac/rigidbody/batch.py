@@ -23,8 +23,8 @@ the bodies (the baseline of ``dirac bench``).
 
 from __future__ import annotations
 
-from functools import lru_cache
 import math
+from functools import lru_cache
 
 import numpy as np
 from numba import njit, prange
@@ -316,7 +316,7 @@ def _validate_batch(
     if with_R:
         if not (isinstance(R, np.ndarray) and R.shape == (n_bodies, 3, 3)):
             raise InputError(
-                f"R must be a float64 array of shape ({n_bodies}, 3, 3) matching M; got {np.shape(R)}"
+                f"R must be a float64 array of shape ({n_bodies}, 3, 3) matching M; got {np.shape(R) if R is not None else ()}"
             )
         if R.dtype != np.float64 or not R.flags.c_contiguous or not R.flags.writeable:
             raise InputError("R must be a writeable C-contiguous float64 array (it is updated in place)")
@@ -423,7 +423,7 @@ def advance_batch_numpy(
     # SoA columns (views would be strided; contiguous copies are what numpy code would use)
     m = [np.ascontiguousarray(M[:, a]) for a in range(3)]
     w = [np.ascontiguousarray(inv[:, a]) for a in range(3)]
-    r = [[np.ascontiguousarray(R[:, a, b]) for b in range(3)] for a in range(3)] if with_R else None
+    r = [[np.ascontiguousarray(R[:, a, b]) for b in range(3)] for a in range(3)] if with_R and R is not None else None
 
     def rotate(k: int, h: float) -> None:
         j, l = (k + 1) % 3, (k + 2) % 3  # noqa: E741
@@ -444,7 +444,7 @@ def advance_batch_numpy(
         rotate(int(axes[last]), fd_join if step < n_steps - 1 else fd[last])
     for a in range(3):
         M[:, a] = m[a]
-    if r is not None:
+    if r is not None and R is not None:
         for a in range(3):
             for b in range(3):
                 R[:, a, b] = r[a][b]

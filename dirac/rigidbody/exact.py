@@ -160,9 +160,8 @@ class ExactRigidBodyFlow:
         else:
             p3, p1 = (hi, lo) if d2 >= 0.0 else (lo, hi)
         a1, a2, a3 = a[p1], a[p2], a[p3]
-        # same-sign sums: 2E - a_k G^2 = sum_{i != k} M_i^2 (a_i - a_k)
-        e_a3 = M[p1] ** 2 * (a1 - a3) + M[p2] ** 2 * (a2 - a3)
-        e_a1 = M[p2] ** 2 * (a2 - a1) + M[p3] ** 2 * (a3 - a1)
+        # same-sign sums: e_ak = 2E - a_k G^2 = sum_{i != k} M_i^2 (a_i - a_k); e_a1 and e_a3
+        # enter only through the hypotenuses below, e_a2 is computed
         e_a2 = M[p1] ** 2 * (a1 - a2) + M[p3] ** 2 * (a3 - a2)
         if a1 == a2:
             # symmetric top, m = 0: the values below without squares, which may underflow

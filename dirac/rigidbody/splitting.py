@@ -125,6 +125,7 @@ def build_sequence(
         ``1/I_a`` for the symmetric split, 0 for the 3-term split.
     """
     inv = np.asarray(inv_inertia, dtype=float)
+    base: tuple[tuple[int, float], ...]
     if splitting == "axes":
         base = ((0, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5))
         rate_of = {k: float(inv[k]) for k in range(3)}

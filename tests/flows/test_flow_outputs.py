@@ -121,9 +121,9 @@ def test_auto_picks_exact_for_the_free_body_sparse_or_dense(standard_problem):
 
 
 def test_auto_meets_the_tolerance_for_a_constrained_system(pendulum_system):
-    from dirac.flows import ConstrainedProblem
-
     from test_flow_convergence import pendulum_exact
+
+    from dirac.flows import ConstrainedProblem
 
     theta = 1.0
     problem = ConstrainedProblem(pendulum_system, [np.sin(theta), -np.cos(theta)], [0.0, 0.0])

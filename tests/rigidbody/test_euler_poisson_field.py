@@ -9,8 +9,8 @@ from dirac.rigidbody.euler_poisson import (
     energy,
     euler_poisson_rhs,
     lab_momentum,
-    lean_rhs_M,
     lean_rhs_full,
+    lean_rhs_M,
 )
 
 

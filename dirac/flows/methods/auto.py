@@ -25,9 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from dirac.errors import InputError
-from dirac.flows.methods.base import StepFailure
+from dirac.flows.methods.base import Method, StepFailure
 from dirac.flows.methods.registry import get_method
 from dirac.flows.methods.rigid_body_stepper import exact_flow, needs_attitude
+from dirac.rigidbody.splitting import CompositionScheme
 
 __all__ = ["AutoChoice", "choose_method"]
 
@@ -49,6 +50,15 @@ class AutoChoice:
     dt: float | None
     reason: str
     estimated_error: float | None = None
+
+
+def _stages(method: Method) -> int:
+    """Base steps per step: the length of the composition (1 for an uncomposed method)."""
+    if isinstance(method.data, CompositionScheme):
+        return len(method.data.coefficients)
+    if isinstance(method.data, tuple):
+        return len(method.data)
+    return 1
 
 
 def _state(stepper) -> np.ndarray:  # noqa: ANN001
@@ -98,6 +108,7 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
     options = {"t_end": t_end, "tolerance": tolerance, "newton_tolerance": 1e-12, "max_newton_iterations": 50}
     if kind == "rigid_body":
         return _rigid_body(problem, t_end, samples, tolerance, outputs, options)
+    candidates: tuple[str, ...]
     if kind == "heavy_top":
         candidates = ("lie-poisson-4", "lie-poisson-8")
         scale = 1.0 / _frequency(problem)
@@ -125,11 +136,7 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
         else:
             factor = 8.0
         step = dt0 * min(8.0, 0.5 * factor)
-        if method.data is None:
-            stages = 1
-        else:
-            stages = len(method.data) if isinstance(method.data, tuple) else len(method.data.coefficients)  # type: ignore[union-attr]
-        cost = (t_end / step) * stages
+        cost = (t_end / step) * _stages(method)
         if cost < best_cost:
             best_cost = cost
             predicted = error * growth * (step / dt0) ** method.order
@@ -165,7 +172,7 @@ def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, 
         factor = (tolerance / max(error * growth, 1e-300)) ** (1.0 / method.order)
         step = dt0 * min(4.0, 0.5 * factor)
         steps = max(samples - 1, math.ceil(t_end / step))
-        substeps = 4 * len(method.data.coefficients)  # type: ignore[union-attr]
+        substeps = 4 * _stages(method)
         cost = floor + batch * steps * substeps * SUBSTEP_US
         if cost < best_cost:
             best_cost = cost

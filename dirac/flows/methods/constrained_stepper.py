@@ -5,6 +5,9 @@ outputs, the Newton options and the translation of kernel failures into
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import numpy as np
 
 from dirac.flows.dirac_field import constrained_outputs
@@ -49,23 +52,17 @@ class ConstrainedStepper(Stepper):
             )
 
 
-class singular_as_step_failure:  # noqa: N801 - used as a context manager
+@contextmanager
+def singular_as_step_failure(what: str) -> Iterator[None]:
     """Turn the kernels' division by a zero pivot into a :class:`StepFailure`.
 
     The Newton matrix ``G M^{-1} G^T`` is singular where the constraints are not independent
     (e.g. a pendulum of length 0 at the origin); the compiled solve then divides by zero.
     """
-
-    def __init__(self, what: str) -> None:
-        self.what = what
-
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, kind, value, traceback) -> bool:  # noqa: ANN001
-        if kind is not None and issubclass(kind, ZeroDivisionError):
-            raise StepFailure(
-                f"{self.what}: the Newton matrix G M^-1 G^T is singular (the constraints are not independent "
-                "here); check the constraints and the state"
-            ) from None
-        return False
+    try:
+        yield
+    except ZeroDivisionError:
+        raise StepFailure(
+            f"{what}: the Newton matrix G M^-1 G^T is singular (the constraints are not independent "
+            "here); check the constraints and the state"
+        ) from None

@@ -46,7 +46,7 @@ class ExactStepper(Stepper):
         self.evaluations += n * batch
         flat_M = M.reshape(n * batch, 3)
         flat_R = R.reshape(n * batch, 3, 3) if R is not None else None
-        values = rigid_body_outputs(self.outputs, flat_M, flat_R, np.asarray(self.problem.inertia), self.problem)
+        values = rigid_body_outputs(self.outputs, flat_M, flat_R, np.asarray(self.problem.inertia))
         return {name: value.reshape((n, batch) + value.shape[1:]) for name, value in values.items()}
 
 

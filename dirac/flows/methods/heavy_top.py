@@ -26,13 +26,15 @@ This module gives the ``lie-poisson-*`` methods their heavy-top factory
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
 from dirac.flows.methods.base import Method, Stepper, StepperFactory
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper, exact_flow
 from dirac.rigidbody.heavy_top import heavy_top_advance, kick
-from dirac.rigidbody.splitting import build_sequence
+from dirac.rigidbody.splitting import CompositionScheme, build_sequence
 
 __all__ = ["HeavyTopSplittingStepper", "ExactKickStepper", "METHODS", "LIE_POISSON_FACTORIES"]
 
@@ -42,9 +44,9 @@ class HeavyTopSplittingStepper(RigidBodyStepper):
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
         super().__init__(problem, outputs)
-        scheme = method.data
-        self.gammas = np.asarray(scheme.coefficients, dtype=float)  # type: ignore[attr-defined]
-        self.sequence = build_sequence(self.inv_inertia, (1.0,), scheme.splitting)  # type: ignore[attr-defined]
+        scheme = cast(CompositionScheme, method.data)
+        self.gammas = np.asarray(scheme.coefficients, dtype=float)
+        self.sequence = build_sequence(self.inv_inertia, (1.0,), scheme.splitting)
         self.w = np.asarray(problem.weight_vector, dtype=float)
         self._stages = len(self.gammas) * (len(self.sequence[0]) + 1)
 
@@ -63,7 +65,7 @@ class ExactKickStepper(RigidBodyStepper):
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
         super().__init__(problem, outputs)
-        self.gammas = np.asarray(method.data, dtype=float)
+        self.gammas = np.asarray(cast(tuple[float, ...], method.data), dtype=float)
         self.w = np.asarray(problem.weight_vector, dtype=float)
 
     def _free(self, b: int, tau: float) -> None:

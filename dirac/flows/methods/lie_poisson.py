@@ -13,6 +13,8 @@ it (``with_R = False``).
 
 from __future__ import annotations
 
+from typing import cast
+
 from dirac.flows.methods.base import Method, Stepper
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
 from dirac.rigidbody import splitting
@@ -29,16 +31,16 @@ class LiePoissonStepper(RigidBodyStepper):
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
         super().__init__(problem, outputs)
-        scheme = method.data
+        scheme = cast(splitting.CompositionScheme, method.data)
         self._axes, self._rates, self._fractions, self._casimir_rate = splitting.build_sequence(
-            self.inv_inertia, scheme.coefficients, scheme.splitting  # type: ignore[attr-defined]
+            self.inv_inertia, scheme.coefficients, scheme.splitting
         )
         self._kernel = splitting.advance_sequence
         self._stages = int(self._axes.shape[0] - 1)
         # many bodies with the 3-term split: all advanced together by the batched kernel
         # (dirac.rigidbody.batch: blocks over the cores, vectorised trigonometry)
-        self._coefficients = tuple(scheme.coefficients)  # type: ignore[attr-defined]
-        self._batched = scheme.splitting == "axes" and self.M.shape[0] >= BATCH_THRESHOLD  # type: ignore[attr-defined]
+        self._coefficients = tuple(scheme.coefficients)
+        self._batched = scheme.splitting == "axes" and self.M.shape[0] >= BATCH_THRESHOLD
 
     def warm_up(self) -> None:
         M = self.M[0].copy()

@@ -16,6 +16,9 @@ the state of the last completed step.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import cast
+
 import numpy as np
 
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
@@ -32,7 +35,8 @@ class RattleStepper(ConstrainedStepper):
     def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
         super().__init__(problem, outputs, options)
         self.name = method.name
-        self.fractions = np.asarray(method.data, dtype=float)
+        self.fractions = np.asarray(cast(tuple[float, ...], method.data), dtype=float)
+        self._kernel: Callable[..., None]
         self.constant = self.mechanics.constant_mass is not None
         if self.constant:
             self.mechanics.mass_matrix(self.q[0])  # checks positivity

@@ -14,7 +14,7 @@ import numpy as np
 
 from dirac.flows.dirac_field import ConstrainedField
 from dirac.flows.methods.base import Method, StepFailure, Stepper
-from dirac.flows.methods.rigid_body_stepper import needs_attitude, rigid_body_outputs
+from dirac.flows.methods.rigid_body_stepper import gravity_weight, needs_attitude, rigid_body_outputs
 from dirac.rigidbody.euler_poisson import lean_rhs_full, lean_rhs_M
 
 __all__ = ["ScipyStepper", "METHODS"]
@@ -98,7 +98,7 @@ class ScipyStepper(Stepper):
 
         M = self.y[:, :3]
         R = self.y[:, 3:].reshape(-1, 3, 3) if self.with_R else None
-        return rigid_body_outputs(self.outputs, M, R, np.asarray(self.problem.inertia), self.problem)
+        return rigid_body_outputs(self.outputs, M, R, np.asarray(self.problem.inertia), gravity_weight(self.problem))
 
     def drift(self) -> float:
         if hasattr(self, "analysed"):
