@@ -308,7 +308,7 @@ WORDS = ["run", "analyze", "systems", "--out", "--json", "--latex", "--param", "
 
 
 @SETTINGS
-@given(argv=st.lists(st.sampled_from(WORDS), min_size=1, max_size=5))  # bare `dirac`: findings F8
+@given(argv=st.lists(st.sampled_from(WORDS), min_size=1, max_size=5))  # includes bare `dirac` (once status 2 without an error: line)
 def test_random_command_lines_never_crash(argv, cli, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     status, out, err = cli(*argv)

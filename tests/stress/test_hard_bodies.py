@@ -91,7 +91,7 @@ def test_exact_matches_the_reference_on_random_bodies(inertia, M0, radians):
 
     Components are 0 or at least 1e-9: closer to an axis is the named hard bodies' job, and
     within ~1e-150 of the separatrix the phase ``u0 ~ ln(1/delta)`` alone costs ~400 eps
-    (robustness finding F16)."""
+    (a limit the stress tests found; docs/stress.md)."""
     from hypothesis import assume
 
     assume(np.linalg.norm(M0) > 1e-3)
