@@ -44,15 +44,29 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from dirac.ensemble.distributions import Fixed, LogUniform, Uniform, parse_distribution
+from dirac.ensemble.distributions import (
+    Distribution,
+    Fixed,
+    LogUniform,
+    Uniform,
+    parse_distribution,
+)
 from dirac.ensemble.sampling import MemberSource, open_member_file
 from dirac.errors import InputError, warn
+from dirac.io.scene import (
+    read_scene_file,
+    scene_inertia,
+    scene_integer,
+    scene_number,
+    scene_table,
+    scene_vector,
+    warn_unknown_keys,
+)
 
 __all__ = [
     "TRAJECTORY_OUTPUTS",
@@ -201,52 +215,41 @@ def load_ensemble_scene(path: str | Path) -> EnsembleScene:
         Missing file, TOML syntax error, or any invalid key (named in the message).
     """
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read scene file {str(path)!r}: {exc.strerror}; check the path") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
+    data = read_scene_file(path)
     return parse_ensemble_scene(data, base_dir=path.resolve().parent, path=str(path))
 
 
 def _section(data: dict, name: str, required: bool) -> dict:
-    section = data.get(name)
-    if section is None:
-        if required:
-            raise InputError(f"the scene has no [{name}] section; add it (see docs/ensembles.md)")
-        return {}
-    if not isinstance(section, dict):
-        raise InputError(f"[{name}] must be a table")
-    for key in sorted(set(section) - _SECTION_KEYS[name]):
-        warn(f"[{name}] key '{key}' is unknown to ensemble scenes (known: {sorted(_SECTION_KEYS[name])}); ignoring it")
+    section = scene_table(data, name, required=required,
+                          hint="an ensemble scene needs [system], [run] and [ensemble]; see docs/ensembles.md")
+    warn_unknown_keys(section, _SECTION_KEYS[name], f"[{name}]", reader="ensemble scenes")
     return section
 
 
-def _number(section: dict, key: str, where: str, default: float | None = None, positive: bool = True) -> float:
+def _number(section: dict, key: str, where: str, default: float | None = None) -> float:
+    """A number ``> 0`` under ``key`` (``default`` when absent, if there is one)."""
     if key not in section:
         if default is None:
             raise InputError(f"{where} needs '{key}'")
         return default
-    value = section[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"{where} {key} = {value!r} must be a finite number")
-    if positive and value <= 0:
-        raise InputError(f"{where} {key} = {value!r} must be > 0")
-    return float(value)
+    return scene_number(section[key], f"{where} {key}", positive=True)
 
 
-def _integer(section: dict, key: str, where: str, default: int | None, minimum: int) -> int | None:
+def _optional_integer(section: dict, key: str, where: str, minimum: int) -> int | None:
+    """An integer ``>= minimum`` under ``key`` (None when absent); a float with an
+    integral value counts."""
     if key not in section:
-        return default
+        return None
     value = section[key]
     if isinstance(value, float) and value.is_integer():
         value = int(value)
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        raise InputError(f"{where} {key} = {value!r} must be an integer >= {minimum}")
-    return value
+    return scene_integer(value, f"{where} {key}", minimum=minimum)
+
+
+def _integer(section: dict, key: str, where: str, default: int, minimum: int) -> int:
+    """As :func:`_optional_integer`, with ``default`` when absent."""
+    value = _optional_integer(section, key, where, minimum)
+    return default if value is None else value
 
 
 def _names(section: dict, key: str, where: str, allowed: dict) -> tuple[str, ...]:
@@ -345,10 +348,13 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
     InputError
         Any invalid or missing key, named with the fix.
     """
-    from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
+    from dirac.rigidbody.inertia import (
+        validate_inertia,
+        validate_momentum,
+        validate_rotation,
+    )
 
-    for name in sorted(set(data) - set(_SECTION_KEYS)):
-        warn(f"scene section [{name}] is unknown to ensemble scenes (known: {sorted(_SECTION_KEYS)}); ignoring it")
+    warn_unknown_keys(data, set(_SECTION_KEYS), "the scene", reader="ensemble scenes")
     system = _section(data, "system", required=True)
     initial = _section(data, "initial", required=False)
     run = _section(data, "run", required=True)
@@ -359,7 +365,7 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
 
     # --- members
     file = ensemble.get("file")
-    count = _integer(ensemble, "count", "[ensemble]", None, 1)
+    count = _optional_integer(ensemble, "count", "[ensemble]", 1)
     digest = None
     if file is not None:
         if not isinstance(file, str):
@@ -372,17 +378,15 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
         if count is None:
             raise InputError("[ensemble] needs 'count' (the number of members) or 'file'")
     seed = _integer(ensemble, "seed", "[ensemble]", 0, 0)
-    if seed is not None and seed >= 2**63:
+    if seed >= 2**63:
         raise InputError(f"[ensemble] seed = {seed} is too large; give an integer below 2**63")
 
     defaults = {
-        "M": validate_momentum(initial["M"]) if "M" in initial else None,
-        "R": validate_rotation(initial["R"]) if "R" in initial else np.eye(3),
-        "inertia": None,
+        "M": validate_momentum(scene_vector(initial["M"], "[initial] M", "", (3,))) if "M" in initial else None,
+        "R": validate_rotation(scene_vector(initial["R"], "[initial] R", "", (3, 3))) if "R" in initial else np.eye(3),
+        "inertia": validate_inertia(scene_inertia(system)) if "inertia" in system else None,
     }
-    if "inertia" in system:
-        defaults["inertia"] = validate_inertia(system["inertia"])
-    distributions = {}
+    distributions: dict[str, Distribution] = {}
     for quantity in ("M", "R", "inertia"):
         table = ensemble.get(quantity, {})
         where = f"[ensemble.{quantity}]"
@@ -431,7 +435,7 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
         flip_axis = int(flip) - 1
     else:
         raise InputError(f"[ensemble] flip_axis = {flip!r}; give 1, 2, 3 or \"intermediate\"")
-    chunk_size = _integer(ensemble, "chunk_size", "[ensemble]", None, 1)
+    chunk_size = _optional_integer(ensemble, "chunk_size", "[ensemble]", 1)
     return EnsembleScene(
         source=MemberSource(count=count, seed=seed, distributions=distributions, file=file),
         method=method,

@@ -32,6 +32,13 @@ scipy baselines; the multipliers are completed on the constraint surface, output
 ``q``, ``p``, ``energy``, ``constraint_residual``). Parameters of a Lagrangian are
 overridden under ``[system] parameters``. Optional ``[run]`` keys: ``drift_limit``,
 ``newton_tolerance``, ``max_newton_iterations``. Unknown keys are warned about and ignored.
+
+This module is the one scene reader: reading the file (:func:`read_scene_file`), its
+tables (:func:`scene_table`), numbers, vectors and the rigid body's inertia
+(:func:`scene_number`, :func:`scene_integer`, :func:`scene_vector`,
+:func:`scene_inertia`) and unknown-key warnings (:func:`warn_unknown_keys`).
+:mod:`dirac.ensemble.scene` reads ensemble scenes with the same helpers and adds only
+what is particular to ensembles.
 """
 
 from __future__ import annotations
@@ -40,11 +47,25 @@ import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from dirac.errors import InputError, warn
-from dirac.validate import validate_array
+from dirac.validate import (
+    validate_array,
+    validate_boolean,
+    validate_finite,
+    validate_integer,
+    validate_positive,
+)
+
+if TYPE_CHECKING:
+    from dirac.flows.analysed import AnalysedProblem
+    from dirac.flows.problems import ConstrainedProblem, RigidBodyProblem
+    from dirac.model.lagrangian import Lagrangian
+
+    SceneProblem = RigidBodyProblem | ConstrainedProblem | AnalysedProblem
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "SCENE_SYSTEMS", "FLAGSHIP_SCENE"]
 
@@ -81,40 +102,127 @@ _GENERAL_INITIAL = {"q", "q_dot", "p", "project"}
 class Scene:
     """A parsed scene: the problem and the arguments of :func:`dirac.flows.integrate`."""
 
-    problem: object
+    problem: SceneProblem
     run: dict[str, object]
     source: str
     system: str
     meta: dict[str, object] = field(default_factory=dict)
 
 
-def _warn_unknown(table: dict, known: set[str], where: str, source: str) -> None:
-    unknown = sorted(set(table) - known)
-    if unknown:
-        warn(f"{source}: unknown key(s) in {where} ignored: {', '.join(unknown)}")
+# ----------------------------------------------------------------------------- reading helpers
+# Shared by every scene reader (this module and dirac.ensemble.scene): messages name the
+# scene (``source``, left out when empty), the table and the key, and say what to give.
 
 
-def _table(data: dict, key: str, source: str, required: bool = True) -> dict:
+def scene_label(source: str, name: str) -> str:
+    """How a message names ``name`` (a table or key) of the scene ``source``."""
+    return f"{source}: {name}" if source else name
+
+
+def read_scene_file(path: str | Path) -> dict:
+    """The tables of a scene file (TOML).
+
+    Raises
+    ------
+    InputError
+        When the file cannot be read (missing, a directory, no permission) or is not
+        valid UTF-8 TOML.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        reason = "it does not exist" if isinstance(exc, FileNotFoundError) else exc.strerror
+        raise InputError(f"cannot read scene file {str(path)!r}: {reason}; check the path") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
+
+
+def scene_table(data: dict, key: str, source: str = "", required: bool = True,
+                hint: str = "a scene needs [system], [initial] and [run]; see docs/file_formats.md") -> dict:
+    """The table ``[key]`` of a scene (``{}`` when it is absent and not ``required``).
+
+    Raises
+    ------
+    InputError
+        A required table is missing (the message adds ``hint``: which tables the scene
+        needs and where its format is described), or ``key`` is not a table.
+    """
     value = data.get(key)
     if value is None:
         if required:
-            raise InputError(f"{source}: missing [{key}] table (a scene needs [system], [initial] and [run]; see docs/file_formats.md)")
+            raise InputError(f"{scene_label(source, f'missing [{key}] table')} ({hint})")
         return {}
     if not isinstance(value, dict):
-        raise InputError(f"{source}: [{key}] must be a table")
+        raise InputError(f"{scene_label(source, f'[{key}]')} must be a table")
     return value
 
 
-def _number(value: object, name: str, source: str, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"{source}: {name} = {value!r} must be a finite number")
-    if positive and value <= 0:
-        raise InputError(f"{source}: {name} = {value!r} must be > 0")
-    return float(value)
+def warn_unknown_keys(table: dict, known: set[str], where: str, source: str = "",
+                      reader: str | None = None) -> None:
+    """Warn about the keys of ``table`` outside ``known``; they are ignored.
+
+    Parameters
+    ----------
+    table : dict
+        The table read.
+    known : set of str
+        The keys the reader uses.
+    where : str
+        The table in messages, e.g. ``"[run]"``.
+    source : str
+        The scene, named in front of the message when given.
+    reader : str, optional
+        The kind of scene, e.g. ``"ensemble scenes"``: then one warning per key, listing
+        the keys that kind of scene knows; otherwise one warning for all of them.
+    """
+    unknown = sorted(set(table) - set(known))
+    if not unknown:
+        return
+    if reader is None:
+        warn(scene_label(source, f"unknown key(s) in {where} ignored: {', '.join(unknown)}"))
+        return
+    for key in unknown:
+        warn(scene_label(source, f"{where} key '{key}' is unknown to {reader} (known: {sorted(known)}); ignoring it"))
 
 
-def _vector(value: object, name: str, source: str, shape: tuple[int, ...]) -> np.ndarray:
-    return validate_array(value, f"{source}: {name}", shape)
+def scene_number(value: object, name: str, source: str = "", positive: bool = False) -> float:
+    """A finite number (``> 0`` with ``positive``) named ``name``, e.g. ``"[run] dt"``."""
+    label = scene_label(source, name)
+    return validate_positive(value, label) if positive else validate_finite(value, label)
+
+
+def scene_integer(value: object, name: str, source: str = "", minimum: int = 1) -> int:
+    """An integer ``>= minimum`` named ``name``, e.g. ``"[run] samples"``."""
+    return validate_integer(value, scene_label(source, name), minimum=minimum)
+
+
+def scene_vector(value: object, name: str, source: str, shape: tuple[int, ...]) -> np.ndarray:
+    """A finite float64 array of the given shape named ``name``, e.g. ``"[initial] M"``."""
+    return validate_array(value, scene_label(source, name), shape)
+
+
+def scene_inertia(system: dict, source: str = "") -> np.ndarray:
+    """The principal moments ``[system] inertia`` of a rigid-body scene, shape (3,).
+
+    Only the numbers are checked here (shape, finiteness);
+    :func:`dirac.rigidbody.inertia.validate_inertia` checks them as the moments of a body.
+
+    Raises
+    ------
+    InputError
+        The key is missing or is not three finite numbers.
+    """
+    if "inertia" not in system:
+        raise InputError(scene_label(source, "[system] lacks 'inertia' (the principal moments [I1, I2, I3])"))
+    return scene_vector(system["inertia"], "[system] inertia", source, (3,))
+
+
+# ----------------------------------------------------------------------------- single-run scenes
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -127,51 +235,42 @@ def load_scene(path: str | Path) -> Scene:
         message names the file and the key.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"scene file {str(path)!r} does not exist")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
-    return scene_from_dict(data, source=str(path), base=path.parent)
+    return scene_from_dict(read_scene_file(path), source=str(path), base=path.parent)
 
 
 def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None) -> Scene:
     """Build a :class:`Scene` from the parsed TOML tables (see the module docstring)."""
-    _warn_unknown(data, _TOP_KEYS, "the scene", source)
-    system = _table(data, "system", source)
-    initial = _table(data, "initial", source)
-    run_table = _table(data, "run", source)
+    warn_unknown_keys(data, _TOP_KEYS, "the scene", source)
+    system = scene_table(data, "system", source)
+    initial = scene_table(data, "initial", source)
+    run_table = scene_table(data, "run", source)
     run = _run_options(run_table, source)
     name = system.get("name")
     if name in SCENE_SYSTEMS:
-        problem = _rigid_problem(str(name), system, initial, source)
+        problem: SceneProblem = _rigid_problem(str(name), system, initial, source)
     else:
         problem = _general_problem(system, initial, source, base or Path("."))
-    meta = {"scene": source}
-    return Scene(problem=problem, run=run, source=source, system=str(problem.system), meta=meta)  # type: ignore[attr-defined]
+    meta: dict[str, object] = {"scene": source}
+    return Scene(problem=problem, run=run, source=source, system=str(problem.system), meta=meta)
 
 
 def _run_options(table: dict, source: str) -> dict[str, object]:
-    _warn_unknown(table, _RUN_KEYS, "[run]", source)
+    warn_unknown_keys(table, _RUN_KEYS, "[run]", source)
     if "t_end" not in table:
         raise InputError(f"{source}: [run] lacks the required key 't_end' (the final time)")
-    run: dict[str, object] = {"t_end": _number(table["t_end"], "[run] t_end", source, positive=True)}
+    run: dict[str, object] = {"t_end": scene_number(table["t_end"], "[run] t_end", source, positive=True)}
     method = table.get("method", "auto")
     if not isinstance(method, str):
         raise InputError(f"{source}: [run] method must be a name (a string), e.g. \"auto\"")
     run["method"] = method
     if "dt" in table:
-        run["dt"] = _number(table["dt"], "[run] dt", source, positive=True)
+        run["dt"] = scene_number(table["dt"], "[run] dt", source, positive=True)
     for key in ("tolerance", "drift_limit", "newton_tolerance"):
         if key in table:
-            run[key] = _number(table[key], f"[run] {key}", source, positive=True)
+            run[key] = scene_number(table[key], f"[run] {key}", source, positive=True)
     for key in ("samples", "max_newton_iterations"):
         if key in table:
-            value = table[key]
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise InputError(f"{source}: [run] {key} = {value!r} must be an integer >= 1")
-            run[key] = value
+            run[key] = scene_integer(table[key], f"[run] {key}", source)
     if "outputs" in table:
         outputs = table["outputs"]
         if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
@@ -180,15 +279,13 @@ def _run_options(table: dict, source: str) -> dict[str, object]:
     return run
 
 
-def _rigid_problem(name: str, system: dict, initial: dict, source: str):  # noqa: ANN202
+def _rigid_problem(name: str, system: dict, initial: dict, source: str) -> RigidBodyProblem:
     from dirac.flows.problems import HeavyTopProblem, RigidBodyProblem
 
-    _warn_unknown(system, _HEAVY_KEYS if name == "heavy_top" else _RIGID_KEYS, "[system]", source)
-    _warn_unknown(initial, _RIGID_INITIAL, "[initial]", source)
-    if "inertia" not in system:
-        raise InputError(f"{source}: [system] lacks 'inertia' (the principal moments [I1, I2, I3])")
-    inertia = _vector(system["inertia"], "[system] inertia", source, (3,))
-    R = _vector(initial["R"], "[initial] R", source, (3, 3)) if "R" in initial else np.eye(3)
+    warn_unknown_keys(system, _HEAVY_KEYS if name == "heavy_top" else _RIGID_KEYS, "[system]", source)
+    warn_unknown_keys(initial, _RIGID_INITIAL, "[initial]", source)
+    inertia = scene_inertia(system, source)
+    R = scene_vector(initial["R"], "[initial] R", source, (3, 3)) if "R" in initial else np.eye(3)
     given = [key for key in ("M", "omega", "m") if key in initial]
     if len(given) != 1:
         raise InputError(
@@ -196,7 +293,7 @@ def _rigid_problem(name: str, system: dict, initial: dict, source: str):  # noqa
             f"velocity) or m (lab angular momentum); it gives {', '.join(given) or 'none'}"
         )
     key = given[0]
-    vector = _vector(initial[key], f"[initial] {key}", source, (3,))
+    vector = scene_vector(initial[key], f"[initial] {key}", source, (3,))
     if key == "omega":
         M = inertia * vector
     elif key == "m":
@@ -206,20 +303,20 @@ def _rigid_problem(name: str, system: dict, initial: dict, source: str):  # noqa
     else:
         M = vector
     if name == "heavy_top":
-        weight = _number(system.get("mass_gravity", 1.0), "[system] mass_gravity", source)
-        chi = _vector(system.get("center_of_mass", [0.0, 0.0, 1.0]), "[system] center_of_mass", source, (3,))
+        weight = scene_number(system.get("mass_gravity", 1.0), "[system] mass_gravity", source)
+        chi = scene_vector(system.get("center_of_mass", [0.0, 0.0, 1.0]), "[system] center_of_mass", source, (3,))
         return HeavyTopProblem(inertia, M, R, mass_gravity=weight, center_of_mass=chi)
     return RigidBodyProblem(inertia, M, R)
 
 
-def _general_problem(system: dict, initial: dict, source: str, base: Path):  # noqa: ANN202
+def _general_problem(system: dict, initial: dict, source: str, base: Path) -> ConstrainedProblem | AnalysedProblem:
     from dirac.flows.mechanics import MechanicalSystem
     from dirac.flows.problems import ConstrainedProblem
     from dirac.model.lagrangian import lagrangian_from_table
     from dirac.model.systems import load_system
 
-    _warn_unknown(system, _LAGRANGIAN_KEYS, "[system]", source)
-    _warn_unknown(initial, _GENERAL_INITIAL, "[initial]", source)
+    warn_unknown_keys(system, _LAGRANGIAN_KEYS, "[system]", source)
+    warn_unknown_keys(initial, _GENERAL_INITIAL, "[initial]", source)
     if "file" in system:
         file = Path(str(system["file"]))
         if not file.is_absolute():
@@ -256,10 +353,7 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path):  # n
     else:
         velocity = _coordinates(initial.get("q_dot", {}), "q_dot", names, source, required=False)
         p = mechanics.mass_matrix(q) @ velocity
-    project = initial.get("project", False)
-    if not isinstance(project, bool):
-        raise InputError(f"{source}: [initial] project must be true or false")
-    if project:
+    if validate_boolean(initial.get("project", False), scene_label(source, "[initial] project")):
         q, p = mechanics.project(q, p)
     try:
         return ConstrainedProblem(mechanics, q, p)
@@ -267,7 +361,7 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path):  # n
         raise InputError(f"{source}: {exc}") from None
 
 
-def _analysed_problem(lagrangian, overrides: dict, initial: dict, source: str):  # noqa: ANN001, ANN202
+def _analysed_problem(lagrangian: Lagrangian, overrides: dict, initial: dict, source: str) -> AnalysedProblem:
     """A Lagrangian that is not of the form 1/2 q_dot^T M q_dot - V (velocity-linear or
     singular): integrate the Dirac vector field of its analysis (``midpoint``, scipy)."""
     from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
@@ -291,7 +385,7 @@ def _analysed_problem(lagrangian, overrides: dict, initial: dict, source: str): 
 
 def _coordinates(value: object, key: str, names: tuple[str, ...], source: str, required: bool) -> np.ndarray:
     if isinstance(value, list):
-        array = _vector(value, f"[initial] {key}", source, (len(names),))
+        array = scene_vector(value, f"[initial] {key}", source, (len(names),))
         return array
     if not isinstance(value, dict):
         raise InputError(f"{source}: [initial] {key} must be a table {{ {names[0]} = ... }} or a list")
@@ -301,4 +395,4 @@ def _coordinates(value: object, key: str, names: tuple[str, ...], source: str, r
     missing = [n for n in names if n not in value]
     if missing and required:
         raise InputError(f"{source}: [initial] {key} lacks {', '.join(missing)}")
-    return np.array([_number(value.get(n, 0.0), f"[initial] {key}.{n}", source) for n in names])
+    return np.array([scene_number(value.get(n, 0.0), f"[initial] {key}.{n}", source) for n in names])

@@ -84,6 +84,26 @@ def test_scene_errors_and_warnings(tmp_path):
     assert scene.with_R and scene.steps == 10
 
 
+def test_ensemble_scenes_read_their_sections_numbers_and_vectors_like_single_run_scenes(tmp_path):
+    """The shared reader of dirac.io.scene: the same messages for the same mistakes."""
+    path = tmp_path / "s.toml"
+    members = 'count = 3\n[ensemble.M]\ndistribution = "sphere"\nnorm = 1.0\n[ensemble.inertia]\nvalue = [1, 1, 1]\n'
+    cases = [
+        (HEAD.replace('name = "rigid_body"', 'name = "rigid_body"\ninertia = [1, true, 2]') + members,
+         r"\[system\] inertia = \[1, True, 2\] contains true/false"),
+        (HEAD.replace('name = "rigid_body"', 'name = "rigid_body"\ninertia = [1, 2]') + members,
+         r"\[system\] inertia has shape \(2,\)"),
+        (HEAD.replace("dt = 0.1", "dt = 0") + members, r"\[run\] dt = 0 must be a finite number > 0"),
+        (HEAD.replace("samples = 3", "samples = 2.5") + members, r"\[run\] samples = 2.5 must be an integer >= 2"),
+        ("[ensemble]\ncount = 3\n[run]\ndt = 0.1\nt_end = 1.0\n", r"missing \[system\] table .*docs/ensembles.md"),
+        (HEAD.replace("[run]", "[initial]\nM = [0, 1]\n[run]") + members, r"\[initial\] M has shape \(2,\)"),
+    ]
+    for text, match in cases:
+        path.write_text(text)
+        with pytest.raises(InputError, match=match):
+            load_ensemble_scene(path)
+
+
 def test_fingerprint_ignores_the_chunk_size_and_sees_the_physics(tmp_path):
     base = HEAD + 'count = 3\n[ensemble.M]\ndistribution = "sphere"\nnorm = 1.0\n[ensemble.inertia]\nvalue = [1, 2, 3]\n'
     (tmp_path / "a.toml").write_text(base)
