@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dirac.bench.standard_body import STANDARD_INERTIA, STANDARD_M0
+
 __all__ = ["RigidBodyCase", "ConstrainedCase", "rigid_body_cases", "constrained_cases", "MethodGrid"]
 
 
@@ -94,8 +96,8 @@ def rigid_body_cases(quick: bool) -> list[RigidBodyCase]:
         RigidBodyCase(
             "standard",
             "I = (2, 1, 2/3), M(0) = (cos 1.1, 0, sin 1.1), T = 100 (the standard test case of Hairer, Lubich & Wanner)",
-            (2.0, 1.0, 2.0 / 3.0),
-            (math.cos(1.1), 0.0, math.sin(1.1)),
+            STANDARD_INERTIA,
+            STANDARD_M0,
             100.0,
             grids,
         ),

@@ -14,8 +14,7 @@ from collections.abc import Callable
 from typing import Any
 
 from dirac.ensemble.chunk import compute_chunk, warm_up
-from dirac.ensemble.chunk_plan import chunk_bounds
-from dirac.ensemble.local_executor import Recorder
+from dirac.ensemble.chunk_work import ChunkWork
 from dirac.ensemble.scene import EnsembleScene
 from dirac.ensemble.store import EnsembleStore
 from dirac.errors import InputError
@@ -60,7 +59,7 @@ def run_chunk(
         worker = get_worker().address
         host = worker.split("://")[-1].rsplit(":", 1)[0]
         threads = max(1, (os.cpu_count() or 1) // max(1, host_threads.get(host, 1)))
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]  # set from the environment at import
     wall, cpu = time.perf_counter(), time.process_time()
     arrays = compute_chunk(scene, start, stop)
     timing = {"seconds": time.perf_counter() - wall, "cpu_seconds": time.process_time() - cpu}
@@ -68,13 +67,7 @@ def run_chunk(
 
 
 def run_dask(
-    scene: EnsembleScene,
-    store: EnsembleStore,
-    missing: list[int],
-    chunk_size: int,
-    run_id: str,
-    retries: int,
-    record: Recorder,
+    work: ChunkWork,
     *,
     scheduler: str | None,
     n_workers: int | None,
@@ -109,23 +102,23 @@ def run_dask(
             host_threads[host] = host_threads.get(host, 0) + int(worker.get("nthreads", 1))
         start_time = time.perf_counter()
         futures = {}
-        for index in missing:
-            start, stop = chunk_bounds(scene.count, chunk_size, index)
-            info = {"run_id": run_id}
+        for index in work.missing:
+            start, stop = work.bounds(index)
+            info = {"run_id": work.run_id}
             future = client.submit(
-                run_chunk, scene, str(store.root), index, start, stop, info, host_threads,
-                key=f"dirac-ensemble-chunk-{index}-{run_id}", retries=retries,
+                run_chunk, work.scene, str(work.store.root), index, start, stop, info, host_threads,
+                key=f"dirac-ensemble-chunk-{index}-{work.run_id}", retries=work.retries,
             )
             futures[future.key] = (future, index)
         for future in as_completed([f for f, _ in futures.values()]):
             index = futures[future.key][1]
             if future.status == "finished":
-                record(future.result(), index, None)
+                work.record(future.result(), index, None)
             elif future.status == "cancelled":
-                record(None, index, "the task was cancelled by the cluster (e.g. its scheduler restarted)")
+                work.record(None, index, "the task was cancelled by the cluster (e.g. its scheduler restarted)")
             else:
-                exc = future.exception()
-                record(None, index, f"{type(exc).__name__}: {exc} (after {retries + 1} attempts)")
+                failure = future.exception()
+                work.record(None, index, f"{type(failure).__name__}: {failure} (after {work.retries + 1} attempts)")
             future.release()
         return start_time, dashboard
     finally:

@@ -43,6 +43,7 @@ from typing import Any
 
 from dirac.ensemble.arguments import ArgumentError
 from dirac.ensemble.chunk_plan import chunk_count, default_chunk_size
+from dirac.ensemble.chunk_work import ChunkWork
 from dirac.ensemble.dask_executor import run_dask
 from dirac.ensemble.local_executor import run_local
 from dirac.ensemble.run_record import RunRecord, new_meta
@@ -198,9 +199,9 @@ def run_ensemble(
             bar.update(added)
 
     try:
+        work = ChunkWork(scene, store, missing, chunk_size, record.run_id, retries, on_chunk)
         report.seconds, report.dashboard = _run_missing(
-            scene, store, missing, chunk_size, record.run_id, retries, on_chunk,
-            scheduler=scheduler, n_workers=n_workers, client=client, say=say, local=local,
+            work, scheduler=scheduler, n_workers=n_workers, client=client, say=say, local=local,
         )
     finally:
         bar.close()
@@ -260,13 +261,7 @@ def _create_store(scene: EnsembleScene, store: EnsembleStore, chunk_size: int, n
 
 
 def _run_missing(
-    scene: EnsembleScene,
-    store: EnsembleStore,
-    missing: list[int],
-    chunk_size: int,
-    run_id: str,
-    retries: int,
-    on_chunk: Callable[[dict | None, int, str | None], None],
+    work: ChunkWork,
     *,
     scheduler: str | None,
     n_workers: int | None,
@@ -274,17 +269,17 @@ def _run_missing(
     say: Callable[[str], None],
     local: bool,
 ) -> tuple[float, str | None]:
-    """Step 4: run the chunks ``missing``; return (computation seconds, dask dashboard address).
+    """Step 4: run the chunks ``work.missing``; return (computation seconds, dask dashboard address).
 
     No cluster is started when nothing is missing.
     """
-    if not missing or local:
+    if not work.missing or local:
         start_time = time.perf_counter()
-        if missing:
-            run_local(scene, store, missing, chunk_size, run_id, retries, on_chunk)
+        if work.missing:
+            run_local(work)
         return time.perf_counter() - start_time, None
     start_time, dashboard = run_dask(
-        scene, store, missing, chunk_size, run_id, retries, on_chunk,
+        work,
         scheduler=scheduler, n_workers=n_workers, client=client, say=say,
     )
     return time.perf_counter() - start_time, dashboard

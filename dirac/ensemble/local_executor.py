@@ -8,30 +8,16 @@ integrated. A failing chunk is tried ``retries + 1`` times, then reported (never
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 
 from dirac.ensemble.chunk import compute_chunk
-from dirac.ensemble.chunk_plan import chunk_bounds
-from dirac.ensemble.scene import EnsembleScene
-from dirac.ensemble.store import EnsembleStore
+from dirac.ensemble.chunk_work import ChunkWork
 
-__all__ = ["Recorder", "run_local"]
+__all__ = ["run_local"]
 
-#: ``record(marker, index, error)``: a finished chunk's marker (``error`` None) or its error.
-Recorder = Callable[[dict | None, int, str | None], None]
-
-
-def run_local(
-    scene: EnsembleScene,
-    store: EnsembleStore,
-    missing: list[int],
-    chunk_size: int,
-    run_id: str,
-    retries: int,
-    record: Recorder,
-) -> None:
-    """Compute and write the chunks ``missing`` one after the other, reporting each to ``record``."""
+def run_local(work: ChunkWork) -> None:
+    """Compute and write the chunks ``work.missing`` one after the other, reporting each to ``work.record``."""
+    scene, store, missing, retries, record = work.scene, work.store, work.missing, work.retries, work.record
 
     def write(index: int, start: int, stop: int, arrays: dict, info: dict) -> dict:
         for attempt in range(retries + 1):
@@ -52,7 +38,7 @@ def run_local(
             record(marker, index, None)
 
     pending: tuple[int, Future[dict]] | None = None
-    bounds = [chunk_bounds(scene.count, chunk_size, index) for index in missing]
+    bounds = [work.bounds(index) for index in missing]
     with ThreadPoolExecutor(max_workers=1) as writer, ThreadPoolExecutor(max_workers=1) as drawer:
         # draw the next chunk's members while this one is integrated (numpy's generators
         # and array operations release the GIL)
@@ -60,7 +46,7 @@ def run_local(
         for position, index in enumerate(missing):
             start, stop = bounds[position]
             try:
-                members = upcoming.result()
+                members = upcoming.result() if upcoming is not None else None
             except Exception:  # noqa: BLE001 -- drawn again below, where errors are counted
                 members = None
             upcoming = drawer.submit(scene.source.members, *bounds[position + 1]) if position + 1 < len(bounds) else None
@@ -78,7 +64,7 @@ def run_local(
                 continue
             if pending is not None:
                 finish(pending)
-            info = {"run_id": run_id, "attempt": attempt + 1, "worker": None, **timing}
+            info = {"run_id": work.run_id, "attempt": attempt + 1, "worker": None, **timing}
             pending = (index, writer.submit(write, index, start, stop, arrays, info))
         if pending is not None:
             finish(pending)
