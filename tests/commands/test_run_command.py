@@ -105,7 +105,7 @@ def test_unknown_keys_warn_and_the_run_goes_on(tmp_path, run_cli):
 
 
 def test_help_lists_every_method(run_cli):
-    from dirac.flows.methods.base import method_names
+    from dirac.flows.methods.registry import method_names
 
     status, stdout, _ = run_cli("run", "--help")
     assert status == 0
