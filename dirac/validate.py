@@ -51,6 +51,11 @@ def _is_integer(value: object) -> TypeGuard[int]:
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
+def _shown(value: object) -> str:
+    """``repr`` of an input on one line (an array as the nested list of its entries)."""
+    return repr(value.tolist()) if isinstance(value, np.ndarray) else repr(value)
+
+
 def _with_hint(message: str, hint: str) -> str:
     return f"{message} ({hint})" if hint else message
 
@@ -191,11 +196,11 @@ def validate_array(value: object, name: str, shape: Sequence[int] | None = None,
     """
     wanted = f"{tuple(shape)} real numbers" if shape is not None else "real numbers"
     if contains_boolean(value):
-        raise InputError(f"{name} = {value!r} contains true/false; give {wanted}")
+        raise InputError(f"{name} = {_shown(value)} contains true/false; give {wanted}")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} = {value!r} is not numeric; give {wanted}") from exc
+        raise InputError(f"{name} = {_shown(value)} is not numeric; give {wanted}") from exc
     if shape is not None and array.shape != tuple(shape):
         raise InputError(f"{name} has shape {array.shape}; it must have shape {tuple(shape)}")
     if finite and not np.all(np.isfinite(array)):

@@ -116,3 +116,34 @@ def test_validate_array_returns_a_new_float_array():
     assert np.isnan(validate_array([math.nan], "q", finite=False)[0])
     with pytest.raises(InputError, match="M0 = .* contains true/false; give real numbers"):
         validate_array([[1.0, 0.0, False]], "M0")
+
+
+def test_the_problems_and_integrate_refuse_booleans_and_bad_numbers_through_these_checks(pendulum_problem_parts):
+    from dirac.flows import ConstrainedProblem, HeavyTopProblem, RigidBodyProblem, integrate
+
+    with pytest.raises(InputError, match=r"M0 = \[\[1.0, 0.0, False\]\] contains true/false"):
+        RigidBodyProblem([1.0, 2.0, 2.5], [[1.0, 0.0, False]])
+    with pytest.raises(InputError, match=r"^R0 = \[\[True, False, False\], \[False, True, False\], \[False, False, True\]\] contains true/false; give real numbers$"):
+        RigidBodyProblem([1.0, 2.0, 2.5], [1.0, 0.0, 0.0], np.eye(3) > 0.5)
+    with pytest.raises(InputError, match=r"mass_gravity = -1.0 must be a finite number >= 0 \(the product m g\)"):
+        HeavyTopProblem([1.0, 1.0, 0.5], [0.0, 0.0, 1.0], mass_gravity=-1.0)
+    with pytest.raises(InputError, match=r"center_of_mass = \[0, 0, True\] contains true/false"):
+        HeavyTopProblem([1.0, 1.0, 0.5], [0.0, 0.0, 1.0], center_of_mass=[0, 0, True])
+    mechanics, q, p = pendulum_problem_parts
+    with pytest.raises(InputError, match=r"initial q = \[True, 0.0\] contains true/false"):
+        ConstrainedProblem(mechanics, [True, 0.0], p)
+    problem = ConstrainedProblem(mechanics, q, p)
+    with pytest.raises(InputError, match=r"^t_end = True must be a finite number > 0$"):
+        integrate(problem, "rattle-2", t_end=True, dt=0.1)
+    with pytest.raises(InputError, match=r"^samples = 2.0 must be an integer >= 1 \(1 stores only the final state\)$"):
+        integrate(problem, "rattle-2", t_end=1.0, dt=0.1, samples=2.0)
+    with pytest.raises(InputError, match=r"^max_newton_iterations = 0 must be an integer in \[1, 1000000\]$"):
+        integrate(problem, "rattle-2", t_end=1.0, dt=0.1, max_newton_iterations=0)
+
+
+@pytest.fixture(scope="module")
+def pendulum_problem_parts():
+    from dirac.flows import MechanicalSystem
+    from dirac.model.systems import load_system
+
+    return MechanicalSystem.from_lagrangian(load_system("pendulum")), [0.0, -1.0], [0.0, 0.0]

@@ -30,6 +30,7 @@ from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, get_method, method_names
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
+from dirac.validate import validate_integer, validate_positive
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS"]
 
@@ -88,17 +89,12 @@ def sample_times(t_end: float, samples: int) -> np.ndarray:
 
 
 def _validate(t_end: object, samples: object, dt: object, tolerance: object) -> tuple[float, int, float | None, float]:
-    if isinstance(t_end, bool) or not isinstance(t_end, (int, float)) or not math.isfinite(t_end) or t_end <= 0:
-        raise InputError(f"t_end = {t_end!r} must be a finite number > 0")
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise InputError(f"samples = {samples!r} must be an integer >= 1 (1 stores only the final state)")
-    if dt is not None:
-        if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt) or dt <= 0:
-            raise InputError(f"dt = {dt!r} must be a finite number > 0")
-        dt = float(dt)
+    end = validate_positive(t_end, "t_end")
+    count = validate_integer(samples, "samples", hint="1 stores only the final state")
+    step = None if dt is None else validate_positive(dt, "dt")
     if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not (0 < tolerance < 1):
         raise InputError(f"tolerance = {tolerance!r} must be a number in (0, 1)")
-    return float(t_end), int(samples), dt, float(tolerance)
+    return end, count, step, float(tolerance)
 
 
 #: Most steps a fixed-step run may take (about a year at 1e8 steps per second); beyond it
@@ -113,9 +109,7 @@ def _validate_guard_rails(drift_limit: object, newton_tolerance: object, max_new
             raise InputError(f"{name} = {value!r} must be a number > 0")
     if isinstance(newton_tolerance, float) and not math.isfinite(newton_tolerance):
         raise InputError(f"newton_tolerance = {newton_tolerance!r} must be finite")
-    if (isinstance(max_newton_iterations, bool) or not isinstance(max_newton_iterations, (int, np.integer))
-            or not 1 <= max_newton_iterations <= 10**6):
-        raise InputError(f"max_newton_iterations = {max_newton_iterations!r} must be an integer in [1, 1000000]")
+    validate_integer(max_newton_iterations, "max_newton_iterations", maximum=10**6)
 
 
 def _validate_size(samples: int, problem: object) -> None:
@@ -258,7 +252,7 @@ def _names_for(kind: str) -> list[str]:
 class _Loop:
     """One run of the loop (keeps the bookkeeping out of :func:`integrate`)."""
 
-    def __init__(self, problem, method: Method, stepper: Stepper, outputs, t_end, samples, dt, progress,  # noqa: ANN001
+    def __init__(self, problem: Problem, method: Method, stepper: Stepper, outputs, t_end, samples, dt, progress,  # noqa: ANN001
                  drift_limit, extra) -> None:  # noqa: ANN001
         self.problem = problem
         self.method = method
@@ -293,7 +287,7 @@ class _Loop:
             if array is None:
                 continue
             array = array[:n]
-            if not getattr(self.problem, "batched", False):
+            if not self.problem.batched:
                 array = array[:, 0]
             outputs[name] = np.ascontiguousarray(array)
         extra = dict(self.extra)
@@ -378,7 +372,7 @@ class _Loop:
         if self.times[0] == 0.0:
             self._keep(0, self.stepper.observe())
         first = 1 if self.times[0] == 0.0 else 0
-        batch = int(getattr(self.problem, "batch", 1))
+        batch = self.problem.batch
         # at least MIN_CHUNK_STEPS steps per call, so that large batches are not advanced
         # (and checked) one step at a time
         chunk = max(MIN_CHUNK_STEPS, CHUNK_STEPS // max(1, batch))

@@ -25,6 +25,7 @@ from typing import ClassVar, Protocol, runtime_checkable
 import numpy as np
 
 from dirac.errors import InputError
+from dirac.validate import validate_array, validate_non_negative
 
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
 
@@ -61,22 +62,6 @@ class Problem(Protocol):
     def parameters(self) -> dict[str, object]:
         """Numerical parameters, for the result file's ``meta``."""
         ...
-
-
-def _refuse_booleans(value: object, name: str) -> None:
-    """``True``/``False`` are not numbers here (numpy would read them as 1.0 and 0.0)."""
-
-    def has_boolean(item: object) -> bool:
-        if isinstance(item, (bool, np.bool_)):
-            return True
-        if isinstance(item, np.ndarray):
-            return item.dtype == bool or (item.dtype == object and any(has_boolean(v) for v in item.flat))
-        if isinstance(item, (list, tuple)):
-            return any(has_boolean(v) for v in item)
-        return False
-
-    if has_boolean(value):
-        raise InputError(f"{name} = {value!r} contains true/false; give numbers")
 
 
 def _batched(array: np.ndarray, single_ndim: int, name: str) -> tuple[np.ndarray, bool]:
@@ -121,9 +106,7 @@ class RigidBodyProblem:
         from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
 
         self.inertia = validate_inertia(self.inertia)
-        _refuse_booleans(self.M0, "M0")
-        _refuse_booleans(self.R0, "R0")
-        moments = np.asarray(self.M0, dtype=float)
+        moments = validate_array(self.M0, "M0", finite=False)  # finiteness: validate_momentum, per body
         self.M0, self.batched = _batched(moments, 1, "M0")
         for body in self.M0:
             validate_momentum(body)
@@ -131,7 +114,7 @@ class RigidBodyProblem:
         if self.R0 is None:
             self.R0 = np.repeat(np.eye(3)[None], batch, axis=0)
         else:
-            rotations = np.asarray(self.R0, dtype=float)
+            rotations = validate_array(self.R0, "R0", finite=False)  # finiteness: validate_rotation
             rotations, _ = _batched(rotations, 2, "R0")
             if rotations.shape[0] == 1 and batch > 1:
                 rotations = np.repeat(rotations, batch, axis=0)
@@ -178,14 +161,8 @@ class HeavyTopProblem(RigidBodyProblem):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        value = self.mass_gravity
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
-            raise InputError(f"mass_gravity = {value!r} must be a finite number >= 0 (the product m g)")
-        self.mass_gravity = float(value)
-        chi = np.asarray(self.center_of_mass, dtype=float)
-        if chi.shape != (3,) or not np.all(np.isfinite(chi)):
-            raise InputError(f"center_of_mass = {self.center_of_mass!r} must be 3 finite numbers (body frame)")
-        self.center_of_mass = chi
+        self.mass_gravity = validate_non_negative(self.mass_gravity, "mass_gravity", hint="the product m g")
+        self.center_of_mass = validate_array(self.center_of_mass, "center_of_mass", (3,))
 
     @property
     def weight_vector(self) -> np.ndarray:
@@ -240,8 +217,8 @@ class ConstrainedProblem:
 
             self.mechanics = MechanicalSystem.from_lagrangian(self.mechanics)
         n = self.mechanics.dimension  # type: ignore[attr-defined]
-        q0, self.batched = _batched(np.asarray(self.q0, dtype=float), 1, "q")
-        p0, _ = _batched(np.asarray(self.p0, dtype=float), 1, "p")
+        q0, self.batched = _batched(validate_array(self.q0, "initial q", finite=False), 1, "q")
+        p0, _ = _batched(validate_array(self.p0, "initial p", finite=False), 1, "p")
         for name, value in (("q", q0), ("p", p0)):
             if value.shape[1] != n:
                 raise InputError(f"initial {name} has {value.shape[1]} entries; the system has {n} coordinates")
