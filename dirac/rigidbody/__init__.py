@@ -5,8 +5,12 @@ Modules, one job each:
 - :mod:`dirac.rigidbody.inertia` -- validation of inertia, rotation matrix, momentum;
 - :mod:`dirac.rigidbody.euler_poisson` -- invariants and the Euler–Poisson vector field
   (250)–(251), plus lean scipy right-hand sides for baselines;
-- :mod:`dirac.rigidbody.splitting` -- Lie–Poisson splitting methods (numba kernels,
-  composition schemes as data);
+- :mod:`dirac.rigidbody.splitting` -- Lie–Poisson splitting methods (numba kernels; the
+  composition coefficients are the rows of :mod:`dirac.compositions`);
+- :mod:`dirac.rigidbody.heavy_top` -- gravity kicks composed with a free-body splitting
+  step (the heavy top);
+- :mod:`dirac.rigidbody.midpoint` -- the implicit midpoint rule on (250)–(251), Newton on
+  ``M`` and a Cayley step for ``R``;
 - :mod:`dirac.rigidbody.elliptic` -- Jacobi functions (accurate as ``m -> 1``) and Carlson's
   symmetric integrals, as numba kernels;
 - :mod:`dirac.rigidbody.exact` -- the exact flow in Jacobi elliptic functions and an
