@@ -218,4 +218,3 @@ def system(
         {},
         description,
     )
-
