@@ -26,6 +26,7 @@ import sympy
 
 from dirac.errors import DiracError, InputError, warn
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
+from dirac.validate import validate_finite
 
 __all__ = ["Lagrangian", "read_system_file", "velocity_name", "momentum_name", "multiplier_name"]
 
@@ -247,9 +248,7 @@ class Lagrangian:
             if label not in symbols:
                 known = ", ".join(sorted(symbols)) or "(none)"
                 raise InputError(f"{self.name!r} has no parameter {label!r}; its parameters are: {known}")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise InputError(f"parameter {label!r} = {value!r} must be a finite number")
-            substitution[symbols[label]] = _as_rational(value)
+            substitution[symbols[label]] = _as_rational(validate_finite(value, f"parameter {label!r}"))
             remaining.pop(symbols[label])
         merged = {**self.fixed_values, **{k: float(v) for k, v in values.items()}}
         if self.validator is not None:
