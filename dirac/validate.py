@@ -20,6 +20,7 @@ import numpy as np
 from dirac.errors import InputError
 
 __all__ = [
+    "is_real_number",
     "contains_boolean",
     "validate_finite",
     "validate_positive",
@@ -41,8 +42,8 @@ def contains_boolean(value: object) -> bool:
     return False
 
 
-def _is_real_number(value: object) -> TypeGuard[float]:
-    """A Python or numpy integer or float, not a boolean."""
+def is_real_number(value: object) -> TypeGuard[float]:
+    """Whether ``value`` is a Python or numpy integer or float (never ``True``/``False``)."""
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
@@ -82,7 +83,7 @@ def validate_finite(value: object, name: str, hint: str = "") -> float:
         ``"<name> = <value> must be a finite number"`` for booleans, non-numbers, NaN and
         infinities.
     """
-    if not _is_real_number(value) or not math.isfinite(value):
+    if not is_real_number(value) or not math.isfinite(value):
         raise InputError(_with_hint(f"{name} = {value!r} must be a finite number", hint))
     return float(value)
 
@@ -99,7 +100,7 @@ def validate_positive(value: object, name: str, hint: str = "") -> float:
     InputError
         ``"<name> = <value> must be a finite number > 0"``.
     """
-    if not _is_real_number(value) or not math.isfinite(value) or value <= 0:
+    if not is_real_number(value) or not math.isfinite(value) or value <= 0:
         raise InputError(_with_hint(f"{name} = {value!r} must be a finite number > 0", hint))
     return float(value)
 
@@ -116,7 +117,7 @@ def validate_non_negative(value: object, name: str, hint: str = "") -> float:
     InputError
         ``"<name> = <value> must be a finite number >= 0"``.
     """
-    if not _is_real_number(value) or not math.isfinite(value) or value < 0:
+    if not is_real_number(value) or not math.isfinite(value) or value < 0:
         raise InputError(_with_hint(f"{name} = {value!r} must be a finite number >= 0", hint))
     return float(value)
 

@@ -11,6 +11,7 @@ import pytest
 from dirac.errors import InputError
 from dirac.validate import (
     contains_boolean,
+    is_real_number,
     validate_array,
     validate_boolean,
     validate_finite,
@@ -20,6 +21,11 @@ from dirac.validate import (
 )
 
 NOT_NUMBERS = [True, False, np.bool_(True), "1.0", None, [1.0], {"x": 1.0}]
+
+
+def test_is_real_number_takes_python_and_numpy_numbers_but_not_booleans():
+    assert all(is_real_number(v) for v in (0, -3, 2.5, math.nan, math.inf, np.int64(4), np.float32(0.5)))
+    assert not any(is_real_number(v) for v in NOT_NUMBERS) and not is_real_number(1 + 2j)
 
 
 def test_contains_boolean_looks_inside_lists_and_arrays():

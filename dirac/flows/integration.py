@@ -30,7 +30,7 @@ from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, get_method, method_names
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
-from dirac.validate import validate_integer, validate_positive
+from dirac.validate import is_real_number, validate_integer, validate_positive
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS"]
 
@@ -92,7 +92,7 @@ def _validate(t_end: object, samples: object, dt: object, tolerance: object) -> 
     end = validate_positive(t_end, "t_end")
     count = validate_integer(samples, "samples", hint="1 stores only the final state")
     step = None if dt is None else validate_positive(dt, "dt")
-    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not (0 < tolerance < 1):
+    if not is_real_number(tolerance) or not (0 < tolerance < 1):
         raise InputError(f"tolerance = {tolerance!r} must be a number in (0, 1)")
     return end, count, step, float(tolerance)
 
@@ -105,7 +105,7 @@ MAX_STEPS = 2**62
 def _validate_guard_rails(drift_limit: object, newton_tolerance: object, max_newton_iterations: object) -> None:
     """The guard-rail options of :func:`integrate` (the scene reader checks them too)."""
     for name, value in (("drift_limit", drift_limit), ("newton_tolerance", newton_tolerance)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or math.isnan(value):
+        if not is_real_number(value) or not value > 0 or math.isnan(value):
             raise InputError(f"{name} = {value!r} must be a number > 0")
     if isinstance(newton_tolerance, float) and not math.isfinite(newton_tolerance):
         raise InputError(f"newton_tolerance = {newton_tolerance!r} must be finite")

@@ -26,7 +26,7 @@ import sympy
 
 from dirac.errors import DiracError, InputError, warn
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
-from dirac.validate import validate_finite
+from dirac.validate import is_real_number, validate_finite
 
 __all__ = ["Lagrangian", "read_system_file", "velocity_name", "momentum_name", "multiplier_name"]
 
@@ -128,7 +128,7 @@ class Lagrangian:
         for p, value in self.parameters.items():
             if value is None:
                 continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
+            if not is_real_number(value):
                 raise InputError(f"parameter {p.name!r} = {value!r} is not a number")
             if not math.isfinite(value):
                 raise InputError(f"parameter {p.name!r} = {value!r} is not finite: give a finite number")
@@ -205,7 +205,7 @@ class Lagrangian:
         )
         values = {psyms[label]: (None if value is None else value) for label, value in parameters.items()}
         for label, value in parameters.items():
-            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            if value is not None and not is_real_number(value):
                 raise InputError(f"parameter {label!r} = {value!r} is not a number")
         return cls(name, q, v, expr, chis, values, description)
 
