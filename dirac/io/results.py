@@ -13,10 +13,14 @@ import os
 import platform
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from dirac.errors import InputError
+
+if TYPE_CHECKING:
+    from dirac.flows.solution import Solution
 
 __all__ = ["write_results", "read_results", "versions"]
 
@@ -43,7 +47,7 @@ def _json_default(value: object) -> object:
     return str(value)
 
 
-def write_results(solution, path: str | Path, extra_meta: dict[str, object] | None = None) -> Path:  # noqa: ANN001
+def write_results(solution: Solution, path: str | Path, extra_meta: dict[str, object] | None = None) -> Path:
     """Write ``solution`` to ``path`` atomically (docs/file_formats.md).
 
     Parameters
@@ -72,7 +76,7 @@ def write_results(solution, path: str | Path, extra_meta: dict[str, object] | No
     meta = solution.meta()
     if extra_meta:
         meta.update(extra_meta)
-    arrays = {"t": np.asarray(solution.t, dtype=float)}
+    arrays: dict[str, Any] = {"t": np.asarray(solution.t, dtype=float)}  # Any: np.savez(**arrays) keywords
     arrays.update({name: np.asarray(value) for name, value in solution.outputs.items()})
     arrays["meta"] = np.array(json.dumps(meta, default=_json_default, allow_nan=True))
     try:
