@@ -57,7 +57,7 @@ class Distribution:
 
     def describe(self) -> dict[str, object]:
         """The distribution as plain data (for ``meta.json``)."""
-        data = {"distribution": self.name}
+        data: dict[str, object] = {"distribution": self.name}
         for key, value in self.__dict__.items():
             data[key] = value.tolist() if isinstance(value, np.ndarray) else value
         return data
