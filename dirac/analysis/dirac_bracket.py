@@ -17,11 +17,11 @@ from collections.abc import Mapping
 import numpy as np
 import sympy
 
-from dirac.errors import InputError
-from dirac.codegen.straight_line import compile_expressions
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import Numerics
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.codegen import scalar_function
+from dirac.errors import InputError
 
 __all__ = ["DiracBracket"]
 
@@ -157,7 +157,7 @@ class DiracBracket:
         if entry is None:
             exprs = build()
             needed = set().union(*[e.free_symbols for e in exprs]) if exprs else set()
-            entry = (compile_expressions(self._args, exprs) if exprs else (lambda *a: []), needed)
+            entry = (scalar_function(self._args, exprs) if exprs else (lambda *a: []), needed)
             self._compiled[key] = entry
         return entry
 

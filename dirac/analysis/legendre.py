@@ -36,12 +36,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy
 
-from dirac.errors import AnalysisError
-from dirac.model.lagrangian import Lagrangian, momentum_name, multiplier_name
 from dirac.analysis.algebra import tidy
 from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.polynomial_kernel import polynomial_kernel
+from dirac.codegen import array_function
+from dirac.errors import AnalysisError
+from dirac.model.lagrangian import Lagrangian, momentum_name, multiplier_name
 
 __all__ = ["LegendreTransform", "legendre_transform"]
 
@@ -166,7 +167,7 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     shifted = p - sympy.Matrix(a)
     # numerical rank and pivots of W at generic configurations
     args = (*q, *lagrangian.parameters)
-    w_fn = sympy.lambdify(args, W, modules="numpy")
+    w_fn = array_function(args, W, cse=False)
     pvals = [float(parameter_values[s]) for s in lagrangian.parameters]
     samples = []
     for _ in range(3):
@@ -190,7 +191,7 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
         used_forms = False
         if forms is not None:
             A, G = forms
-            a_fn = sympy.lambdify(args, A, modules="numpy")
+            a_fn = array_function(args, A, cse=False)
             a_samples = []
             for _ in range(3):
                 z = rng.uniform(0.5, 1.5, n) * rng.choice([-1.0, 1.0], n)

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import sympy
 
+from dirac.codegen import array_function
 from dirac.errors import AnalysisError, InputError
 
 __all__ = [
@@ -266,12 +267,12 @@ class NoncanonicalVariables:
 
     @cached_property
     def _values_function(self) -> Any:
-        return sympy.lambdify(self._canonical_symbols, [self.functions[n] for n in self.names], "numpy")
+        return array_function(self._canonical_symbols, [self.functions[n] for n in self.names], cse=False)
 
     @cached_property
     def _gradient_function(self) -> Any:
         jacobian = sympy.Matrix([self.functions[n] for n in self.names]).jacobian(self._canonical_symbols)
-        return sympy.lambdify(self._canonical_symbols, jacobian, "numpy", cse=True)
+        return array_function(self._canonical_symbols, jacobian)
 
     def _arguments(self, point: Mapping[str, float]) -> list[float]:
         missing = [s.name for s in self._canonical_symbols if s.name not in point]

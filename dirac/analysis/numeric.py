@@ -6,7 +6,7 @@ constraints are independent, and what rank a bracket matrix has on the surface i
 numerically at several random points of that surface (probabilistic identity testing):
 an expression that vanishes at independent random points of an irreducible surface
 vanishes on it, up to an event of probability zero. Points are found by Gauss–Newton
-projection (minimum-norm steps) of random points, with lambdified residuals and
+projection (minimum-norm steps) of random points, with compiled residuals and
 Jacobians. Parameters that are still symbolic take generic random values for these
 decisions, so the answers hold for generic parameters.
 """
@@ -18,9 +18,9 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 import sympy
 
-from dirac.errors import AnalysisError
-from dirac.codegen.straight_line import compile_expressions
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.codegen import UnsupportedExpression, array_function, scalar_function
+from dirac.errors import AnalysisError
 
 __all__ = ["Numerics", "numeric_rank", "independent_rows"]
 
@@ -97,7 +97,7 @@ class Numerics:
         self._batches: list[Callable] = []
         self._args = (*phase_space.variables, *self.parameters)
 
-    # ------------------------------------------------------------------ lambdify
+    # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
         """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""
         exprs = [sympy.sympify(e) for e in exprs]
@@ -115,10 +115,11 @@ class Numerics:
         missing = list(dict.fromkeys(e for e in exprs if not e.is_number and e not in self._index))
         if not missing:
             return
+        raw: Callable
         try:
-            raw = compile_expressions(self._args, missing)
-        except TypeError:  # an unusual function: fall back to sympy's printer
-            raw = sympy.lambdify(self._args, missing, modules="numpy", cse=True)
+            raw = scalar_function(self._args, missing)
+        except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
+            raw = array_function(self._args, missing)
         batch = len(self._batches)
         self._batches.append(raw)
         for i, e in enumerate(missing):

@@ -7,7 +7,7 @@ coordinates and multipliers, then their momenta), the numerical Hamiltonian vect
     C_ab = {Phi_a, Phi_b}  (240),
 
 over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
-``grad Phi`` are generated from sympy (:mod:`dirac.codegen.generate`), ``C`` is evaluated and
+``grad Phi`` are generated from sympy (:mod:`dirac.codegen.numba_backend`), ``C`` is evaluated and
 solved numerically at each point (:func:`dirac.flows.constrained_kernels.analysed_field`).
 ``H`` is the canonical Hamiltonian; with first-class constraints the gauge ``u = 0`` is
 taken (their multipliers stay arbitrary in ``H_T``). This path takes every Lagrangian the
@@ -52,7 +52,7 @@ class AnalysedSystem:
         InputError
             Unknown parameters or parameters without a value.
         """
-        from dirac.codegen.generate import GeneratedFunction, generate_module
+        from dirac.codegen import GeneratedFunction, array_function, generate_module
         from dirac.analysis.constraint_analysis import analyze
 
         values = dict(lagrangian.parameter_values)
@@ -80,8 +80,8 @@ class AnalysedSystem:
         g = module.hamiltonian_gradient
         functions = (g, module.second_class, module.second_class_jacobian, module.hamiltonian, g, g, g)
         velocities = list(fixed.velocities)
-        momenta = sympy.lambdify([list(fixed.coordinates), velocities],
-                                 [sympy.diff(fixed.expression, v) for v in velocities], modules="numpy")
+        momenta = array_function([list(fixed.coordinates), velocities],
+                                 [sympy.diff(fixed.expression, v) for v in velocities], cse=False)
         return cls(
             name=lagrangian.name,
             variable_names=tuple(s.name for s in z),

@@ -2,7 +2,7 @@
 
 The system-specific pieces -- ``mass``, ``mass_derivative``, ``potential``,
 ``grad_potential``, ``constraints``, ``constraint_jacobian``, ``constraint_hessian`` --
-are generated per system by :mod:`dirac.codegen.generate` as ``numba.cfunc`` objects of the
+are generated per system by :mod:`dirac.codegen.numba_backend` as ``numba.cfunc`` objects of the
 one signature ``void(float64[::1] x, float64[::1] params, float64[::1] out)`` and handed to
 these kernels as a tuple ``fns`` of first-class functions (indices ``MASS`` ...). The
 kernels therefore compile once and are cached on disk for every system.

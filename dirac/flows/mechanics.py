@@ -11,7 +11,7 @@ stage (Sect. X). The multipliers ``lambda`` are those of the extended Lagrangian
 
 :class:`MechanicalSystem` extracts ``M(q)``, ``V(q)`` and ``chi(q)`` from a
 :class:`dirac.Lagrangian` (sympy, once), and generates numba functions for them
-(:mod:`dirac.codegen.generate`). Lagrangians that are not of this form (terms linear in the
+(:mod:`dirac.codegen.numba_backend`). Lagrangians that are not of this form (terms linear in the
 velocities, non-quadratic kinetic energy, a singular mass matrix) are refused with an
 :class:`InputError` saying why.
 """
@@ -130,7 +130,7 @@ class MechanicalSystem:
         dmass = [mass.diff(s) for s in q]
         hessians = [e for chi in chis for e in sympy.hessian(chi, q)]
         constant = all(not (entry.free_symbols & set(q)) for entry in mass)
-        from dirac.codegen.generate import GeneratedFunction, generate_module
+        from dirac.codegen import GeneratedFunction, generate_module
 
         args = tuple(q)
         functions = [

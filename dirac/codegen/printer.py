@@ -1,0 +1,272 @@
+"""The one printer from sympy expressions to straight-line Python source.
+
+Every backend of :mod:`dirac.codegen` gets its source from :func:`straight_line`: a list
+of assignments ``name = code`` followed by one code string per output, with the inputs
+bound to local names. Two targets:
+
+* ``"math"``: scalar Python with :mod:`math` functions (the numba and scalar backends).
+  Numbers print as floats, small integer powers as products, ``x**(1/2)`` as ``sqrt``:
+  code that numba compiles to plain floating-point arithmetic.
+* ``"numpy"``: array expressions with :mod:`numpy` functions (the numpy backend), printed
+  as ``sympy.lambdify(..., "numpy")`` prints them, so that values are those lambdify gave.
+
+Three ways to share sub-expressions:
+
+* ``sharing="cse"``: :func:`sympy.cse` over all outputs, each reduced expression printed
+  whole (target ``"math"``: ``optimizations="basic"``, names ``t0, t1, …``, the smallest
+  code, for functions that run many times; target ``"numpy"``: sympy's defaults, names
+  ``x0, x1, …``, as ``lambdify(..., cse=True)``).
+* ``sharing="dag"`` (target ``"math"``): one walk over the expression DAG, one assignment
+  per distinct sub-expression (structural sharing through sympy's hashing). Fast to
+  generate even for brackets whose trees print exponentially long: used for evaluations
+  at a few points.
+* ``sharing="tree"``: every output printed whole, nothing shared (small expressions).
+"""
+
+from __future__ import annotations
+
+import builtins
+import keyword
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import sympy
+from sympy.printing.codeprinter import PrintMethodNotImplementedError
+from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.pycode import PythonCodePrinter
+
+__all__ = ["StraightLineCode", "UnsupportedExpression", "flat_expressions", "input_name", "straight_line"]
+
+Target = Literal["math", "numpy"]
+Sharing = Literal["cse", "dag", "tree"]
+
+
+class UnsupportedExpression(TypeError):
+    """An expression the straight-line printer cannot turn into code (e.g. ``Piecewise``
+    under ``sharing="dag"``, an undefined function, a free symbol that is not an input)."""
+
+
+@dataclass(frozen=True)
+class StraightLineCode:
+    """Expressions as straight-line code.
+
+    Attributes
+    ----------
+    assignments : tuple of (str, str)
+        ``(name, code)`` in evaluation order; ``code`` uses the input names and earlier names.
+    outputs : tuple of str
+        The code of each output, in the order of the expressions.
+    """
+
+    assignments: tuple[tuple[str, str], ...]
+    outputs: tuple[str, ...]
+
+    def body(self, indent: str = "    ") -> list[str]:
+        """The assignments as indented source lines."""
+        return [f"{indent}{name} = {code}" for name, code in self.assignments]
+
+
+class _MathPrinter(PythonCodePrinter):
+    """Scalar Python with ``math`` functions and numbers as floats.
+
+    Parameters
+    ----------
+    unroll_powers
+        ``True``: integer powers ``-4..4`` as products (numba then compiles plain
+        multiplications); ``False``: as ``x**k`` and ``1.0/(x**k)``.
+    exact_floats
+        ``True``: floats as ``repr(float(x))`` (every bit); ``False``: as sympy prints them
+        (the float's decimal precision).
+    """
+
+    def __init__(self, unroll_powers: bool, exact_floats: bool) -> None:
+        super().__init__({"fully_qualified_modules": True, "standard": "python3"})
+        self.unroll_powers = unroll_powers
+        self.exact_floats = exact_floats
+
+    def _print_Float(self, expr: sympy.Float) -> str:
+        if self.exact_floats:
+            return repr(float(expr))
+        code: str = super()._print_Float(expr)
+        return code
+
+    def _print_Rational(self, expr: sympy.Rational) -> str:
+        return f"({float(expr.p)!r}/{float(expr.q)!r})"
+
+    def _print_Integer(self, expr: sympy.Integer) -> str:
+        return f"{float(expr.p)!r}"
+
+    def _print_Pow(self, expr: sympy.Pow, rational: bool = False) -> str:
+        base, exponent = expr.as_base_exp()
+        return self.power(self._print(base), exponent)
+
+    def power(self, base: str, exponent: sympy.Expr, exponent_code: str | None = None) -> str:
+        """``base ** exponent`` with the code ``base`` of the base.
+
+        With ``unroll_powers``, integer exponents ``1..4`` become products and ``-4..-1``
+        one over a product (otherwise ``x**k``, ``1.0/(x**k)``); ``1/2`` a square root;
+        any other exponent a power of the printed exponent (or of ``exponent_code``).
+        """
+        if exponent.is_Integer and not self.unroll_powers:
+            k = int(exponent)
+            return f"{base}**{k}" if k > 0 else f"1.0/({base}**{-k})"
+        if exponent.is_Integer and 0 < int(exponent) <= 4:
+            factor = f"({base})"
+            return "(" + "*".join([factor] * int(exponent)) + ")"
+        if exponent.is_Integer and -4 <= int(exponent) < 0:
+            factor = f"({base})"
+            return "(1.0/(" + "*".join([factor] * -int(exponent)) + "))"
+        if exponent == sympy.S.Half:
+            return f"math.sqrt({base})"
+        code = exponent_code if exponent_code is not None else self._print(exponent)
+        return f"{base}**{code}" if not self.unroll_powers else f"(({base})**({code}))"
+
+
+def _printer(target: Target, sharing: Sharing) -> PythonCodePrinter:
+    if target == "math":
+        # kernels ("cse"): products for small powers; fast-to-build scalar code ("dag"): every
+        # bit of a float constant
+        return _MathPrinter(unroll_powers=sharing != "dag", exact_floats=sharing == "dag")
+    if target == "numpy":
+        return NumPyPrinter({"fully_qualified_modules": True, "inline": True})
+    raise ValueError(f"target = {target!r}: use 'math' or 'numpy'")
+
+
+#: names the printed code itself uses (modules, builtins the printers call)
+_RESERVED = frozenset({"math", "numpy"}) | frozenset(dir(builtins))
+
+
+def input_name(symbol: sympy.Symbol, index: int, taken: set[str]) -> str:
+    """The symbol's own name when it is a safe local name (as lambdify keeps it), else ``a<index>_``."""
+    name = symbol.name
+    if name.isidentifier() and not keyword.iskeyword(name) and name not in _RESERVED and name not in taken:
+        return name
+    return f"a{index}_"
+
+
+def flat_expressions(expressions: object) -> list[sympy.Expr]:
+    """The expressions as a flat list (a matrix in C order, i.e. row by row)."""
+    return [sympy.sympify(e) for e in expressions]  # type: ignore[attr-defined]  # Matrix or sequence
+
+
+def straight_line(
+    inputs: Mapping[sympy.Symbol, str],
+    expressions: object,
+    target: Target = "math",
+    sharing: Sharing = "cse",
+    label: str = "expressions",
+) -> StraightLineCode:
+    """Straight-line code of ``expressions`` in the local names of their inputs.
+
+    Parameters
+    ----------
+    inputs
+        Every symbol the expressions may use -> its local name in the generated code
+        (valid Python names, none of the form ``t<digits>``, which name shared
+        sub-expressions).
+    expressions
+        The outputs: a sympy matrix (row by row) or a sequence of expressions.
+    target
+        ``"math"`` (scalar) or ``"numpy"`` (arrays).
+    sharing
+        ``"cse"``, ``"dag"`` (target ``"math"`` only) or ``"tree"`` (see the module
+        docstring).
+    label
+        Names the expressions in error messages.
+
+    Raises
+    ------
+    ValueError
+        An expression uses a symbol that is not an input (``"cse"``, ``"tree"``).
+    UnsupportedExpression
+        ``sharing="dag"``: a node the walk cannot print, or a symbol that is not an input.
+    """
+    printer = _printer(target, sharing)
+    if sharing == "dag":
+        if not isinstance(printer, _MathPrinter):
+            raise ValueError("sharing = 'dag' prints for the 'math' target only")
+        return _dag_code(printer, inputs, flat_expressions(expressions))
+    if sharing not in ("cse", "tree"):
+        raise ValueError(f"sharing = {sharing!r}: use 'cse', 'dag' or 'tree'")
+    local_of = {symbol: sympy.Symbol(name, real=True) for symbol, name in inputs.items() if symbol.name != name}
+    known = {local_of.get(symbol, symbol) for symbol in inputs}
+    if isinstance(expressions, sympy.MatrixBase):
+        localised: Any = expressions.xreplace(local_of) if local_of else expressions
+        free = localised.free_symbols
+    else:
+        localised = [e.xreplace(local_of) for e in flat_expressions(expressions)]
+        free = set().union(*(e.free_symbols for e in localised)) if localised else set()
+    leftover = free - known
+    if leftover:
+        names = ", ".join(sorted(s.name for s in leftover))
+        raise ValueError(f"{label}: expressions use symbols that are neither arguments nor parameters: {names}")
+    if sharing == "tree":
+        return StraightLineCode((), tuple(printer.doprint(e) for e in flat_expressions(localised)))
+    if target == "math":
+        outputs = flat_expressions(localised)
+        replacements, reduced = sympy.cse(outputs, symbols=sympy.numbered_symbols("t", real=True), optimizations="basic")
+    else:  # lambdify's cse=True
+        replacements, reduced = sympy.cse(localised, list=False)
+    assignments = tuple((symbol.name, printer.doprint(value)) for symbol, value in replacements)
+    return StraightLineCode(assignments, tuple(printer.doprint(value) for value in flat_expressions(reduced)))
+
+
+def _dag_code(
+    printer: _MathPrinter, inputs: Mapping[sympy.Symbol, str], outputs: Sequence[sympy.Expr]
+) -> StraightLineCode:
+    names: dict[Any, str] = dict(inputs)
+    lines: list[tuple[str, str]] = []
+
+    def atom(e: sympy.Basic) -> str | None:
+        known = names.get(e)
+        if known is not None:
+            return known
+        if e.is_Number or e is sympy.pi or e is sympy.E:
+            code: str = printer.doprint(e)
+            names[e] = code
+            return code
+        return None
+
+    def function_code(node: sympy.Basic, parts: list[str]) -> str:
+        # the printer's own function table: print f(operand names)
+        try:
+            code: str = printer.doprint(node.func(*[sympy.Symbol(part) for part in parts]))
+        except (PrintMethodNotImplementedError, TypeError, ValueError):
+            raise UnsupportedExpression(f"cannot compile {node.func}") from None
+        return code
+
+    def emit(root: sympy.Basic) -> str:
+        done = atom(root)
+        if done is not None:
+            return done
+        stack = [(root, False)]
+        while stack:
+            node, expanded = stack.pop()
+            if atom(node) is not None:
+                continue
+            if not expanded:
+                stack.append((node, True))
+                stack.extend((a, False) for a in node.args if atom(a) is None)
+                continue
+            parts = [atom(a) for a in node.args]
+            if any(part is None for part in parts):  # only a symbol that is not an input is left
+                raise UnsupportedExpression(f"cannot compile {node}: it is not an input")
+            operands: list[str] = parts  # type: ignore[assignment]  # checked just above
+            if node.is_Add:
+                code = " + ".join(operands)
+            elif node.is_Mul:
+                code = " * ".join(operands)
+            elif node.is_Pow:
+                code = printer.power(operands[0], node.exp, operands[1])
+            elif isinstance(node, sympy.Function):
+                code = function_code(node, operands)
+            else:
+                raise UnsupportedExpression(f"cannot compile {node.func}")
+            name = f"t{len(lines)}"
+            lines.append((name, code))
+            names[node] = name
+        return names[root]
+
+    results = tuple(emit(e) for e in outputs)
+    return StraightLineCode(tuple(lines), results)

@@ -1,0 +1,66 @@
+"""The one printer of dirac.codegen: the code it writes for known expressions."""
+
+from __future__ import annotations
+
+import pytest
+import sympy
+
+from dirac.codegen import StraightLineCode, UnsupportedExpression, straight_line
+
+x, y = sympy.symbols("x y", real=True)
+INPUTS = {x: "a0", y: "a1"}
+
+
+def test_kernel_code_unrolls_small_powers_and_prints_numbers_as_floats():
+    code = straight_line(INPUTS, [x**2 * y**-3 + sympy.Rational(1, 3) * sympy.sqrt(x)], "math", "cse")
+    assert code.assignments == ()
+    assert code.outputs == ("((1.0/3.0))*math.sqrt(a0) + ((a0)*(a0))/((a1)*(a1)*(a1))",)
+
+
+def test_cse_shares_a_repeated_sub_expression_once():
+    shared = sympy.sin(x + y)
+    code = straight_line(INPUTS, [shared**2 + 1, shared * x], "math", "cse")
+    assert code.assignments == (("t0", "math.sin(a0 + a1)"),)
+    assert code.outputs == ("((t0)*(t0)) + 1.0", "a0*t0")
+
+
+def test_dag_code_has_one_line_per_distinct_node():
+    code = straight_line(INPUTS, [(x + y) ** 3 * sympy.exp(x + y)], "math", "dag")
+    assert isinstance(code, StraightLineCode)
+    names = dict(code.assignments)
+    assert names["t0"] == "a0 + a1"  # x + y printed once, used twice
+    assert "t0**3" in names.values() and "math.exp(t0)" in names.values()
+    assert code.body()[0] == "    t0 = a0 + a1"
+
+
+def test_dag_code_keeps_every_bit_of_a_float():
+    third = sympy.Float(1.0 / 3.0)
+    code = straight_line(INPUTS, [third * x], "math", "dag")
+    assert repr(1.0 / 3.0) in code.assignments[-1][1]
+
+
+def test_numpy_target_prints_numpy_functions():
+    code = straight_line(INPUTS, [sympy.atan2(x, y) + sympy.sqrt(x)], "numpy", "tree")
+    assert code.outputs == ("numpy.sqrt(a0) + numpy.arctan2(a0, a1)",)
+
+
+def test_a_symbol_that_is_not_an_input_is_named():
+    z = sympy.Symbol("z")
+    with pytest.raises(ValueError, match="neither arguments nor parameters: z"):
+        straight_line(INPUTS, [x * z], "math", "cse", "function f")
+    with pytest.raises(UnsupportedExpression):
+        straight_line(INPUTS, [x * z], "math", "dag")
+
+
+def test_dag_code_refuses_what_it_cannot_print():
+    with pytest.raises(UnsupportedExpression):
+        straight_line(INPUTS, [sympy.Piecewise((x, y > 0), (y, True))], "math", "dag")
+    with pytest.raises(UnsupportedExpression):
+        straight_line(INPUTS, [sympy.Function("f")(x)], "math", "dag")
+
+
+def test_unknown_target_and_sharing_are_named():
+    with pytest.raises(ValueError, match="target"):
+        straight_line(INPUTS, [x], "fortran", "cse")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="sharing"):
+        straight_line(INPUTS, [x], "math", "global")  # type: ignore[arg-type]
