@@ -2,7 +2,7 @@
 
 Text by default (stage by stage, with counts), ``--json`` (docs/file_formats.md) or ``--latex``.
 ``--param NAME=VALUE`` fixes parameters (the others stay symbolic); ``--compare SPEC``
-compares the result with a reference (see :mod:`dirac.analysis.compare`).
+compares two brackets of the result (see :mod:`dirac.commands.analyze_compare`).
 """
 
 from __future__ import annotations
@@ -65,12 +65,8 @@ def main(args: argparse.Namespace) -> int:
     lagrangian = load_system(args.system, **params)
     analysis = analyze(lagrangian)
     if args.compare is not None:
-        try:
-            from dirac.analysis.compare import cli_compare
-        except ModuleNotFoundError as exc:
-            if exc.name != "dirac.analysis.compare":
-                raise
-            raise InputError("--compare is not available in this version yet") from None
+        from dirac.commands.analyze_compare import cli_compare
+
         print(cli_compare(analysis, args.compare, as_json=args.json))
         return 0
     if args.json:

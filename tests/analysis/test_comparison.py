@@ -1,30 +1,19 @@
 """Comparing brackets: built-in structures, Jacobi identity, Casimirs, agreement and
-disagreement reports on the rigid body (78), and ``cli_compare``."""
+disagreement reports on the rigid body (78)."""
 
 from __future__ import annotations
-
-import json
 
 import numpy as np
 import pytest
 import sympy
-
-import dirac
 from rigid_body_analyses import cached_analysis
-from dirac.errors import InputError
-from dirac.analysis.compare import (
-    CanonicalBracket,
-    StructureBracket,
-    analysis_variables,
-    casimirs,
-    chetaev_structure,
-    cli_compare,
-    compare_brackets,
-    jacobi_residual,
-    lie_poisson_so3_structure,
-    named_bracket,
-)
+
+from dirac.analysis.brackets import CanonicalBracket, StructureBracket, analysis_variables
+from dirac.analysis.casimirs import casimirs, jacobi_residual
+from dirac.analysis.comparison import compare_brackets
 from dirac.analysis.noncanonical import NoncanonicalVariables
+from dirac.analysis.structures import chetaev_structure, lie_poisson_so3_structure, named_bracket
+from dirac.errors import InputError
 
 M = sympy.symbols("M_1:4", real=True)
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
@@ -155,30 +144,3 @@ def test_dirac_and_canonical_differ_exactly_where_the_hand_calculation_says(anal
 def test_jacobi_identity_of_the_dirac_bracket(analysis):
     dirac_bracket = named_bracket("dirac", analysis)
     assert jacobi_residual(dirac_bracket, [analysis.surface_point(seed=1)]) < 1e-6
-
-
-def test_cli_compare_json_and_text(analysis):
-    report = json.loads(cli_compare(analysis, "dirac,chetaev:2", as_json=True))
-    assert report["agree"] is True and report["points"] == 2 and report["differ"] == []
-    assert report["jacobi"]["dirac"] < 1e-6 and report["jacobi"]["chetaev"] < 1e-12
-    assert len(report["casimirs"]["chetaev"]) == 6
-    text = cli_compare(analysis, "lie_poisson_so3, dirac:2", as_json=False)
-    assert "agree on all 3 pairs" in text and "M_1**2 + M_2**2 + M_3**2" in text
-
-
-@pytest.mark.parametrize(
-    "spec, message",
-    [("dirac", "name two brackets"), ("dirac,foo", "unknown bracket"), ("dirac,chetaev:x", "integer"), ("dirac,chetaev:0", "at least 1")],
-)
-def test_cli_compare_rejects_bad_specs(analysis, spec, message):
-    with pytest.raises(InputError, match=message):
-        cli_compare(analysis, spec, as_json=False)
-
-
-def test_chetaev_needs_a_rigid_body():
-    pendulum = dirac.analyze(dirac.load_system("pendulum"))
-    with pytest.raises(InputError, match="R_11"):
-        cli_compare(pendulum, "dirac,chetaev", as_json=False)
-    report = json.loads(cli_compare(pendulum, "dirac,canonical:3", as_json=True))
-    assert report["variables"] == ["x", "y", "p_x", "p_y"]
-    assert not report["agree"]  # {x, p_x} = 1 canonically, less on the circle
