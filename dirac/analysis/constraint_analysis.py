@@ -14,14 +14,15 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import sympy
 
-from dirac.errors import AnalysisError, InputError
-from dirac.model.lagrangian import Lagrangian
 from dirac.analysis.classification import bracket_matrix, classify
 from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.numeric import Numerics
+from dirac.analysis.report import to_json, to_latex, to_text
+from dirac.errors import AnalysisError, InputError
+from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["ConstraintAnalysis", "analyze"]
 
@@ -253,25 +254,17 @@ class ConstraintAnalysis:
     # ------------------------------------------------------------------ reports
     def to_json(self) -> dict:
         """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys)."""
-        from dirac.analysis.report import to_json
-
         return to_json(self)
 
     def to_text(self) -> str:
         """The chain stage by stage, classes, multipliers, counts: readable text."""
-        from dirac.analysis.report import to_text
-
         return to_text(self)
 
     def to_latex(self) -> str:
         """The analysis as a LaTeX fragment (align environments)."""
-        from dirac.analysis.report import to_latex
-
         return to_latex(self)
 
     def _repr_latex_(self) -> str:
-        from dirac.analysis.report import to_latex
-
         return to_latex(self, display=True)
 
     def __repr__(self) -> str:

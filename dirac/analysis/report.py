@@ -1,15 +1,62 @@
-"""Text, JSON (docs/file_formats.md, "Analysis JSON") and LaTeX renderings of a :class:`ConstraintAnalysis`."""
+"""Text, JSON (docs/file_formats.md, "Analysis JSON") and LaTeX renderings of an analysis.
+
+The functions read an analysis through :class:`AnalysisResult`, the attributes of a
+:class:`~dirac.analysis.constraint_analysis.ConstraintAnalysis` that a report shows, so
+that this module does not import the engine (whose ``to_text``/``to_json``/``to_latex``
+call it).
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Mapping, Sequence
+from typing import Any, Protocol
 
 import sympy
 
-if TYPE_CHECKING:  # pragma: no cover
-    from dirac.analysis.constraint_analysis import ConstraintAnalysis
+from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["to_json", "to_text", "to_latex"]
+__all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
+
+
+class AnalysisResult(Protocol):
+    """What a report reads of an analysis (a ``ConstraintAnalysis`` provides all of it)."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def lagrangian(self) -> Lagrangian: ...
+    @property
+    def coordinates(self) -> Sequence[sympy.Symbol]: ...
+    @property
+    def phase_space(self) -> Sequence[sympy.Symbol]: ...
+    @property
+    def parameters(self) -> Sequence[sympy.Symbol]: ...
+    @property
+    def canonical_hamiltonian(self) -> sympy.Expr: ...
+    @property
+    def hessian_rank(self) -> int: ...
+    @property
+    def primary_constraints(self) -> Sequence[sympy.Expr]: ...
+    @property
+    def primary_multipliers(self) -> Sequence[sympy.Symbol]: ...
+    @property
+    def stages(self) -> Sequence[Sequence[sympy.Expr]]: ...
+    @property
+    def constraints(self) -> Sequence[sympy.Expr]: ...
+    @property
+    def multipliers(self) -> Mapping[Any, sympy.Expr]: ...
+    @property
+    def undetermined_multipliers(self) -> Sequence[sympy.Symbol]: ...
+    @property
+    def first_class(self) -> Sequence[sympy.Expr]: ...
+    @property
+    def second_class(self) -> Sequence[sympy.Expr]: ...
+    @property
+    def physical_degrees_of_freedom(self) -> int: ...
+    @property
+    def bracket_strategy(self) -> str: ...
+    @property
+    def notes(self) -> Sequence[str]: ...
 
 #: longest expression printed in full in the text report
 TEXT_LIMIT = 400
@@ -88,7 +135,7 @@ def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
     return f"{text[: limit - 40]} ... ({len(text)} characters; full form in --json)"
 
 
-def to_json(analysis: "ConstraintAnalysis") -> dict:
+def to_json(analysis: AnalysisResult) -> dict:
     """The analysis JSON object of docs/file_formats.md; constraints are ``str()`` of sympy expressions.
 
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
@@ -123,7 +170,7 @@ def to_json(analysis: "ConstraintAnalysis") -> dict:
     return out
 
 
-def to_text(analysis: "ConstraintAnalysis") -> str:
+def to_text(analysis: AnalysisResult) -> str:
     """Readable report: the chain stage by stage with counts, classes, multipliers."""
     a = analysis
     n = len(a.coordinates)
@@ -181,7 +228,7 @@ def to_text(analysis: "ConstraintAnalysis") -> str:
     return "\n".join(lines)
 
 
-def to_latex(analysis: "ConstraintAnalysis", display: bool = False) -> str:
+def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
     """LaTeX rendering: one ``align*`` environment (``display=True``: ``$$ aligned $$`` for Jupyter)."""
     a = analysis
     lx = _latex
