@@ -13,14 +13,11 @@ import os
 import platform
 import tempfile
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from dirac.errors import InputError
-
-if TYPE_CHECKING:
-    from dirac.flows.solution import Solution
 
 __all__ = ["write_results", "read_results", "versions"]
 
@@ -39,6 +36,16 @@ def versions() -> dict[str, str]:
     return result
 
 
+class RunResult(Protocol):
+    """What a result file holds (a :class:`dirac.flows.Solution` is one): sample times,
+    outputs by name and the run's ``meta``."""
+
+    t: np.ndarray
+    outputs: dict[str, np.ndarray]
+
+    def meta(self) -> dict[str, object]: ...
+
+
 def _json_default(value: object) -> object:
     if isinstance(value, np.generic):
         return value.item()
@@ -47,13 +54,13 @@ def _json_default(value: object) -> object:
     return str(value)
 
 
-def write_results(solution: Solution, path: str | Path, extra_meta: dict[str, object] | None = None) -> Path:
+def write_results(solution: RunResult, path: str | Path, extra_meta: dict[str, object] | None = None) -> Path:
     """Write ``solution`` to ``path`` atomically (docs/file_formats.md).
 
     Parameters
     ----------
-    solution : dirac.flows.Solution
-        Complete or partial (``complete = False`` is recorded in ``meta``).
+    solution : RunResult
+        A :class:`dirac.flows.Solution`, complete or partial (``complete = False`` is recorded in ``meta``).
     path
         Destination ``.npz`` file; its directory must exist.
     extra_meta
