@@ -17,7 +17,9 @@ velocities, singular Lagrangians such as the rigid body's (228)).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import sympy
@@ -25,12 +27,20 @@ import sympy
 from dirac.errors import InputError
 from dirac.model.lagrangian import Lagrangian
 
+if TYPE_CHECKING:
+    from dirac.analysis.constraint_analysis import ConstraintAnalysis
+
 __all__ = ["AnalysedSystem", "AnalysedProblem"]
 
 
 @dataclass
 class AnalysedSystem:
-    """Compiled Dirac vector field of an analysed Lagrangian (build with :meth:`from_lagrangian`)."""
+    """Compiled Dirac vector field of an analysed Lagrangian.
+
+    Build it from an analysis with :meth:`from_analysis` (the road
+    ``Lagrangian -> analyze -> compiled flow``), or from a Lagrangian with
+    :meth:`from_lagrangian`, which fixes the parameters, analyses and then does the same.
+    """
 
     name: str
     variable_names: tuple[str, ...]
@@ -38,33 +48,64 @@ class AnalysedSystem:
     n_constraints: int
     parameter_values: dict[str, float]
     params: np.ndarray
-    module: object
+    module: Any
     functions: tuple
-    analysis: object = field(repr=False)
-    momenta: object = field(repr=False, default=None)
+    analysis: ConstraintAnalysis = field(repr=False)
+    momenta: Callable[..., np.ndarray] = field(repr=False)
 
     @classmethod
-    def from_lagrangian(cls, lagrangian: Lagrangian, parameters: dict[str, float] | None = None) -> "AnalysedSystem":
-        """Fix the parameters (defaults, overridden by ``parameters``), analyse, compile.
+    def from_lagrangian(cls, lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> AnalysedSystem:
+        """Fix every parameter (its default, overridden by ``parameters``), analyse, compile.
+
+        The same as ``from_analysis(analyze(lagrangian.fix(...)))``: the analysis then
+        decides the constraint structure at exactly these values.
 
         Raises
         ------
         InputError
-            Unknown parameters or parameters without a value.
+            Unknown parameters, values that are not finite numbers, or parameters
+            without a value.
+        """
+        from dirac.analysis.constraint_analysis import analyze
+        from dirac.flows.mechanics import resolve_parameters
+
+        values = resolve_parameters(lagrangian, parameters)
+        return cls.from_analysis(analyze(lagrangian.fix(**values)))
+
+    @classmethod
+    def from_analysis(cls, analysis: ConstraintAnalysis) -> AnalysedSystem:
+        """Compile the Dirac vector field of an existing analysis (nothing is analysed again).
+
+        ``grad H_c``, the second-class constraints ``Phi`` and ``grad Phi`` are generated
+        once from the analysis (:mod:`dirac.codegen`). Parameters the analysed Lagrangian
+        still has as symbols take their default values at run time; the analysis decided
+        the constraint structure at generic values of them, which holds at the defaults
+        unless these are special. To analyse at exactly the values used, fix them first
+        (:meth:`Lagrangian.fix`, or :meth:`from_lagrangian`).
+
+        Parameters
+        ----------
+        analysis : ConstraintAnalysis
+            The result of :func:`dirac.analyze`.
+
+        Raises
+        ------
+        InputError
+            ``analysis`` is not an analysis, or a parameter still symbolic in it has no
+            default value.
         """
         from dirac.codegen import GeneratedFunction, array_function, generate_module
-        from dirac.analysis.constraint_analysis import analyze
 
-        values = dict(lagrangian.parameter_values)
-        for key, value in (parameters or {}).items():
-            if key not in values:
-                raise InputError(f"system {lagrangian.name!r} has no parameter {key!r}")
-            values[key] = value
-        missing = sorted(k for k, v in values.items() if v is None)
+        lagrangian = getattr(analysis, "lagrangian", None)
+        if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
+            raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
+        defaults = {p: float(v) for p, v in lagrangian.parameters.items() if v is not None}
+        missing = [p.name for p in lagrangian.parameters if p not in defaults]
         if missing:
-            raise InputError(f"system {lagrangian.name!r}: parameters {', '.join(missing)} have no value; give them")
-        fixed = lagrangian.fix(**{k: float(v) for k, v in values.items()})  # type: ignore[arg-type]
-        analysis = analyze(fixed)
+            raise InputError(
+                f"system {lagrangian.name!r}: parameters {', '.join(missing)} have no value; fix them before "
+                "the analysis (Lagrangian.fix) or use AnalysedSystem.from_lagrangian(lagrangian, {name: value})"
+            )
         z = tuple(analysis.phase_space)
         H = analysis.canonical_hamiltonian
         constraints = list(analysis.second_class)
@@ -76,19 +117,20 @@ class AnalysedSystem:
             GeneratedFunction("second_class_jacobian", z, jacobian, "grad Phi, (k, N)"),
             GeneratedFunction("hamiltonian", z, [H], "canonical Hamiltonian H_c"),
         ]
-        module = generate_module(generated, (), title=f"analysed system {lagrangian.name}")
+        module = generate_module(generated, list(defaults), title=f"analysed system {lagrangian.name}")
         g = module.hamiltonian_gradient
         functions = (g, module.second_class, module.second_class_jacobian, module.hamiltonian, g, g, g)
-        velocities = list(fixed.velocities)
-        momenta = array_function([list(fixed.coordinates), velocities],
-                                 [sympy.diff(fixed.expression, v) for v in velocities], cse=False)
+        velocities = list(lagrangian.velocities)
+        expression = lagrangian.expression.subs(defaults)
+        momenta = array_function([list(lagrangian.coordinates), velocities],
+                                 [sympy.diff(expression, v) for v in velocities], cse=False)
         return cls(
             name=lagrangian.name,
             variable_names=tuple(s.name for s in z),
             dimension=len(z),
             n_constraints=len(constraints),
-            parameter_values={k: float(v) for k, v in values.items()},  # type: ignore[arg-type]
-            params=np.zeros(0),
+            parameter_values={**lagrangian.fixed_values, **{p.name: v for p, v in defaults.items()}},
+            params=np.array(list(defaults.values()), dtype=float),
             module=module,
             functions=functions,
             analysis=analysis,
@@ -131,7 +173,7 @@ class AnalysedSystem:
         InputError
             If no point of the surface has these values.
         """
-        lagrangian = self.analysis.lagrangian  # type: ignore[attr-defined]
+        lagrangian = self.analysis.lagrangian
         names = [s.name for s in lagrangian.coordinates]
         values = {k: float(v) for k, v in q.items()}
         if q_dot is not None:
@@ -141,7 +183,7 @@ class AnalysedSystem:
             values.update({f"p_{n}": float(m) for n, m in zip(names, momenta)})
         elif p is not None:
             values.update({f"p_{n}": float(v) for n, v in p.items()})
-        point = self.analysis.surface_point(values)  # type: ignore[attr-defined]
+        point = self.analysis.surface_point(values)
         return np.array([point[n] for n in self.variable_names])
 
 

@@ -18,15 +18,45 @@ velocities, non-quadratic kinetic energy, a singular mass matrix) are refused wi
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy
 
 from dirac.errors import InputError
 from dirac.model.lagrangian import Lagrangian
+from dirac.validate import validate_finite
 
-__all__ = ["MechanicalSystem"]
+if TYPE_CHECKING:
+    from dirac.analysis.constraint_analysis import ConstraintAnalysis
+
+__all__ = ["MechanicalSystem", "resolve_parameters"]
+
+
+def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
+    """The value of every parameter of ``lagrangian``: its default, overridden by ``parameters``.
+
+    Raises
+    ------
+    InputError
+        A name that is not a parameter, a value that is not a finite number, or a
+        parameter with neither a default nor a value given.
+    """
+    values = dict(lagrangian.parameter_values)
+    for key, value in (parameters or {}).items():
+        if key not in values:
+            known = ", ".join(sorted(values)) or "(none)"
+            raise InputError(f"system {lagrangian.name!r} has no parameter {key!r}; its parameters are: {known}")
+        values[key] = validate_finite(value, f"parameter {key!r}")
+    missing = sorted(k for k, v in values.items() if v is None)
+    if missing:
+        raise InputError(
+            f"system {lagrangian.name!r}: parameters {', '.join(missing)} have no value; give them "
+            "(in a scene: under [system] parameters)"
+        )
+    return {k: float(v) for k, v in values.items() if v is not None}
 
 
 @dataclass
@@ -67,9 +97,39 @@ class MechanicalSystem:
 
     # ------------------------------------------------------------------ building
     @classmethod
+    def from_analysis(
+        cls, analysis: ConstraintAnalysis, parameters: Mapping[str, float] | None = None, extra_source: str = ""
+    ) -> MechanicalSystem:
+        """The mechanical system of an analysed Lagrangian (the road ``Lagrangian ->
+        analyze -> compiled flow``, as :meth:`AnalysedSystem.from_analysis`).
+
+        RATTLE needs only ``M(q)``, ``V(q)`` and ``chi(q)``, which come from the Lagrangian
+        the analysis keeps (``analysis.lagrangian``); its stages 3 and 4 (the hidden
+        constraint ``G M^{-1} p = 0`` and the multiplier) are what the integrator enforces.
+        Parameters fixed before the analysis stay fixed; the others are given at run
+        time, as in :meth:`from_lagrangian`.
+
+        Parameters
+        ----------
+        analysis : ConstraintAnalysis
+            The result of :func:`dirac.analyze`.
+        parameters, extra_source
+            As for :meth:`from_lagrangian`.
+
+        Raises
+        ------
+        InputError
+            ``analysis`` is not an analysis, or as for :meth:`from_lagrangian`.
+        """
+        lagrangian = getattr(analysis, "lagrangian", None)
+        if not isinstance(lagrangian, Lagrangian):
+            raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
+        return cls.from_lagrangian(lagrangian, parameters, extra_source)
+
+    @classmethod
     def from_lagrangian(
-        cls, lagrangian: Lagrangian, parameters: dict[str, float] | None = None, extra_source: str = ""
-    ) -> "MechanicalSystem":
+        cls, lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None, extra_source: str = ""
+    ) -> MechanicalSystem:
         """Split ``L`` into ``1/2 q_dot^T M(q) q_dot - V(q)`` and generate its functions.
 
         Parameters
@@ -87,20 +147,7 @@ class MechanicalSystem:
             Unknown or missing parameter values, velocity-linear terms, a kinetic energy
             that is not quadratic in the velocities, or a mass matrix that is singular.
         """
-        values = {name: value for name, value in lagrangian.parameter_values.items()}
-        for key, value in (parameters or {}).items():
-            if key not in values:
-                known = ", ".join(sorted(values)) or "(none)"
-                raise InputError(f"system {lagrangian.name!r} has no parameter {key!r}; its parameters are: {known}")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-                raise InputError(f"parameter {key!r} = {value!r} must be a finite number")
-            values[key] = float(value)
-        missing = sorted(k for k, v in values.items() if v is None)
-        if missing:
-            raise InputError(
-                f"system {lagrangian.name!r}: parameters {', '.join(missing)} have no value; give them under "
-                "[system] parameters in the scene"
-            )
+        values = resolve_parameters(lagrangian, parameters)
         q = list(lagrangian.coordinates)
         v = list(lagrangian.velocities)
         L = sympy.expand(lagrangian.expression)

@@ -38,6 +38,83 @@ def test_pendulum_on_the_full_phase_space_matches_the_elliptic_solution(analysed
     assert 3.5 < errors[0] / errors[1] < 4.5  # order 2
 
 
+def _refuse_to_analyse(monkeypatch):
+    """Make every entry point of the Dirac-Bergmann analysis raise."""
+    import dirac.analysis.constraint_analysis as constraint_analysis
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the system was analysed again")
+
+    monkeypatch.setattr(constraint_analysis, "analyze", refuse)
+    monkeypatch.setattr(constraint_analysis.ConstraintAnalysis, "__init__", refuse)
+
+
+def test_from_analysis_hands_on_the_analysis_and_gives_the_flow_of_from_lagrangian(analysed_pendulum, monkeypatch):
+    """``Lagrangian -> analyze -> AnalysedSystem.from_analysis``: the analysis a user holds is
+    used as it is (not run again) and gives the same flow as ``from_lagrangian``."""
+    import dirac
+
+    analysis = dirac.analyze(load_system("pendulum").with_defaults())
+    _refuse_to_analyse(monkeypatch)
+    flow = AnalysedSystem.from_analysis(analysis)
+    assert flow.analysis is analysis
+    assert flow.variable_names == analysed_pendulum.variable_names
+    assert flow.n_constraints == analysed_pendulum.n_constraints
+    assert flow.parameter_values == analysed_pendulum.parameter_values == {"m": 1.0, "g": 9.81, "l": 1.0}
+    q, q_dot = {"x": np.sin(0.7), "y": -np.cos(0.7)}, {"x": 0.3 * np.cos(0.7), "y": 0.3 * np.sin(0.7)}
+    z0 = flow.initial_state(q, q_dot=q_dot)  # Gauss-Newton from a random start: equal up to round-off
+    assert np.allclose(z0, analysed_pendulum.initial_state(q, q_dot=q_dot), rtol=1e-13, atol=1e-13)
+    assert flow.module is analysed_pendulum.module  # the same generated code
+    assert np.array_equal(flow.field(z0), analysed_pendulum.field(z0))
+    assert flow.energy(z0) == analysed_pendulum.energy(z0)
+    assert flow.constraint_residual(z0) == analysed_pendulum.constraint_residual(z0)
+
+
+def test_from_analysis_with_symbolic_parameters_runs_them_at_their_defaults(analysed_pendulum, monkeypatch):
+    """Parameters left symbolic in the analysis are given their defaults at run time: the
+    same field as the analysis at fixed values, up to round-off."""
+    import dirac
+
+    analysis = dirac.analyze(load_system("pendulum", l=1.0))  # m and g stay symbolic
+    without_default = dirac.analyze(
+        Lagrangian.from_strings("spring", ["x"], "x_dot**2/2 - k*x**2/2", parameters={"k": None}))
+    _refuse_to_analyse(monkeypatch)
+    flow = AnalysedSystem.from_analysis(analysis)
+    assert flow.parameter_values == {"l": 1.0, "m": 1.0, "g": 9.81}
+    assert sorted(flow.params.tolist()) == [1.0, 9.81]
+    q, q_dot = {"x": np.sin(0.7), "y": -np.cos(0.7)}, {"x": 0.3 * np.cos(0.7), "y": 0.3 * np.sin(0.7)}
+    z0 = flow.initial_state(q, q_dot=q_dot)
+    assert np.allclose(z0, analysed_pendulum.initial_state(q, q_dot=q_dot), rtol=1e-13, atol=1e-13)
+    assert np.allclose(flow.field(z0), analysed_pendulum.field(z0), rtol=1e-12, atol=1e-12)
+    assert flow.energy(z0) == pytest.approx(analysed_pendulum.energy(z0), rel=1e-13)
+    with pytest.raises(InputError, match="parameters k have no value"):
+        AnalysedSystem.from_analysis(without_default)
+
+
+def test_mechanical_system_from_analysis_is_the_one_from_its_lagrangian(monkeypatch):
+    import dirac
+    from dirac.flows import MechanicalSystem
+
+    analysis = dirac.analyze(load_system("pendulum"))
+    _refuse_to_analyse(monkeypatch)
+    mechanics = MechanicalSystem.from_analysis(analysis, {"l": 2.0})
+    reference = MechanicalSystem.from_lagrangian(load_system("pendulum"), {"l": 2.0})
+    assert mechanics.coordinate_names == reference.coordinate_names
+    assert mechanics.parameter_values == reference.parameter_values
+    q, p = np.array([0.6, -np.sqrt(4.0 - 0.36)]), np.array([0.2, 0.1])
+    assert mechanics.energy(q, p) == reference.energy(q, p)
+    assert np.array_equal(mechanics.residuals(q, p)[0], reference.residuals(q, p)[0])
+
+
+@pytest.mark.parametrize("not_an_analysis", [load_system("pendulum"), None, "pendulum"])
+def test_from_analysis_refuses_anything_but_an_analysis(not_an_analysis):
+    from dirac.flows import MechanicalSystem
+
+    for build in (AnalysedSystem.from_analysis, MechanicalSystem.from_analysis):
+        with pytest.raises(InputError, match="from_analysis needs the result of dirac.analyze"):
+            build(not_an_analysis)
+
+
 def test_off_surface_state_is_refused(analysed_pendulum):
     with pytest.raises(InputError, match="off the constraint surface"):
         AnalysedProblem(analysed_pendulum, [0.5, -0.5, 0.0, 0.0, 0.0, 0.0])
