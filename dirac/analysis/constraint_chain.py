@@ -25,17 +25,16 @@ when a stage adds nothing; the last system then fixes the determined multipliers
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import sympy
 
-from dirac.errors import AnalysisError, InconsistentSystemError
 from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]
 
@@ -105,7 +104,7 @@ class ConstraintChain:
         return values[:, :, 0], values[:, :, 1:]
 
     # ------------------------------------------------------------------ the algorithm
-    def run(self, max_stages: int | None = None) -> "ConstraintChain":
+    def run(self, max_stages: int | None = None) -> ConstraintChain:
         """Carry out the algorithm; returns ``self``.
 
         Raises
@@ -141,7 +140,7 @@ class ConstraintChain:
             pivot_cols = independent_rows([m[pivots_rows].T for m in A_num], list(range(K))) if pivots_rows else []
             direct: list[sympy.Expr] = []
             deferred: list[tuple[int, list[int]]] = []  # (row, pivot positions it must be reduced by)
-            for i, c in enumerate(constraints):
+            for i in range(len(constraints)):
                 if i in pivots_rows or (b_zero[i] and a_row_zero[i]):
                     continue
                 needed = [] if a_row_zero[i] else self._needed(i, pivots_rows, pivot_cols, A_num, b_zero)

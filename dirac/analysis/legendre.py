@@ -160,7 +160,6 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     lambdas = tuple(sympy.Symbol(multiplier_name(k + 1), real=True) for k in range(len(lagrangian.constraints)))
     coords = q + lambdas
     momenta = tuple(sympy.Symbol(momentum_name(c.name), real=True) for c in coords)
-    free_parameters = tuple(p for p in lagrangian.parameters if p in (lagrangian.expression.free_symbols | set().union(*[c.free_symbols for c in lagrangian.constraints])))
     space = PhaseSpace(coords, momenta, tuple(lagrangian.parameters))
     W, a, V = _quadratic_parts(lagrangian)
     p = sympy.Matrix(momenta[:n])

@@ -24,8 +24,8 @@ import sympy
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_bipartite_matching
 
-from dirac.errors import AnalysisError
 from dirac.analysis.algebra import tidy
+from dirac.errors import AnalysisError
 
 __all__ = ["weak_solve", "block_order"]
 
@@ -153,7 +153,7 @@ def weak_solve(
     X = sympy.zeros(k, cols)
     for block in blocks:
         unknowns = [int(match[i]) for i in block]
-        rhs = sympy.Matrix(len(block), cols, lambda r, c: B[block[r], c])
+        rhs = sympy.Matrix(len(block), cols, lambda r, c, block=block: B[block[r], c])
         for r, i in enumerate(block):
             for j in range(k):
                 if j in unknowns or A[i, j] == 0:
@@ -171,7 +171,7 @@ def weak_solve(
                 )
             if time.monotonic() - start > time_limit:
                 raise SolveTooLarge(f"the exact solve took more than {time_limit:g} s")
-        sub = sympy.Matrix(len(block), len(block), lambda r, s: A[block[r], unknowns[s]])
+        sub = sympy.Matrix(len(block), len(block), lambda r, s, block=block, unknowns=unknowns: A[block[r], unknowns[s]])
         if len(block) == 1:
             sol = rhs / sub[0, 0]
         else:

@@ -14,6 +14,7 @@ decisions, so the answers hold for generic parameters.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import sympy
@@ -102,7 +103,8 @@ class Numerics:
         """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""
         exprs = [sympy.sympify(e) for e in exprs]
         self._compile(exprs)
-        plan = [(self._index[e] if not e.is_number else (None, float(e))) for e in exprs]
+        # (batch, index in it) of a compiled expression, (None, value) of a number
+        plan: list[tuple[int | None, Any]] = [(self._index[e] if not e.is_number else (None, float(e))) for e in exprs]
         batches = sorted({b for b, _ in plan if b is not None})
 
         def fn(z: np.ndarray) -> np.ndarray:
@@ -130,15 +132,15 @@ class Numerics:
             out = self._batches[batch](*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
         return [complex(v).real if isinstance(v, complex) else float(v) for v in out]
 
-    def evaluate(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
+    def evaluate(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray] | np.ndarray) -> np.ndarray:
         """Values of ``exprs`` at each point: array of shape ``(len(points), len(exprs))``."""
         fn = self.function(exprs)
         return np.array([fn(z) for z in points], dtype=float).reshape(len(points), len(exprs))
 
     def term_scale(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
         """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests)."""
-        terms = []
-        owner = []
+        terms: list[sympy.Expr] = []
+        owner: list[int] = []
         for k, e in enumerate(exprs):
             e = sympy.sympify(e)
             parts = e.args if isinstance(e, sympy.Add) else (e,)

@@ -41,8 +41,8 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 from sympy.polys.rings import PolyRing
 
-from dirac.errors import AnalysisError
 from dirac.analysis.numeric import Numerics
+from dirac.errors import AnalysisError
 
 __all__ = ["PolynomialKernel", "polynomial_kernel"]
 
@@ -212,9 +212,10 @@ def polynomial_kernel(
         if lowest is not None and holonomic:
             if samples is None:
                 samples = _holonomic_samples(numerics, holonomic, 400), _holonomic_samples(numerics, holonomic, 8)
-            if samples[0] is not None and samples[1] is not None:
-                unit = _unit_denominator(solutions, numerics, holonomic, *samples) or _unit_denominator(
-                    [(B, d) for B, d in solutions if d != 0], numerics, holonomic, *samples, tangent=False
+            walk, check = samples
+            if walk is not None and check is not None:
+                unit = _unit_denominator(solutions, numerics, holonomic, walk, check) or _unit_denominator(
+                    [(B, d) for B, d in solutions if d != 0], numerics, holonomic, walk, check, tangent=False
                 )
                 if unit is not None:
                     return PolynomialKernel(null_basis, [unit], (null_degree, degree), unit_denominator=True)
@@ -253,7 +254,7 @@ def _holonomic_samples(numerics: Numerics, holonomic: Sequence[sympy.Expr], coun
         z = numerics.surface_points(holonomic, 1)[0]
     except AnalysisError:
         return None
-    points = []
+    points: list[np.ndarray] = []
     failures = 0
     while len(points) < count:
         try:

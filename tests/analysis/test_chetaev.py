@@ -12,8 +12,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy
-
-import dirac
 from rigid_body_analyses import cached_analysis, eps, hat
 
 PAIRS = ((1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3))

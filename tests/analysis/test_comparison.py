@@ -116,7 +116,7 @@ def test_dirac_and_canonical_differ_exactly_where_the_hand_calculation_says(anal
     G_a delta_ja R_ib, non-zero iff j is a or b. M and R keep their brackets ((246) with
     (239))."""
     s = analysis.symbols
-    R_, p_ = (sympy.Matrix(3, 3, lambda i, j: s[f"{x}_{i + 1}{j + 1}"]) for x in ("R", "p_R"))
+    R_, p_ = (sympy.Matrix(3, 3, lambda i, j, x=x: s[f"{x}_{i + 1}{j + 1}"]) for x in ("R", "p_R"))
     G = sympy.diag(sympy.Rational(2, 5), sympy.Rational(2, 3), 2)
     S = R_.T * p_ * G + G * p_.T * R_
     base = analysis_variables(analysis)

@@ -1,21 +1,21 @@
 """Brackets in noncanonical variables: the change (235) ``(R, p) -> (R, M, P)`` and the
 brackets (236)–(238), written out by hand here; Dirac brackets of the new variables on
 the constraint surface of (228) from the engine. (Those on the surface of (78) are
-exercised in test_compare.py and test_chetaev.py.)"""
+exercised in test_comparison.py and test_chetaev.py.)"""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 import sympy
+from rigid_body_analyses import cached_analysis, eps, hat
 
-from dirac.errors import AnalysisError, InputError
 from dirac.analysis.noncanonical import (
     NoncanonicalVariables,
     canonical_bracket,
     rigid_body_variables,
 )
-from rigid_body_analyses import cached_analysis, eps, hat
+from dirac.errors import AnalysisError, InputError
 
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 M = sympy.symbols("M_1:4", real=True)
