@@ -163,8 +163,8 @@ def straight_line(
     ----------
     inputs
         Every symbol the expressions may use -> its local name in the generated code
-        (valid Python names, none of the form ``t<digits>``, which name shared
-        sub-expressions).
+        (valid Python names; ``sharing="dag"`` names shared sub-expressions ``t<digits>``,
+        so no input may be named so there; :func:`sympy.cse` picks names no input uses).
     expressions
         The outputs: a sympy matrix (row by row) or a sequence of expressions.
     target
