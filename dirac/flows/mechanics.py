@@ -32,7 +32,13 @@ from dirac.validate import validate_finite
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
 
-__all__ = ["MechanicalSystem", "resolve_parameters"]
+__all__ = ["MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
+
+
+class NotMechanicalError(InputError):
+    """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
+    velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
+    flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
 
 
 def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
@@ -154,14 +160,14 @@ class MechanicalSystem:
         zero_velocity = {s: 0 for s in v}
         hessian = sympy.hessian(L, v)
         if any(entry.free_symbols & set(v) for entry in hessian):
-            raise InputError(
+            raise NotMechanicalError(
                 f"the Lagrangian of {lagrangian.name!r} is not quadratic in the velocities: RATTLE and the "
                 "flows here need L = 1/2 q_dot^T M(q) q_dot - V(q)"
             )
         linear = [sympy.simplify(sympy.diff(L, s).subs(zero_velocity)) for s in v]
         offending = [s.name for s, term in zip(v, linear) if term != 0]
         if offending:
-            raise InputError(
+            raise NotMechanicalError(
                 f"the Lagrangian of {lagrangian.name!r} has terms linear in the velocities "
                 f"({', '.join(offending)}, e.g. magnetic or gyroscopic terms): RATTLE needs "
                 "L = 1/2 q_dot^T M(q) q_dot - V(q); use method = \"midpoint\" on the Dirac flow instead"

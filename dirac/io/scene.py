@@ -310,7 +310,7 @@ def _rigid_problem(name: str, system: dict, initial: dict, source: str) -> Rigid
 
 
 def _general_problem(system: dict, initial: dict, source: str, base: Path) -> ConstrainedProblem | AnalysedProblem:
-    from dirac.flows.mechanics import MechanicalSystem
+    from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
     from dirac.flows.problems import ConstrainedProblem
     from dirac.model.lagrangian import lagrangian_from_table
     from dirac.model.systems import load_system
@@ -338,9 +338,7 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
         raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ l = 2.0 }}")
     try:
         mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides)
-    except InputError as exc:
-        if "velocities" not in str(exc):
-            raise
+    except NotMechanicalError:
         return _analysed_problem(lagrangian, overrides, initial, source)
     names = mechanics.coordinate_names
     if "q" not in initial:
@@ -363,7 +361,11 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
 
 def _analysed_problem(lagrangian: Lagrangian, overrides: dict, initial: dict, source: str) -> AnalysedProblem:
     """A Lagrangian that is not of the form 1/2 q_dot^T M q_dot - V (velocity-linear or
-    singular): integrate the Dirac vector field of its analysis (``midpoint``, scipy)."""
+    singular): integrate the Dirac vector field of its analysis (``midpoint``, scipy).
+
+    The Lagrangian is analysed once, with the scene's parameter values fixed
+    (:meth:`AnalysedSystem.from_lagrangian`: analyze, then ``from_analysis``); that same
+    analysis completes the initial state on the constraint surface."""
     from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
 
     analysed = AnalysedSystem.from_lagrangian(lagrangian, overrides)
