@@ -151,7 +151,7 @@ class DiracBracket:
             ) from None
         return float(plain - alpha @ x)
 
-    def _compiled_once(self, key: object, build) -> tuple:  # noqa: ANN001
+    def _compiled_once(self, key: object, build) -> tuple:
         """``(compiled function, free symbols)`` of the expressions ``build()``, compiled on first use."""
         entry = self._compiled.get(key)
         if entry is None:

@@ -61,7 +61,7 @@ class CReference:
         )
 
     @property
-    def _function(self):  # noqa: ANN202
+    def _function(self):
         function = self.library.strang_advance
         function.restype = None
         return function

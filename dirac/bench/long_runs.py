@@ -55,7 +55,7 @@ def long_run(method: str, steps: int, dt: float, samples: int = 1001) -> dict:
 
 
 
-def _constrained_problem(system: str):  # noqa: ANN202
+def _constrained_problem(system: str):
     import dirac
     from dirac.flows.mechanics import MechanicalSystem
     from dirac.flows.problems import ConstrainedProblem

@@ -169,7 +169,7 @@ def taylor_rigid_body(
     return np.array(M_out), np.array(R_out).reshape(-1, 3, 3)
 
 
-def _cached(kind: str, key: dict, compute) -> dict:  # noqa: ANN001
+def _cached(kind: str, key: dict, compute) -> dict:
     text = json.dumps({"kind": kind, "version": _REFERENCE_VERSION, **key}, sort_keys=True)
     name = hashlib.sha256(text.encode()).hexdigest()[:20]
     path = cache_directory() / f"{kind}_{name}.json"

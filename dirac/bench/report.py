@@ -96,7 +96,7 @@ def format_rows(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def format_targets(targets: list) -> str:  # noqa: ANN001
+def format_targets(targets: list) -> str:
     """The performance targets (docs/performance.md): value, target, met or missed by how much."""
     lines = ["\n== targets (each measured in this run; ratios against baselines of this run) =="]
     for t in targets:

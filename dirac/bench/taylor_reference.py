@@ -50,7 +50,7 @@ def _dot(u: list[int], v: list[int]) -> int:
     return sum(map(int.__mul__, u, v))
 
 
-def _scaled_coefficients(M: list[int], R: list[list[int]], ha: list[int], order: int, with_R: bool):  # noqa: ANN202
+def _scaled_coefficients(M: list[int], R: list[list[int]], ha: list[int], order: int, with_R: bool):
     """Taylor coefficients of ``M(t0 + h s)``, ``R(t0 + h s)`` in ``s`` (fixed point).
 
     ``dM/ds = M x (h a M)``, ``dR/ds = R hat(h a M)`` (250)-(251) with ``a = 1/I``: the

@@ -70,7 +70,7 @@ def _rigid_errors(M: np.ndarray, R: np.ndarray, case: RigidBodyCase, M_ref: np.n
     }
 
 
-def _rigid_package_run(case: RigidBodyCase, grid: MethodGrid, value: float | None, problem, refs) -> Callable[[], dict]:  # noqa: ANN001
+def _rigid_package_run(case: RigidBodyCase, grid: MethodGrid, value: float | None, problem, refs) -> Callable[[], dict]:
     from dirac.flows import integrate
 
     def run() -> dict:
@@ -98,7 +98,7 @@ def _rigid_package_run(case: RigidBodyCase, grid: MethodGrid, value: float | Non
     return run
 
 
-def _rigid_scipy_run(case: RigidBodyCase, grid: MethodGrid, tolerance: float, refs) -> Callable[[], dict]:  # noqa: ANN001
+def _rigid_scipy_run(case: RigidBodyCase, grid: MethodGrid, tolerance: float, refs) -> Callable[[], dict]:
     from scipy.integrate import solve_ivp
 
     from dirac.rigidbody.euler_poisson import lean_rhs_full
@@ -153,7 +153,7 @@ def run_rigid_body_case(case: RigidBodyCase, repeats: int, progress: Progress) -
     return rows
 
 
-def _constrained_problem(case: ConstrainedCase):  # noqa: ANN202
+def _constrained_problem(case: ConstrainedCase):
     from dirac.flows import ConstrainedProblem, MechanicalSystem
     from dirac.model.systems import load_system
 
@@ -161,7 +161,7 @@ def _constrained_problem(case: ConstrainedCase):  # noqa: ANN202
     params = mechanics.parameter_values
     if case.system == "pendulum":
         (a,) = case.angles
-        l = params["l"]  # noqa: E741
+        l = params["l"]
         q0 = np.array([l * math.sin(a), -l * math.cos(a)])
     else:
         a1, a2 = case.angles

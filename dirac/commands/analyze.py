@@ -58,8 +58,8 @@ def parse_params(items: list[str]) -> dict[str, float]:
 
 
 def main(args: argparse.Namespace) -> int:
-    from dirac.model.systems import load_system
     from dirac.analysis.constraint_analysis import analyze
+    from dirac.model.systems import load_system
 
     params = parse_params(args.param)
     lagrangian = load_system(args.system, **params)

@@ -56,7 +56,7 @@ def main(args: argparse.Namespace) -> int:
         raise InputError(f"--plot {args.plot!r}: give a file name ending in .png")
     if args.plot:
         try:
-            import matplotlib  # noqa: F401
+            import matplotlib  # noqa: F401 -- imported only to check that it is installed
         except ModuleNotFoundError:
             raise InputError("--plot needs matplotlib: pip install 'dirac-mechanics[plot]'") from None
     from dirac.bench.run import run_benchmark

@@ -86,7 +86,7 @@ def main(args: argparse.Namespace) -> int:
     scene = load_scene(scene_path)
     progress = (not args.no_progress) and sys.stderr.isatty()
 
-    def terminate(signum, frame):  # noqa: ANN001, ANN202
+    def terminate(signum, frame):
         raise KeyboardInterrupt
 
     previous = signal.signal(signal.SIGTERM, terminate)

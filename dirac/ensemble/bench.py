@@ -27,7 +27,7 @@ from typing import Any
 __all__ = ["measure", "format_table", "BENCH_SIZES"]
 
 
-def _scene(count: int, steps: int, dt: float):  # noqa: ANN202
+def _scene(count: int, steps: int, dt: float):
     from dirac.ensemble.scene import parse_ensemble_scene
 
     with warnings.catch_warnings():

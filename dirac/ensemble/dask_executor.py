@@ -138,7 +138,7 @@ QUIET_DASK = {
 }
 
 
-def dask_client(address_or_cluster: object):  # noqa: ANN201
+def dask_client(address_or_cluster: object):
     """A ``distributed.Client`` created with :data:`QUIET_DASK` (its own timers are slower)."""
     import dask
     from distributed import Client
@@ -147,7 +147,7 @@ def dask_client(address_or_cluster: object):  # noqa: ANN201
         return Client(address_or_cluster, timeout="20s")
 
 
-def local_cluster(n_workers: int, dashboard_address: str | None = None):  # noqa: ANN201
+def local_cluster(n_workers: int, dashboard_address: str | None = None):
     """A dask ``LocalCluster`` for ensembles: ``n_workers`` processes on the loopback.
 
     One thread per worker (each task's kernel gets the host's cores divided by the
@@ -169,11 +169,11 @@ def local_cluster(n_workers: int, dashboard_address: str | None = None):  # noqa
         )
 
 
-def _dashboard(client) -> str | None:  # noqa: ANN001
+def _dashboard(client) -> str | None:
     """The dashboard address, if the scheduler runs one (needs bokeh)."""
     try:
         services = client.scheduler_info(n_workers=0).get("services", {})
-    except Exception:  # noqa: BLE001 -- the address is a convenience
+    except Exception:
         return None
     if "dashboard" not in services:
         return None

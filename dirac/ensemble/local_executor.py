@@ -32,7 +32,7 @@ def run_local(work: ChunkWork) -> None:
         index, future = pending
         try:
             marker = future.result()
-        except Exception as exc:  # noqa: BLE001 -- reported, never dropped
+        except Exception as exc:
             record(None, index, f"write failed: {type(exc).__name__}: {exc}")
         else:
             record(marker, index, None)
@@ -47,7 +47,7 @@ def run_local(work: ChunkWork) -> None:
             start, stop = bounds[position]
             try:
                 members = upcoming.result() if upcoming is not None else None
-            except Exception:  # noqa: BLE001 -- drawn again below, where errors are counted
+            except Exception:
                 members = None
             upcoming = drawer.submit(scene.source.members, *bounds[position + 1]) if position + 1 < len(bounds) else None
             error = None
@@ -57,7 +57,7 @@ def run_local(work: ChunkWork) -> None:
                     arrays = compute_chunk(scene, start, stop, members if attempt == 0 else None)
                     timing = {"seconds": time.perf_counter() - wall, "cpu_seconds": time.process_time() - cpu}
                     break
-                except Exception as exc:  # noqa: BLE001 -- retried, then reported
+                except Exception as exc:
                     error = f"{type(exc).__name__}: {exc} (after {attempt + 1} attempts)"
             else:
                 record(None, index, error)

@@ -26,7 +26,7 @@ import numpy as np
 __all__ = ["Reduction", "make_reductions", "reduction_arrays"]
 
 
-def energy_of(M: np.ndarray, inv_inertia: np.ndarray) -> np.ndarray:  # noqa: N803
+def energy_of(M: np.ndarray, inv_inertia: np.ndarray) -> np.ndarray:
     """``H_0 = sum_i M_i^2 / (2 I_i)`` (247) of each member (rows of ``M``).
 
     The row-wise form of :func:`dirac.rigidbody.euler_poisson.energy` with the members'
@@ -35,7 +35,7 @@ def energy_of(M: np.ndarray, inv_inertia: np.ndarray) -> np.ndarray:  # noqa: N8
     return 0.5 * np.einsum("ij,ij->i", M * inv_inertia, M)
 
 
-def casimir_of(M: np.ndarray) -> np.ndarray:  # noqa: N803
+def casimir_of(M: np.ndarray) -> np.ndarray:
     """``|M|^2``, the Casimir (248), of each member (rows of ``M``)."""
     return np.einsum("ij,ij->i", M, M)
 
@@ -55,7 +55,7 @@ class Reduction:
     """A streaming summary: :meth:`start` at ``t = 0``, :meth:`update` at each later sample,
     :meth:`result` at the end (arrays with the chunk's members along axis 0)."""
 
-    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:
         """Called with the chunk's initial state (``t = 0``)."""
         raise NotImplementedError  # pragma: no cover - abstract
 
@@ -73,7 +73,7 @@ class FlipTime(Reduction):
     def __init__(self, axis: int | None) -> None:
         self.axis = axis
 
-    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:
         n = M.shape[0]
         self.rows = np.arange(n)
         if self.axis is None:
@@ -84,7 +84,7 @@ class FlipTime(Reduction):
         self.prev = self.a0.copy()
         self.time = np.full(n, np.nan)
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:  # noqa: N803
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
         a = M[self.rows, self.cols]
         new = np.isnan(self.time) & (a * self.a0 < 0.0)
         if np.any(new):
@@ -102,18 +102,18 @@ class MaxRelativeError(Reduction):
     def __init__(self, name: str) -> None:
         self.name = name
 
-    def _value(self, M: np.ndarray) -> np.ndarray:  # noqa: N803
+    def _value(self, M: np.ndarray) -> np.ndarray:
         if self.name == "max_energy_error":
             return energy_of(M, self.inv)
         return casimir_of(M)
 
-    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:
         self.inv = 1.0 / inertia
         self.f0 = self._value(M)
         self.scale = np.where(self.f0 != 0.0, np.abs(self.f0), 1.0)
         self.error = np.zeros(M.shape[0])
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:  # noqa: N803
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
         np.maximum(self.error, np.abs(self._value(M) - self.f0) / self.scale, out=self.error)
 
     def result(self) -> dict[str, np.ndarray]:
@@ -123,10 +123,10 @@ class MaxRelativeError(Reduction):
 class FinalState(Reduction):
     """``M`` and ``R`` at the last sample."""
 
-    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:
         self.M, self.R = M, R
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:  # noqa: N803
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
         self.M, self.R = M, R
 
     def result(self) -> dict[str, np.ndarray]:
@@ -136,7 +136,7 @@ class FinalState(Reduction):
 class InitialState(Reduction):
     """The member's initial data."""
 
-    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:  # noqa: N803
+    def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:
         self.data = {"initial_M": M.copy(), "initial_R": R.copy(), "inertia": inertia.copy()}
 
     def result(self) -> dict[str, np.ndarray]:

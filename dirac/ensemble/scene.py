@@ -286,7 +286,7 @@ def _check_member_file(file: str, count: int | None) -> tuple[int, str]:
         raise InputError(f"[ensemble] file {file!r} does not exist; give a path relative to the scene file")
     try:
         arrays = open_member_file(file)
-    except Exception as exc:  # noqa: BLE001 -- any unreadable file is bad input
+    except Exception as exc:
         raise InputError(f"[ensemble] file {file!r} cannot be read ({exc}); give an .npz file or a zarr group") from None
     if "M" not in arrays:
         raise InputError(f"[ensemble] file {file!r} has no array 'M' (shape (count, 3)); add it")

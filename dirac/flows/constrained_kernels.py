@@ -286,7 +286,7 @@ def rattle_constant_mass(fns, q, p, minv, params, m, fractions, dt, n_steps, tol
                     lam[a] = 0.0
                 q1[:] = qp
                 converged = False
-                for it in range(max_iter):
+                for _it in range(max_iter):
                     fns[CONSTRAINTS](q1, params, chi)
                     evals += 1.0
                     residual = _max_abs(chi)
@@ -414,7 +414,7 @@ def rattle_general(fns, q, p, params, m, fractions, dt, n_steps, tol, max_iter, 
                     J[i, j] = (rr[i] - r[i]) / d
             evals += N
             converged = False
-            for it in range(max_iter):
+            for _it in range(max_iter):
                 delta = _solve_vec(J, r)
                 for i in range(N):
                     x[i] -= delta[i]
@@ -540,7 +540,7 @@ def _project_analysed(fns, z, params, N, k, tol):
         return
     phi = np.empty(k)
     flat = np.empty(k * N)
-    for it in range(5):
+    for _it in range(5):
         fns[ANALYSED_CONSTRAINTS](z, params, phi)
         size = 0.0
         scale = 1.0
@@ -608,7 +608,7 @@ def midpoint_run(kind, fns, z, params, n, m, dt, n_steps, tol, max_iter, info):
         for i in range(N):
             z1[i] = z[i] + dt * f[i]
         converged = False
-        for it in range(max_iter):
+        for _it in range(max_iter):
             for i in range(N):
                 zm[i] = 0.5 * (z[i] + z1[i])
             _field(kind, fns, zm, params, n, m, fz)

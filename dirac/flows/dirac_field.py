@@ -25,7 +25,7 @@ __all__ = ["ConstrainedField", "constrained_outputs"]
 class ConstrainedField:
     """Numerical Dirac vector field of a :class:`MechanicalSystem` (numba kernel)."""
 
-    def __init__(self, mechanics) -> None:  # noqa: ANN001
+    def __init__(self, mechanics) -> None:
         self.mechanics = mechanics
         self.n = mechanics.dimension
         self.m = mechanics.n_constraints
@@ -52,7 +52,7 @@ class ConstrainedField:
         return constrained_outputs(self.mechanics, names, q, p)
 
 
-def constrained_outputs(mechanics, names: tuple[str, ...], q: np.ndarray, p: np.ndarray) -> dict[str, np.ndarray]:  # noqa: ANN001
+def constrained_outputs(mechanics, names: tuple[str, ...], q: np.ndarray, p: np.ndarray) -> dict[str, np.ndarray]:
     """Outputs of a constrained system from batched ``q`` (B, n) and ``p`` (B, n).
 
     ``q_dot = M(q)^{-1} p``; ``energy = H``; ``constraint_residual`` is

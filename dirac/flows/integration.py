@@ -252,8 +252,8 @@ def _names_for(kind: str) -> list[str]:
 class _Loop:
     """One run of the loop (keeps the bookkeeping out of :func:`integrate`)."""
 
-    def __init__(self, problem: Problem, method: Method, stepper: Stepper, outputs, t_end, samples, dt, progress,  # noqa: ANN001
-                 drift_limit, extra) -> None:  # noqa: ANN001
+    def __init__(self, problem: Problem, method: Method, stepper: Stepper, outputs, t_end, samples, dt, progress,
+                 drift_limit, extra) -> None:
         self.problem = problem
         self.method = method
         self.stepper = stepper
@@ -368,7 +368,7 @@ class _Loop:
         self.dt = spacing / per_interval
         return [(float(a), float(b), per_interval) for a, b in zip(starts, ends)]
 
-    def _run_fixed(self, bar, intervals: list[tuple[float, float, int]]) -> None:  # noqa: ANN001
+    def _run_fixed(self, bar, intervals: list[tuple[float, float, int]]) -> None:
         if self.times[0] == 0.0:
             self._keep(0, self.stepper.observe())
         first = 1 if self.times[0] == 0.0 else 0
@@ -395,7 +395,7 @@ class _Loop:
                 self._check(final=True)
             self._keep(first + index, self.stepper.observe())
 
-    def _run_adaptive(self, bar) -> None:  # noqa: ANN001
+    def _run_adaptive(self, bar) -> None:
         for index, t in enumerate(self.times):
             if t > 0.0:
                 self.stepper.advance_to(float(t))
@@ -404,7 +404,7 @@ class _Loop:
             self._keep(index, self.stepper.observe())
             bar.update(1)
 
-    def _run_exact(self, bar) -> None:  # noqa: ANN001
+    def _run_exact(self, bar) -> None:
         for begin in range(0, len(self.times), CHUNK_SAMPLES):
             chunk = self.times[begin : begin + CHUNK_SAMPLES]
             values = self.stepper.evaluate(chunk)

@@ -170,7 +170,7 @@ class Lagrangian:
         constraints: Iterable[str] = (),
         parameters: Mapping[str, float | None] | None = None,
         description: str = "",
-    ) -> "Lagrangian":
+    ) -> Lagrangian:
         """Build a Lagrangian from expressions written as text (docs/file_formats.md).
 
         Examples
@@ -229,7 +229,7 @@ class Lagrangian:
         """The velocity symbol that belongs to ``coordinate``."""
         return self.velocities[self.coordinates.index(coordinate)]
 
-    def fix(self, **values: float) -> "Lagrangian":
+    def fix(self, **values: float) -> Lagrangian:
         """Substitute numbers for some parameters; the others stay symbolic.
 
         Values are substituted as exact rationals of the numbers as written, so the
@@ -265,7 +265,7 @@ class Lagrangian:
             merged,
         )
 
-    def with_defaults(self) -> "Lagrangian":
+    def with_defaults(self) -> Lagrangian:
         """All parameters that have a default value fixed to it (for numerical work)."""
         return self.fix(**{p.name: v for p, v in self.parameters.items() if v is not None})
 

@@ -18,7 +18,7 @@ __all__ = ["new_figure", "save_png", "check_png_path"]
 
 def _require_matplotlib() -> None:
     try:
-        import matplotlib  # noqa: F401
+        import matplotlib  # noqa: F401 -- imported only to check that it is installed
     except ModuleNotFoundError as exc:  # pragma: no cover - matplotlib is in the test extra
         raise InputError(
             "drawing needs matplotlib, which is not installed: "

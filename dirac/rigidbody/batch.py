@@ -73,19 +73,19 @@ _C6 = -1.13596475577881948265e-11
 
 
 @njit(cache=True, inline="always")
-def _sin_poly(z):  # noqa: ANN001, ANN202 -- numba kernel
+def _sin_poly(z):
     """``S2 + z (S3 + z (S4 + z (S5 + z S6)))`` of fdlibm ``k_sin.c`` (``z = r^2``)."""
     return _S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))
 
 
 @njit(cache=True, inline="always")
-def _cos_poly(z):  # noqa: ANN001, ANN202 -- numba kernel
+def _cos_poly(z):
     """``z (C1 + z (C2 + ... + z C6))`` of fdlibm ``k_cos.c`` (``z = r^2``)."""
     return z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
 
 
 @njit(cache=True, inline="always")
-def _cos_sum(z, rest):  # noqa: ANN001, ANN202 -- numba kernel
+def _cos_sum(z, rest):
     """``1 - z/2 + rest`` with the compensated sum of fdlibm ``k_cos.c``."""
     hz = 0.5 * z
     w = 1.0 - hz
@@ -93,7 +93,7 @@ def _cos_sum(z, rest):  # noqa: ANN001, ANN202 -- numba kernel
 
 
 @njit(cache=True, inline="always")
-def _sincos_reduced(r):  # noqa: ANN001, ANN202 -- numba kernel
+def _sincos_reduced(r):
     """``(sin r, cos r)`` for ``|r| <= pi/4``: fdlibm ``k_sin.c`` / ``k_cos.c`` kernels."""
     z = r * r
     v = z * r
@@ -103,7 +103,7 @@ def _sincos_reduced(r):  # noqa: ANN001, ANN202 -- numba kernel
 
 
 @njit(cache=True, inline="always")
-def _sincos_reduced_tail(x, y):  # noqa: ANN001, ANN202 -- numba kernel
+def _sincos_reduced_tail(x, y):
     """``(sin(x + y), cos(x + y))`` for ``|x| <= pi/4``, ``|y| <= ulp(x)/2`` (fdlibm kernels
     with the tail ``y`` of a double-double reduced angle)."""
     z = x * x
@@ -114,7 +114,7 @@ def _sincos_reduced_tail(x, y):  # noqa: ANN001, ANN202 -- numba kernel
 
 
 @njit(cache=True, inline="always")
-def _two_sum(a, b):  # noqa: ANN001, ANN202 -- numba kernel
+def _two_sum(a, b):
     """Knuth's TwoSum: ``s = fl(a + b)`` and the exact rounding error ``e = a + b - s``."""
     s = a + b
     bv = s - a
@@ -123,7 +123,7 @@ def _two_sum(a, b):  # noqa: ANN001, ANN202 -- numba kernel
 
 
 @njit(cache=True, inline="always")
-def sincos_poly(theta):  # noqa: ANN001, ANN201 -- numba kernel
+def sincos_poly(theta):
     """``(sin theta, cos theta)`` by polynomials on the reduced angle, branch-free.
 
     ``n = round(2 theta / pi)`` and ``r = theta - n pi/2`` as a double-double
@@ -154,7 +154,7 @@ def sincos_poly(theta):  # noqa: ANN001, ANN201 -- numba kernel
 
 
 @njit(cache=True)
-def _sincos_poly_array(theta, s_out, c_out):  # noqa: ANN001, ANN202
+def _sincos_poly_array(theta, s_out, c_out):
     for i in range(theta.shape[0]):
         s, c = sincos_poly(theta[i])
         s_out[i] = s
@@ -187,7 +187,7 @@ _TRIG_SMALL = 2  # |theta| <= pi/4 for every sub-step: polynomial, no reduction 
 
 
 @njit(cache=True)
-def _rotate_block(X, S, C, width, k, h, with_R, trig):  # noqa: ANN001, ANN202, N803, PLR0913
+def _rotate_block(X, S, C, width, k, h, with_R, trig):
     """One exact sub-flow ``H_k`` for the ``width`` bodies of the SoA block ``X``.
 
     ``X`` rows: 0-2 ``M``, 3-5 ``1/I``, 6-14 ``R`` (row-major); ``S``, ``C`` scratch rows.
@@ -195,7 +195,7 @@ def _rotate_block(X, S, C, width, k, h, with_R, trig):  # noqa: ANN001, ANN202, 
     bodies (angles, then rotations) so that both vectorise.
     """
     j = (k + 1) % 3
-    l = (k + 2) % 3  # noqa: E741
+    l = (k + 2) % 3
     mk = X[k]
     wk = X[3 + k]
     if trig == _TRIG_SMALL:
@@ -220,7 +220,7 @@ def _rotate_block(X, S, C, width, k, h, with_R, trig):  # noqa: ANN001, ANN202, 
 
 
 @njit(cache=True, inline="always")
-def _turn_rows(a, b, S, C, width):  # noqa: ANN001, ANN202, N803
+def _turn_rows(a, b, S, C, width):
     for i in range(width):
         ai = a[i]
         bi = b[i]
@@ -229,7 +229,7 @@ def _turn_rows(a, b, S, C, width):  # noqa: ANN001, ANN202, N803
 
 
 @njit(cache=True, parallel=True)
-def _advance_blocks(M, R, inv, axes, fractions, dt, n_steps, with_R, trig, n_workers):  # noqa: ANN001, ANN202, N803, PLR0913
+def _advance_blocks(M, R, inv, axes, fractions, dt, n_steps, with_R, trig, n_workers):
     n_bodies = M.shape[0]
     length = axes.shape[0]
     last = length - 1
@@ -426,7 +426,7 @@ def advance_batch_numpy(
     r = [[np.ascontiguousarray(R[:, a, b]) for b in range(3)] for a in range(3)] if with_R and R is not None else None
 
     def rotate(k: int, h: float) -> None:
-        j, l = (k + 1) % 3, (k + 2) % 3  # noqa: E741
+        j, l = (k + 1) % 3, (k + 2) % 3
         theta = (h * w[k]) * m[k]
         c = np.cos(theta)
         s = np.sin(theta)

@@ -74,7 +74,7 @@ def agm_sequence(mc: float) -> tuple[np.ndarray, np.ndarray, float]:
 
 
 @njit(cache=True)
-def sncndn(u, em, en, agm):  # noqa: ANN001, ANN201
+def sncndn(u, em, en, agm):
     """Jacobi ``sn, cn, dn (u | m)`` by Bulirsch's descending Gauss transformation.
 
     Takes the AGM data of :func:`agm_sequence` (so ``mc = 1 - m`` is used directly). No
@@ -111,7 +111,7 @@ def sncndn(u, em, en, agm):  # noqa: ANN001, ANN201
 
 
 @njit(cache=True)
-def carlson_rc(x, y):  # noqa: ANN001, ANN201
+def carlson_rc(x, y):
     """Carlson's degenerate integral ``R_C(x, y)``, ``x > 0``, ``y > 0`` (DLMF 19.2.17, 19.2.18).
 
     With ``e = (y - x) / x``: ``atan(sqrt((y - x)/x)) / sqrt(y - x)`` for ``e > 0``,
@@ -129,7 +129,7 @@ def carlson_rc(x, y):  # noqa: ANN001, ANN201
 
 
 @njit(cache=True)
-def carlson_rf(x, y, z):  # noqa: ANN001, ANN201
+def carlson_rf(x, y, z):
     """Carlson's ``R_F(x, y, z)`` for ``x, y, z >= 0``, at most one zero (DLMF 19.16.1)."""
     xt = x
     yt = y
@@ -154,7 +154,7 @@ def carlson_rf(x, y, z):  # noqa: ANN001, ANN201
 
 
 @njit(cache=True)
-def carlson_rf_rj(x, y, z, p):  # noqa: ANN001, ANN201
+def carlson_rf_rj(x, y, z, p):
     """``(R_F(x, y, z), R_J(x, y, z, p))`` from one shared duplication sequence.
 
     ``x, y, z >= 0`` (at most one zero), ``p > 0`` (DLMF 19.16.1, 19.16.2; Carlson 1995
@@ -222,21 +222,21 @@ def carlson_rf_rj(x, y, z, p):  # noqa: ANN001, ANN201
 
 
 @njit(cache=True)
-def carlson_rj(x, y, z, p):  # noqa: ANN001, ANN201
+def carlson_rj(x, y, z, p):
     """Carlson's ``R_J(x, y, z, p)`` for ``x, y, z >= 0`` (at most one zero), ``p > 0``
     (DLMF 19.16.2)."""
     return carlson_rf_rj(x, y, z, p)[1]
 
 
 @njit(cache=True)
-def _f_reduced(phi, mc):  # noqa: ANN001, ANN202
+def _f_reduced(phi, mc):
     s = math.sin(phi)
     c = math.cos(phi)
     return s * carlson_rf(c * c, c * c + mc * s * s, 1.0)
 
 
 @njit(cache=True)
-def _pi_reduced(phi, n, mc):  # noqa: ANN001, ANN202
+def _pi_reduced(phi, n, mc):
     s = math.sin(phi)
     c = math.cos(phi)
     delta2 = c * c + mc * s * s
@@ -247,7 +247,7 @@ def _pi_reduced(phi, n, mc):  # noqa: ANN001, ANN202
 
 
 @njit(cache=True)
-def complete_pi(n, mc):  # noqa: ANN001, ANN201
+def complete_pi(n, mc):
     """Complete integral of the third kind ``Pi(n | m)``, ``n < 1``, ``mc > 0``
     (DLMF 19.25.2); ``n = 0`` gives ``K(m)``."""
     if n == 0.0:
@@ -257,7 +257,7 @@ def complete_pi(n, mc):  # noqa: ANN001, ANN201
 
 
 @njit(cache=True)
-def elliptic_pi(phi, n, mc, pi_complete):  # noqa: ANN001, ANN201
+def elliptic_pi(phi, n, mc, pi_complete):
     """Incomplete ``Pi(n; phi | m) = int_0^phi dt / ((1 - n sin^2 t) sqrt(1 - m sin^2 t))``
     for any real ``phi`` (``n < 1``; DLMF 19.25.14 and 19.2.10's quasi-periodicity
     ``Pi(phi + j pi) = Pi(phi) + 2 j Pi(n | m)``); ``pi_complete = complete_pi(n, mc)``
@@ -269,7 +269,7 @@ def elliptic_pi(phi, n, mc, pi_complete):  # noqa: ANN001, ANN201
 
 
 @njit(cache=True)
-def elliptic_f(phi, mc):  # noqa: ANN001, ANN201
+def elliptic_f(phi, mc):
     """Incomplete integral of the first kind ``F(phi | m)`` for any real ``phi``
     (DLMF 19.25.5 with quasi-periodicity); ``mc = 1 - m``."""
     j = math.floor(phi / math.pi + 0.5)
@@ -315,7 +315,7 @@ def jacobi_sncndn(u: np.ndarray | float, m: float, mc: float | None = None) -> t
 
 
 @njit(cache=True)
-def reduced_sncndn(u, em, en, agm, K, kp):  # noqa: ANN001, ANN201, PLR0913
+def reduced_sncndn(u, em, en, agm, K, kp):
     """``u = 2 j K + w`` with ``|w| <= K``; returns ``j`` and ``sn, cn, dn (w)`` (``cn >= 0``).
 
     Near ``w = +-K`` the half-period shift keeps ``cn`` and ``dn`` *relatively* accurate

@@ -74,7 +74,7 @@ def _frame(M: np.ndarray, p3: int) -> np.ndarray:
     """The rotation ``A(M)`` of the module docstring (rows ``r1, r2, r3``)."""
     G = math.sqrt(float(M[0] * M[0] + M[1] * M[1] + M[2] * M[2]))
     mu = [float(M[0]) / G, float(M[1]) / G, float(M[2]) / G]
-    j, l = (p3 + 1) % 3, (p3 + 2) % 3  # noqa: E741
+    j, l = (p3 + 1) % 3, (p3 + 2) % 3
     r1 = [0.0, 0.0, 0.0]
     r1[j] = -mu[l]  # e_p3 x mu for the cyclic triple (p3, j, l)
     r1[l] = mu[j]
@@ -337,12 +337,12 @@ def _uniform_rotation(R0: np.ndarray, omega: np.ndarray, t: np.ndarray) -> np.nd
 
 
 @njit(cache=True)
-def _reduced_jacobi(u, p, em, en):  # noqa: ANN001, ANN202
+def _reduced_jacobi(u, p, em, en):
     return reduced_sncndn(u, em, en, p[14], p[12], p[13])
 
 
 @njit(cache=True)
-def _pi_of_reduced(j, sn, cn, dn, n, pi_complete):  # noqa: ANN001, ANN202
+def _pi_of_reduced(j, sn, cn, dn, n, pi_complete):
     """``Pi(n; am u | m)`` from ``u = 2 j K + w`` and ``sn, cn, dn (w)`` (DLMF 19.25.14)."""
     if n == 0.0:
         value = sn * carlson_rf(cn * cn, dn * dn, 1.0)
@@ -355,7 +355,7 @@ def _pi_of_reduced(j, sn, cn, dn, n, pi_complete):  # noqa: ANN001, ANN202
 
 
 @njit(cache=True)
-def _pi_separatrix(u, n):  # noqa: ANN001, ANN202
+def _pi_separatrix(u, n):
     """``Pi(n; am u | 1)`` for ``n <= 0``: ``sin am u = tanh u``, ``atanh(tanh u) = u``, and
     ``1/((1 - n s^2)(1 - s^2)) = (1/(1 - s^2) - n/(1 - n s^2)) / (1 - n)`` give
     ``(u + sqrt(-n) atan(sqrt(-n) tanh u)) / (1 - n)``."""
@@ -364,7 +364,7 @@ def _pi_separatrix(u, n):  # noqa: ANN001, ANN202
 
 
 @njit(cache=True)
-def _eval_M(times, p, perm, em, en, out):  # noqa: ANN001, ANN202
+def _eval_M(times, p, perm, em, en, out):
     for i in range(times.shape[0]):
         j, sn, cn, dn = _reduced_jacobi(p[3] * times[i] + p[4], p, em, en)
         parity = 1.0 - 2.0 * (j % 2.0)
@@ -374,7 +374,7 @@ def _eval_M(times, p, perm, em, en, out):  # noqa: ANN001, ANN202
 
 
 @njit(cache=True)
-def _eval_state(times, p, perm, em, en, Q, M_out, R_out):  # noqa: ANN001, ANN202, PLR0913
+def _eval_state(times, p, perm, em, en, Q, M_out, R_out):
     p3 = perm[3]  # the Euler-angle axis b
     j3 = (p3 + 1) % 3
     l3 = (p3 + 2) % 3

@@ -152,7 +152,7 @@ def build_sequence(
 
 
 @njit(cache=True, inline="always")
-def _turn_M(M, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
+def _turn_M(M, j, l, c, s):
     mj = M[j]
     ml = M[l]
     M[j] = c * mj + s * ml
@@ -160,7 +160,7 @@ def _turn_M(M, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
 
 
 @njit(cache=True, inline="always")
-def _turn_R(R, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
+def _turn_R(R, j, l, c, s):
     for row in range(3):
         rj = R[row, j]
         rl = R[row, l]
@@ -169,7 +169,7 @@ def _turn_R(R, j, l, c, s):  # noqa: ANN001, N802, E741 -- numba kernel
 
 
 @njit(cache=True, inline="always")
-def _sub_step(M, R, k, j, l, h, with_R):  # noqa: ANN001, ANN202, N803, E741, PLR0913 -- numba kernel
+def _sub_step(M, R, k, j, l, h, with_R):
     """Exact flow of ``rate M_k^2 / 2`` for ``h = fraction dt rate``: ``theta = h M_k``,
     ``M`` turned about ``e_k`` by ``-theta`` and (``with_R``) ``R`` on the right by ``+theta``."""
     theta = h * M[k]
@@ -181,7 +181,7 @@ def _sub_step(M, R, k, j, l, h, with_R):  # noqa: ANN001, ANN202, N803, E741, PL
 
 
 @njit(cache=True)
-def advance_sequence(M, R, axes, rates, fractions, casimir_rate, dt, n_steps, with_R):  # noqa: ANN001, N803, PLR0913
+def advance_sequence(M, R, axes, rates, fractions, casimir_rate, dt, n_steps, with_R):
     """Advance ``(M, R)`` in place by ``n_steps`` composed steps of size ``dt``.
 
     Each sub-step ``(k, rate, fraction)`` turns ``M`` about body axis ``e_k`` by

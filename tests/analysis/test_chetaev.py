@@ -109,7 +109,7 @@ def test_dirac_bracket_of_M_is_chetaev_symbolically(analysis):
 
 def test_H0_247_generates_the_euler_poisson_equations_250_251(analysis):
     M = body_momentum(analysis)
-    I = analysis.parameters  # noqa: E741 - I_1, I_2, I_3 (symbolic)
+    I = analysis.parameters
     assert [p.name for p in I] == ["I_1", "I_2", "I_3"]
     H0 = sum(M[k] ** 2 / I[k] for k in range(3)) / 2  # (247), principal axes
     s = analysis.symbols

@@ -149,7 +149,9 @@ def test_the_printed_238_is_not_antisymmetric_so_it_has_a_typo():
     K = Rt @ Rt.T
 
     def printed(i, j, a, b):  # -K_ia eps_jbn M_n - K_jb eps_jan M_n + (a <-> b), as printed
-        term = lambda a_, b_: -sum(K[i, a_] * eps(j, b_, n) * M_[n] + K[j, b_] * eps(j, a_, n) * M_[n] for n in range(3))  # noqa: E731
+        def term(a_, b_):
+            return -sum(K[i, a_] * eps(j, b_, n) * M_[n] + K[j, b_] * eps(j, a_, n) * M_[n] for n in range(3))
+
         return term(a, b) + term(b, a)
 
     assert abs(printed(0, 1, 1, 2) + printed(1, 2, 0, 1)) > 1e-3

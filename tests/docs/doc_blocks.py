@@ -186,8 +186,8 @@ def run_python(page: str, block: Block, namespace: dict) -> list[str]:
     wanted = block.options.get("raises")
     try:
         with contextlib.redirect_stdout(out):
-            exec(code, namespace)  # noqa: S102 - the documentation's own examples
-    except Exception as exc:  # noqa: BLE001 - reported below
+            exec(code, namespace)
+    except Exception as exc:
         names = {cls.__name__ for cls in type(exc).__mro__} | {
             f"{cls.__module__}.{cls.__name__}" for cls in type(exc).__mro__
         }

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from doc_blocks import console_commands, parse_blocks, run_page
 
 PAGE = '''# Page
@@ -44,7 +43,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 
 @pytest.fixture
-def run_text(tmp_path: Path, monkeypatch):  # noqa: ANN201
+def run_text(tmp_path: Path, monkeypatch):
     """Run a page text as ``page.md`` in ``tmp_path``, which is made the working directory."""
     monkeypatch.chdir(tmp_path)
 

@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 from dirac.flows import RigidBodyProblem, integrate
 
 
-def euler_poisson(t, y, i1, i2, i3):  # noqa: ANN001, ANN201
+def euler_poisson(t, y, i1, i2, i3):
     """dM/dt = M x Omega, dR/dt = R hat(Omega), Omega = I^{-1} M, in plain floats (speed)."""
     m1, m2, m3, a, b, c, d, e, f, g, h, k = y
     w1, w2, w3 = m1 / i1, m2 / i2, m3 / i3

@@ -51,7 +51,7 @@ def test_energy_bounded_over_a_million_steps(method, stress):
     _no_drift(_energy_run(method, steps, 0.05), 5e-3)
 
 
-def _pendulum_run(system, method: str, steps: int, dt: float):  # noqa: ANN001, ANN202
+def _pendulum_run(system, method: str, steps: int, dt: float):
     theta = 1.2
     problem = ConstrainedProblem(system, [np.sin(theta), -np.cos(theta)], [0.3, 0.3 * np.tan(theta)])
     return integrate(problem, method, t_end=steps * dt, dt=dt, samples=201,

@@ -13,7 +13,7 @@ from dirac.flows.integration import IntegrationInterrupted
 from dirac.model.lagrangian import Lagrangian
 
 
-def _pendulum(system, theta=1.0):  # noqa: ANN001, ANN202
+def _pendulum(system, theta=1.0):
     return ConstrainedProblem(system, [np.sin(theta), -np.cos(theta)], [0.0, 0.0])
 
 
@@ -59,7 +59,7 @@ def test_interruption_keeps_the_samples_computed_so_far(monkeypatch):
     calls = {"n": 0}
     original = LiePoissonStepper.step
 
-    def step(self, n_steps, dt):  # noqa: ANN001, ANN202
+    def step(self, n_steps, dt):
         calls["n"] += 1
         if calls["n"] == 4:
             raise KeyboardInterrupt

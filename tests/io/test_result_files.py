@@ -11,7 +11,7 @@ import pytest
 from dirac.flows import RigidBodyProblem, integrate, read_results, write_results
 
 
-def _solution(outputs=("M", "energy")):  # noqa: ANN001, ANN202
+def _solution(outputs=("M", "energy")):
     return integrate(RigidBodyProblem([1.0, 2.0, 3.0], [0.6, 0.8, 0.5]), "lie-poisson-4", t_end=1.0, dt=0.01,
                      samples=5, outputs=list(outputs))
 
@@ -36,7 +36,7 @@ def test_failed_write_leaves_the_existing_file_untouched_and_no_debris(tmp_path,
     write_results(_solution(("M",)), path)
     before = path.read_bytes()
 
-    def broken_savez(stream, **arrays):  # noqa: ANN001, ANN202
+    def broken_savez(stream, **arrays):
         stream.write(b"PK\x03\x04 half a file")
         raise OSError("disk full")
 
@@ -48,7 +48,7 @@ def test_failed_write_leaves_the_existing_file_untouched_and_no_debris(tmp_path,
 
 
 def test_interrupted_write_leaves_no_debris(tmp_path, monkeypatch):
-    def interrupted(stream, **arrays):  # noqa: ANN001, ANN202
+    def interrupted(stream, **arrays):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(np, "savez", interrupted)

@@ -12,7 +12,7 @@ RIGID = {"system": {"name": "rigid_body", "inertia": [1.0, 2.0, 3.0]}, "initial"
          "run": {"t_end": 1.0}}
 
 
-def _with(base: dict, **tables) -> dict:  # noqa: ANN003
+def _with(base: dict, **tables) -> dict:
     data = {k: dict(v) for k, v in base.items()}
     for key, value in tables.items():
         data[key] = {**data.get(key, {}), **value}

@@ -56,12 +56,12 @@ def toml_document(tables: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _timeout(signum, frame):  # noqa: ANN001, ANN202
+def _timeout(signum, frame):
     raise TimeoutError(f"a dirac command ran longer than {CLI_SECONDS} s (hang?)")
 
 
 @pytest.fixture
-def cli(run_cli):  # noqa: ANN001, ANN201
+def cli(run_cli):
     """``run_cli`` under an alarm."""
 
     def run(*argv: str) -> tuple[int, str, str]:
@@ -77,7 +77,7 @@ def cli(run_cli):  # noqa: ANN001, ANN201
 
 
 @pytest.fixture
-def run_scene(cli, tmp_path):  # noqa: ANN001, ANN201
+def run_scene(cli, tmp_path):
     """``dirac run`` of a scene text, written to ``scene.toml``, into a fresh ``out.npz``.
 
     Returns ``(status, stderr, out)``. Hypothesis reuses ``tmp_path`` across examples, so a
@@ -125,7 +125,7 @@ METHOD_NAMES = {"auto", "exact", "midpoint", "scipy-RK45", "scipy-DOP853"} | {
 
 
 @st.composite
-def left_handed_or_skewed_rotation(draw) -> list:  # noqa: ANN001
+def left_handed_or_skewed_rotation(draw) -> list:
     """A matrix that is not a proper rotation: a rotation with one column flipped, or skewed."""
     q = np.array(draw(st.lists(st.floats(-1, 1, allow_nan=False), min_size=4, max_size=4)))
     assume(np.linalg.norm(q) > 0.1)
@@ -142,7 +142,7 @@ def left_handed_or_skewed_rotation(draw) -> list:  # noqa: ANN001
 
 
 @st.composite
-def bad_scene(draw) -> dict:  # noqa: ANN001
+def bad_scene(draw) -> dict:
     """A good scene with exactly one thing wrong."""
     scene = good_scene()
     kind = draw(st.sampled_from([
@@ -182,7 +182,7 @@ def bad_scene(draw) -> dict:  # noqa: ANN001
 
 
 @st.composite
-def good_rigid_scene(draw) -> dict:  # noqa: ANN001
+def good_rigid_scene(draw) -> dict:
     inertia = draw(st.lists(st.floats(0.1, 10.0), min_size=3, max_size=3))
     M = draw(st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3))
     method = draw(st.sampled_from(["lie-poisson-2", "lie-poisson-4", "exact", "midpoint", "scipy-DOP853", "auto"]))
@@ -249,7 +249,7 @@ def test_unknown_keys_are_warned_about_by_name_and_the_run_goes_on(keys, table, 
 
 # ----------------------------------------------------------------------------- system files
 @st.composite
-def bad_system(draw) -> dict:  # noqa: ANN001
+def bad_system(draw) -> dict:
     system = {"name": "pendulum", "coordinates": ["x", "y"], "lagrangian": "m/2*(x_dot**2 + y_dot**2) - m*g*y",
               "constraints": ["x**2 + y**2 - l**2"], "parameters": {"m": 1.0, "g": 9.81, "l": 1.0}}
     kind = draw(st.sampled_from(["unknown_name", "non_holonomic", "syntax", "forbidden_call", "coordinates",

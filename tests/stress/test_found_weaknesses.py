@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from cli_output import one_error_line
 
 RIGID = """
@@ -30,7 +29,7 @@ t_end = {t_end}
 """
 
 
-def _scene(tmp_path, **fields) -> str:  # noqa: ANN001
+def _scene(tmp_path, **fields) -> str:
     values = {"inertia": "[1.0, 2.0, 3.0]", "M": "[1.0, 0.2, 0.1]", "t_end": "1.0", "extra": ""} | fields
     path = tmp_path / "scene.toml"
     path.write_text(RIGID.format(**values))

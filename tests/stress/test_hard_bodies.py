@@ -28,7 +28,7 @@ from dirac.errors import DiracWarning
 BODIES = {body.name: body for body in HARD_BODIES}
 
 
-def _exact_flow(body):  # noqa: ANN001, ANN202
+def _exact_flow(body):
     from dirac.rigidbody.exact import ExactRigidBodyFlow
 
     with warnings.catch_warnings():

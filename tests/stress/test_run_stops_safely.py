@@ -12,8 +12,8 @@ import re
 
 import numpy as np
 import pytest
-
 from cli_output import one_error_line
+
 from dirac.io.results import read_results
 
 RUNAWAY = """

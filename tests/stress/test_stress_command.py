@@ -41,7 +41,7 @@ def test_a_failed_row_makes_the_command_fail(tmp_path, run_cli, monkeypatch):
         long_runs=[("lie-poisson-2", 2_000, 0.05)], constrained=[], bodies=(), samples=11))
     real = stress.long_run
 
-    def strict(method, steps, dt, samples=1001):  # noqa: ANN001, ANN202
+    def strict(method, steps, dt, samples=1001):
         row = real(method, steps, dt, samples)
         row["passed"] = row["passed"] and row["energy_error_last_tenth"] == 0.0  # impossible
         return row

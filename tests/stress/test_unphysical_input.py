@@ -13,9 +13,9 @@ import warnings
 
 import numpy as np
 import pytest
+from cli_output import one_error_line
 
 import dirac
-from cli_output import one_error_line
 from dirac.errors import DiracWarning, InputError
 
 STANDARD_SCENE = """

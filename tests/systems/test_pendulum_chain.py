@@ -15,7 +15,6 @@ Dirac bracket is that of a particle on the circle: {x, p_x}_D = 1 - x^2/l^2,
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 import sympy
 

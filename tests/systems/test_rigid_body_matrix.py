@@ -12,11 +12,11 @@ import warnings
 import numpy as np
 import pytest
 import sympy
+from rigid_body_analyses import cached_analysis, eps, hat
 
 import dirac
 from dirac.errors import InputError
 from dirac_systems import rigid_body_matrix
-from rigid_body_analyses import cached_analysis, eps, hat
 
 I1, I2, I3 = (sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3))
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
@@ -101,7 +101,10 @@ def hand_chain(analysis) -> list[list[sympy.Expr]]:
     S = R.T * p * g_inv
     S = S + S.T  # (210)
     F = g_inv * lam + lam * g_inv - 2 * g_inv * p.T * p * g_inv  # (215)
-    pick = lambda A: [A[i - 1, j - 1] for i, j in PAIRS]  # noqa: E731
+
+    def pick(A):
+        return [A[i - 1, j - 1] for i, j in PAIRS]
+
     return [stage1, pick(T), pick(S), pick(F)]
 
 

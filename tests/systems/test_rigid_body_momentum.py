@@ -10,14 +10,14 @@ import warnings
 import numpy as np
 import pytest
 import sympy
+from rigid_body_analyses import cached_analysis, eps, hat
 
 import dirac
 from dirac.analysis.legendre import legendre_transform
 from dirac.errors import DiracWarning, InputError
 from dirac_systems import rigid_body_momentum
-from rigid_body_analyses import cached_analysis, eps, hat
 
-I = [sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3)]  # noqa: E741
+I = [sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3)]
 R = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}", real=True))
 R_DOT = sympy.Matrix(3, 3, lambda i, j: sympy.Symbol(f"R_{i + 1}{j + 1}_dot", real=True))
 

@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy
+from rigid_body_analyses import cached_analysis
 
 import dirac
 from dirac.errors import InputError
 from dirac_systems import rigid_body_particles
-from rigid_body_analyses import cached_analysis
 
 UNIT_TETRAHEDRON = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
 

@@ -61,7 +61,7 @@ def _stages(method: Method) -> int:
     return 1
 
 
-def _state(stepper) -> np.ndarray:  # noqa: ANN001
+def _state(stepper) -> np.ndarray:
     if hasattr(stepper, "analysed"):
         return stepper.z.ravel().copy()
     if hasattr(stepper, "q"):
@@ -72,15 +72,15 @@ def _state(stepper) -> np.ndarray:  # noqa: ANN001
     return np.concatenate(parts)
 
 
-def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) -> np.ndarray:  # noqa: ANN001
+def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) -> np.ndarray:
     stepper = get_method(method_name).start(problem, outputs, options)
     n = max(1, int(round(span / dt)))
     stepper.step(n, span / n)
     return _state(stepper)
 
 
-def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float,  # noqa: ANN001
-                  options) -> tuple[float, np.ndarray]:  # noqa: ANN001
+def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float,
+                  options) -> tuple[float, np.ndarray]:
     """``dt0`` halved until a pilot of 64 steps runs without a failed step: that step and
     the pilot's final state (the coarse run of the Richardson estimate).
 
@@ -97,12 +97,12 @@ def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float, 
     raise InputError(f"method auto: {method_name} fails even with dt = {dt:.3g}; choose a method and dt in [run]")
 
 
-def _frequency(problem) -> float:  # noqa: ANN001
+def _frequency(problem) -> float:
     M = np.asarray(problem.M0, dtype=float)
     return float(np.max(np.linalg.norm(M, axis=-1)) * np.max(1.0 / np.asarray(problem.inertia)) + 1e-300)
 
 
-def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: float, dt: float | None,  # noqa: ANN001
+def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: float, dt: float | None,
                   outputs: tuple[str, ...]) -> AutoChoice:
     """Choose method and step for ``problem`` (see the module docstring)."""
     options = {"t_end": t_end, "tolerance": tolerance, "newton_tolerance": 1e-12, "max_newton_iterations": 50}
@@ -146,7 +146,7 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
     return best
 
 
-def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, options) -> AutoChoice:  # noqa: ANN001
+def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, options) -> AutoChoice:
     with_R = needs_attitude(outputs)
     batch = problem.M0.shape[0]
     exact_cost = batch * samples * (EXACT_SAMPLE_US if with_R else EXACT_SAMPLE_M_US)

@@ -25,7 +25,7 @@ def newton_options(options: dict) -> tuple[float, int, np.ndarray]:
 class ConstrainedStepper(Stepper):
     """Common state ``(q, p)`` (batched) and outputs of steppers of constrained systems."""
 
-    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__()
         self.problem = problem
         self.mechanics = problem.mechanics

@@ -22,7 +22,7 @@ class ExactStepper(Stepper):
 
     kind = "exact"
 
-    def __init__(self, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
+    def __init__(self, problem, outputs: tuple[str, ...]) -> None:
         super().__init__()
         self.problem = problem
         self.outputs = outputs
@@ -50,7 +50,7 @@ class ExactStepper(Stepper):
         return {name: value.reshape((n, batch) + value.shape[1:]) for name, value in values.items()}
 
 
-def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _factory(method: Method, problem, outputs, options) -> Stepper:
     return ExactStepper(problem, outputs)
 
 

@@ -42,7 +42,7 @@ __all__ = ["HeavyTopSplittingStepper", "ExactKickStepper", "METHODS", "LIE_POISS
 class HeavyTopSplittingStepper(RigidBodyStepper):
     """Kick + Lie–Poisson free step, composed (numba loop)."""
 
-    def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
+    def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:
         super().__init__(problem, outputs)
         scheme = cast(CompositionScheme, method.data)
         self.gammas = np.asarray(scheme.coefficients, dtype=float)
@@ -63,7 +63,7 @@ class HeavyTopSplittingStepper(RigidBodyStepper):
 class ExactKickStepper(RigidBodyStepper):
     """Kick + exact free flow (Celledoni et al. 2008), composed; Python loop over stages."""
 
-    def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
+    def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:
         super().__init__(problem, outputs)
         self.gammas = np.asarray(cast(tuple[float, ...], method.data), dtype=float)
         self.w = np.asarray(problem.weight_vector, dtype=float)
@@ -92,12 +92,12 @@ class ExactKickStepper(RigidBodyStepper):
         self.evaluations += n_steps * 3 * len(self.gammas) * self.M.shape[0]
 
 
-def _splitting_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _splitting_factory(method: Method, problem, outputs, options) -> Stepper:
     """Stepper of a ``lie-poisson-*`` method on a :class:`HeavyTopProblem`."""
     return HeavyTopSplittingStepper(method, problem, outputs)
 
 
-def _exact_kick_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _exact_kick_factory(method: Method, problem, outputs, options) -> Stepper:
     return ExactKickStepper(method, problem, outputs)
 
 

@@ -29,7 +29,7 @@ BATCH_THRESHOLD = 2
 class LiePoissonStepper(RigidBodyStepper):
     """Composed Lie–Poisson splitting (McLachlan 1993; Reich 1994; Touma & Wisdom 1994)."""
 
-    def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:  # noqa: ANN001
+    def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:
         super().__init__(problem, outputs)
         scheme = cast(splitting.CompositionScheme, method.data)
         self._axes, self._rates, self._fractions, self._casimir_rate = splitting.build_sequence(
@@ -63,7 +63,7 @@ class LiePoissonStepper(RigidBodyStepper):
         self.evaluations += n_steps * self._stages * self.M.shape[0]
 
 
-def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _factory(method: Method, problem, outputs, options) -> Stepper:
     return LiePoissonStepper(method, problem, outputs)
 
 

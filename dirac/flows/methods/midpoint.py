@@ -44,7 +44,7 @@ def _raise_if_failed(info: np.ndarray, max_iter: int) -> None:
 class RigidBodyMidpointStepper(RigidBodyStepper):
     """Implicit midpoint on the Euler–Poisson equations."""
 
-    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__(problem, outputs)
         self.tol, self.max_iter, self.info = newton_options(options)
 
@@ -64,7 +64,7 @@ class RigidBodyMidpointStepper(RigidBodyStepper):
 class ConstrainedMidpointStepper(ConstrainedStepper):
     """Implicit midpoint on the Dirac vector field of a general system."""
 
-    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__(problem, outputs, options)
         for q in self.q:
             self.mechanics.mass_matrix(q)
@@ -93,7 +93,7 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
 class AnalysedMidpointStepper(Stepper):
     """Implicit midpoint on the Dirac vector field of an analysed system (full phase space)."""
 
-    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+    def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__()
         self.problem = problem
         self.analysed = problem.analysed
@@ -129,15 +129,15 @@ class AnalysedMidpointStepper(Stepper):
         return max(self.analysed.constraint_residual(z) for z in self.z)
 
 
-def _rigid_body_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _rigid_body_factory(method: Method, problem, outputs, options) -> Stepper:
     return RigidBodyMidpointStepper(problem, outputs, options)
 
 
-def _constrained_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _constrained_factory(method: Method, problem, outputs, options) -> Stepper:
     return ConstrainedMidpointStepper(problem, outputs, options)
 
 
-def _analysed_factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _analysed_factory(method: Method, problem, outputs, options) -> Stepper:
     return AnalysedMidpointStepper(problem, outputs, options)
 
 

@@ -32,7 +32,7 @@ __all__ = ["RattleStepper", "METHODS"]
 class RattleStepper(ConstrainedStepper):
     """RATTLE composed with the coefficients of ``method.data`` (fractions of a step)."""
 
-    def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+    def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__(problem, outputs, options)
         self.name = method.name
         self.fractions = np.asarray(cast(tuple[float, ...], method.data), dtype=float)
@@ -69,7 +69,7 @@ class RattleStepper(ConstrainedStepper):
         self.steps += n_steps
 
 
-def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _factory(method: Method, problem, outputs, options) -> Stepper:
     return RattleStepper(method, problem, outputs, options)
 
 

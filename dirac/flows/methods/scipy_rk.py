@@ -25,7 +25,7 @@ class ScipyStepper(Stepper):
 
     kind = "adaptive"
 
-    def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:  # noqa: ANN001
+    def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__()
         self.method = method
         self.problem = problem
@@ -56,7 +56,7 @@ class ScipyStepper(Stepper):
         solver_class = {"scipy-RK45": integrate.RK45, "scipy-DOP853": integrate.DOP853}[self.method.name]
         args = self._args
 
-        def fun(t, y):  # noqa: ANN001, ANN202
+        def fun(t, y):
             return self._fun(t, y, *args)
 
         return [
@@ -109,12 +109,12 @@ class ScipyStepper(Stepper):
         return 0.0  # RK methods do not preserve R^T R = 1; that is what the baseline shows
 
 
-def _rigid_body_rhs(problem, with_R: bool):  # noqa: ANN001, ANN202
+def _rigid_body_rhs(problem, with_R: bool):
     i1, i2, i3 = (float(x) for x in problem.inertia)
     if problem.kind == "heavy_top":
         w = problem.weight_vector
 
-        def heavy(t, y, i1, i2, i3):  # noqa: ANN001, ANN202
+        def heavy(t, y, i1, i2, i3):
             dy = lean_rhs_full(t, y, i1, i2, i3)
             g0, g1, g2 = y[9], y[10], y[11]  # gamma = R^T e_z = third row of R
             dy[0] += g1 * w[2] - g2 * w[1]
@@ -126,7 +126,7 @@ def _rigid_body_rhs(problem, with_R: bool):  # noqa: ANN001, ANN202
     return (lean_rhs_full if with_R else lean_rhs_M), (i1, i2, i3)
 
 
-def _factory(method: Method, problem, outputs, options) -> Stepper:  # noqa: ANN001
+def _factory(method: Method, problem, outputs, options) -> Stepper:
     return ScipyStepper(method, problem, outputs, options)
 
 
