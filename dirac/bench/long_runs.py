@@ -56,11 +56,11 @@ def long_run(method: str, steps: int, dt: float, samples: int = 1001) -> dict:
 
 
 def _constrained_problem(system: str):
-    import dirac
     from dirac.flows.mechanics import MechanicalSystem
     from dirac.flows.problems import ConstrainedProblem
+    from dirac.model.systems import load_system
 
-    mechanics = MechanicalSystem.from_lagrangian(dirac.load_system(system))
+    mechanics = MechanicalSystem.from_lagrangian(load_system(system))
     if system == "pendulum":
         q = np.array([math.sin(1.0), -math.cos(1.0)])
     elif system == "double_pendulum":

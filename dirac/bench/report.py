@@ -8,6 +8,8 @@ import os
 import platform
 from pathlib import Path
 
+from dirac.versions import installed_versions
+
 __all__ = ["machine_description", "format_rows", "format_targets", "write_json", "write_plot"]
 
 
@@ -23,14 +25,7 @@ def _cpu_model() -> str:
 
 def machine_description() -> dict:
     """CPU model, logical CPUs, OS, load average and library versions."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    versions = {}
-    for package in ("numpy", "scipy", "numba", "dirac-mechanics"):
-        try:
-            versions[package] = version(package)
-        except PackageNotFoundError:
-            versions[package] = "not installed"
+    versions = installed_versions(("numpy", "scipy", "numba", "dirac-mechanics"), missing="not installed", python=False)
     try:
         load = os.getloadavg()
     except OSError:

@@ -9,13 +9,13 @@ chunks and members complete, the done ranges, the failed chunks and the CPU time
 
 from __future__ import annotations
 
-import platform
 import time
 import uuid
 
 from dirac.ensemble.chunk_plan import chunk_bounds
 from dirac.ensemble.scene import EnsembleScene
 from dirac.ensemble.store import FORMAT, EnsembleStore, array_layout
+from dirac.versions import installed_versions
 
 __all__ = ["RunRecord", "new_meta"]
 
@@ -32,15 +32,7 @@ def _ranges(indices: list[int]) -> list[list[int]]:
 
 
 def _versions() -> dict[str, str]:
-    from importlib.metadata import PackageNotFoundError, version
-
-    found = {"python": platform.python_version()}
-    for name in ("dirac-mechanics", "numpy", "numba", "zarr", "dask", "distributed"):
-        try:
-            found[name] = version(name)
-        except PackageNotFoundError:
-            pass
-    return found
+    return installed_versions(("dirac-mechanics", "numpy", "numba", "zarr", "dask", "distributed"), missing=None)
 
 
 def new_meta(scene: EnsembleScene, chunk_size: int, n_chunks: int) -> dict:

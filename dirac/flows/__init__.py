@@ -1,12 +1,13 @@
-"""Numerical flows: problems, methods, the one ``integrate`` loop, solutions, scenes and
-result files.
+"""Numerical flows: problems, methods, the one ``integrate`` loop and its solutions.
+
+Scene and result files are read and written by :mod:`dirac.io` (``dirac.load_scene``,
+``dirac.write_results``, ``dirac.read_results``), which builds on this package.
 
 Public names (imported on first use, so ``import dirac.flows`` stays cheap):
 :func:`integrate`, :class:`Solution`, :class:`RigidBodyProblem`, :class:`HeavyTopProblem`,
 :class:`ConstrainedProblem`, :class:`MechanicalSystem`, :class:`AnalysedSystem`,
-:class:`AnalysedProblem`, :class:`Problem` (what they have in common), :func:`load_scene`, :func:`scene_from_dict`,
-:func:`write_results`, :func:`read_results`, :func:`get_method`, :func:`method_names`,
-:data:`METHODS`.
+:class:`AnalysedProblem`, :class:`Problem` (what they have in common), :func:`get_method`,
+:func:`method_names`, :data:`METHODS`.
 """
 
 from __future__ import annotations
@@ -24,10 +25,6 @@ _LAZY = {
     "MechanicalSystem": "dirac.flows.mechanics",
     "AnalysedSystem": "dirac.flows.analysed",
     "AnalysedProblem": "dirac.flows.analysed",
-    "load_scene": "dirac.io.scene",
-    "scene_from_dict": "dirac.io.scene",
-    "write_results": "dirac.io.results",
-    "read_results": "dirac.io.results",
     "get_method": "dirac.flows.methods.registry",
     "method_names": "dirac.flows.methods.registry",
     "METHODS": "dirac.flows.methods.registry",

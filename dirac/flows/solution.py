@@ -66,7 +66,7 @@ class Solution:
 
     def meta(self) -> dict[str, object]:
         """The ``meta`` record of the result file (docs/file_formats.md)."""
-        from dirac.io.results import versions
+        from dirac.versions import result_versions
 
         record: dict[str, object] = {
             "system": self.system,
@@ -80,7 +80,7 @@ class Solution:
             "complete": self.complete,
             "samples": int(self.t.shape[0]),
             "outputs": list(self.outputs),
-            "versions": versions(),
+            "versions": result_versions(),
         }
         if self.message:
             record["message"] = self.message

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import platform
 import tempfile
 from pathlib import Path
 from typing import Any, Protocol
@@ -19,21 +18,7 @@ import numpy as np
 
 from dirac.errors import InputError
 
-__all__ = ["write_results", "read_results", "versions"]
-
-
-def versions() -> dict[str, str]:
-    """Versions of dirac, Python and the numerical libraries (for ``meta``)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    result = {"python": platform.python_version()}
-    for distribution, key in (("dirac-mechanics", "dirac"), ("numpy", "numpy"), ("scipy", "scipy"),
-                              ("numba", "numba"), ("sympy", "sympy")):
-        try:
-            result[key] = version(distribution)
-        except PackageNotFoundError:
-            result[key] = "unknown"
-    return result
+__all__ = ["write_results", "read_results"]
 
 
 class RunResult(Protocol):

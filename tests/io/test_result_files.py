@@ -8,7 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from dirac.flows import RigidBodyProblem, integrate, read_results, write_results
+from dirac.flows import RigidBodyProblem, integrate
+from dirac.io.results import read_results, write_results
 
 
 def _solution(outputs=("M", "energy")):
