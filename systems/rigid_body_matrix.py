@@ -62,7 +62,7 @@ def rotation_symbols() -> tuple[sympy.Matrix, sympy.Matrix]:
 
 def inertia_symbols() -> tuple[sympy.Symbol, sympy.Symbol, sympy.Symbol]:
     """The parameters ``I_1, I_2, I_3`` (principal moments of inertia, positive)."""
-    return tuple(sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3))  # type: ignore[return-value]
+    return tuple(sympy.Symbol(f"I_{k}", positive=True) for k in (1, 2, 3))
 
 
 def mass_matrix_from_inertia(I_1, I_2, I_3):
@@ -134,7 +134,7 @@ def check_inertia(I_1: float, I_2: float, I_3: float) -> tuple[float, float, flo
                 f"the Lagrangian needs a positive mass matrix; choose moments with "
                 f"I_{i} + I_{j} > I_{k} (triangle inequality)"
             )
-    return g  # type: ignore[return-value]
+    return g
 
 
 def _validate_fixed_inertia(values: Mapping[str, float]) -> None:

@@ -20,7 +20,8 @@ import sympy
 
 from dirac.errors import InputError, warn
 from dirac.model.lagrangian import Lagrangian
-from dirac_systems.rigid_body_matrix import (
+
+from .rigid_body_matrix import (
     DEFAULT_INERTIA,
     _hat,
     inertia_symbols,
