@@ -12,7 +12,7 @@ not disturbed by binary round-off.
 from __future__ import annotations
 
 import ast
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import sympy
 
@@ -21,7 +21,7 @@ from dirac.errors import InputError
 __all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS"]
 
 #: function name -> sympy function; the only calls an expression may make
-ALLOWED_FUNCTIONS: dict[str, object] = {
+ALLOWED_FUNCTIONS: dict[str, Callable[..., sympy.Expr]] = {
     "sin": sympy.sin,
     "cos": sympy.cos,
     "tan": sympy.tan,
@@ -152,5 +152,5 @@ class _Converter:
             expected = 2 if node.func.id == "atan2" else 1
             if len(args) != expected:
                 raise self.fail(f"{node.func.id} takes {expected} argument(s), got {len(args)}")
-            return ALLOWED_FUNCTIONS[node.func.id](*args)  # type: ignore[operator]
+            return ALLOWED_FUNCTIONS[node.func.id](*args)
         raise self.fail(f"{ast.unparse(node)!r} is not allowed in an expression")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from importlib.metadata import entry_points
+from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 
 from dirac.errors import InputError
@@ -21,7 +21,7 @@ __all__ = ["load_system", "builtin_systems", "ENTRY_POINT_GROUP"]
 ENTRY_POINT_GROUP = "dirac.systems"
 
 
-def _entry_points() -> dict[str, object]:
+def _entry_points() -> dict[str, EntryPoint]:
     return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
 
 
@@ -29,7 +29,7 @@ def builtin_systems() -> dict[str, str]:
     """Built-in system name -> one-line description (first docstring line of its factory)."""
     result: dict[str, str] = {}
     for name, ep in sorted(_entry_points().items()):
-        factory = ep.load()  # type: ignore[attr-defined]
+        factory = ep.load()
         doc = inspect.getdoc(factory) or ""
         result[name] = doc.splitlines()[0] if doc else ""
     return result
@@ -42,7 +42,7 @@ def _factory(name: str) -> Callable[..., Lagrangian]:
         raise InputError(
             f"unknown system {name!r}: give a built-in name ({known}) or a path to a .toml or .py system file"
         )
-    return eps[name].load()  # type: ignore[attr-defined]
+    return eps[name].load()
 
 
 def load_system(name_or_path: str | Path, **options: object) -> Lagrangian:
@@ -78,4 +78,4 @@ def load_system(name_or_path: str | Path, **options: object) -> Lagrangian:
         lagrangian = factory(**factory_options)
         if not isinstance(lagrangian, Lagrangian):
             raise TypeError(f"built-in system {text!r} returned {type(lagrangian).__name__}, not a Lagrangian")
-    return lagrangian.fix(**fixed) if fixed else lagrangian  # type: ignore[arg-type]
+    return lagrangian.fix(**fixed) if fixed else lagrangian  # type: ignore[arg-type]  # user options; fix() raises InputError for a non-number
