@@ -71,7 +71,7 @@ class Fixed(Distribution):
     name = "fixed"
 
     @property
-    def shape(self) -> tuple[int, ...]:  # type: ignore[override]
+    def shape(self) -> tuple[int, ...]:  # type: ignore[override]  # a read-only property for the base class attribute: the shape follows value
         return tuple(self.value.shape)
 
     def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:

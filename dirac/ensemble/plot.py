@@ -19,10 +19,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from dirac.errors import InputError, warn
+
+if TYPE_CHECKING:
+    import zarr
 
 __all__ = ["unstable_coordinate", "predicted_flip_time", "plot_flip_times"]
 
@@ -56,6 +60,16 @@ def predicted_flip_time(M0: np.ndarray, inertia: np.ndarray) -> np.ndarray:
     return np.log(c / np.abs(unstable_coordinate(M0, inertia))) / lam
 
 
+def _read_array(group: zarr.Group, name: str) -> np.ndarray:
+    """The whole array ``name`` of the results group ``data.zarr``, read into memory."""
+    import zarr
+
+    array = group[name]
+    if not isinstance(array, zarr.Array):
+        raise InputError(f"{name} in the ensemble results is a zarr group, not an array")
+    return np.asarray(array[:])
+
+
 def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
     """Draw the flip-time figure of the ensemble in ``out`` into ``image``.
 
@@ -80,12 +94,12 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
         warn(f"{out}: the ensemble is not complete ({meta.get('chunks_complete')} of {meta.get('chunks_total')} chunks); plotting the finished members")
     if "flip_time" not in group:
         raise InputError(f"{out} has no flip_time array; add \"flip_time\" to [ensemble] reductions and rerun")
-    flip = group["flip_time"][:]
+    flip = _read_array(group, "flip_time")
     t_end = float(meta["scene"]["t_end"])
     summary = {"members": int(flip.size), "flipped": int(np.isfinite(flip).sum()), "median": float(np.nanmedian(flip))}
-    inertia = group["inertia"][:] if "inertia" in group else None
-    shared = inertia is not None and np.all(inertia == inertia[0])
-    panels = 2 if shared else 1
+    inertia = _read_array(group, "inertia") if "inertia" in group else None
+    shared_inertia = inertia[0] if inertia is not None and np.all(inertia == inertia[0]) else None
+    panels = 2 if shared_inertia is not None else 1
     fig, axes = plt.subplots(1, panels, figsize=(5.2 * panels, 4.0), squeeze=False)
     ax = axes[0, 0]
     if not np.isfinite(flip).any():
@@ -94,9 +108,9 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
     ax.set_xlabel("time of the first flip of the intermediate axis")
     ax.set_ylabel("members")
     ax.set_title(f"{summary['flipped']} of {summary['members']} members flip by t = {t_end:g}")
-    if shared:
-        M0 = group["initial_M"][:]
-        predicted = predicted_flip_time(M0, inertia[0])
+    if shared_inertia is not None:
+        M0 = _read_array(group, "initial_M")
+        predicted = predicted_flip_time(M0, shared_inertia)
         ok = np.isfinite(flip)
         summary["max_deviation"] = float(np.max(np.abs(flip[ok] - predicted[ok])))
         ax = axes[0, 1]

@@ -42,13 +42,14 @@ def casimir_of(M: np.ndarray) -> np.ndarray:
 
 def reduction_arrays(name: str) -> dict[str, tuple[int, ...]]:
     """The arrays a reduction stores: array name -> shape of one member's entry."""
-    return {
+    layouts: dict[str, dict[str, tuple[int, ...]]] = {
         "flip_time": {"flip_time": ()},
         "max_energy_error": {"max_energy_error": ()},
         "max_casimir_error": {"max_casimir_error": ()},
         "final_state": {"final_M": (3,), "final_R": (3, 3)},
         "initial_state": {"initial_M": (3,), "initial_R": (3, 3), "inertia": (3,)},
-    }[name]
+    }
+    return layouts[name]
 
 
 class Reduction:
@@ -59,7 +60,7 @@ class Reduction:
         """Called with the chunk's initial state (``t = 0``)."""
         raise NotImplementedError  # pragma: no cover - abstract
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray) -> None:
         """Called after the members were advanced from ``t_prev`` to ``t``."""
 
     def result(self) -> dict[str, np.ndarray]:
@@ -84,7 +85,7 @@ class FlipTime(Reduction):
         self.prev = self.a0.copy()
         self.time = np.full(n, np.nan)
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray) -> None:
         a = M[self.rows, self.cols]
         new = np.isnan(self.time) & (a * self.a0 < 0.0)
         if np.any(new):
@@ -113,7 +114,7 @@ class MaxRelativeError(Reduction):
         self.scale = np.where(self.f0 != 0.0, np.abs(self.f0), 1.0)
         self.error = np.zeros(M.shape[0])
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray) -> None:
         np.maximum(self.error, np.abs(self._value(M) - self.f0) / self.scale, out=self.error)
 
     def result(self) -> dict[str, np.ndarray]:
@@ -126,7 +127,7 @@ class FinalState(Reduction):
     def start(self, M: np.ndarray, R: np.ndarray, inertia: np.ndarray) -> None:
         self.M, self.R = M, R
 
-    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray | None) -> None:
+    def update(self, t_prev: float, t: float, M: np.ndarray, R: np.ndarray) -> None:
         self.M, self.R = M, R
 
     def result(self) -> dict[str, np.ndarray]:
