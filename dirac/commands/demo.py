@@ -35,6 +35,7 @@ def main(args: argparse.Namespace) -> int:
     import numpy as np
 
     from dirac.flows.integration import integrate
+    from dirac.flows.problems import RigidBodyProblem
     from dirac.io.scene import FLAGSHIP_SCENE, scene_from_dict
 
     plot_path = None
@@ -52,7 +53,10 @@ def main(args: argparse.Namespace) -> int:
     run["dt"] = args.dt if args.dt is not None else 0.01
     scene = scene_from_dict(data, source="flagship scene")
     progress = (not args.no_progress) and sys.stderr.isatty()
-    solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]
+    problem = scene.problem
+    assert isinstance(problem, RigidBodyProblem)  # the flagship scene is the free rigid body
+    # the scene parser checked the type of each [run] option; Scene.run keeps them as objects
+    solution = integrate(problem, progress=progress, **scene.run)  # type: ignore[arg-type]
     if args.out:
         from dirac.io.results import write_results
 
@@ -62,7 +66,7 @@ def main(args: argparse.Namespace) -> int:
     casimir = solution["casimir"]
     lab = solution["lab_momentum"]
     orthogonality = np.max(np.abs(np.einsum("nki,nkj->nij", R, R) - np.eye(3)))
-    inertia = scene.problem.inertia  # type: ignore[attr-defined]
+    inertia = problem.inertia
     choice = solution.extra.get("auto", {})
     print("dirac demo: free asymmetric rigid body (the standard test case of Hairer, Lubich & Wanner)")
     print(f"  inertia        I = ({', '.join(f'{x:.6g}' for x in inertia)})")
@@ -70,8 +74,8 @@ def main(args: argparse.Namespace) -> int:
     method_line = f"  method         {solution.method} (order {solution.order})"
     if solution.dt:
         method_line += f", dt = {solution.dt:.6g}"
-    if choice:
-        method_line += f"  [auto: {choice.get('reason', '')}]"  # type: ignore[union-attr]
+    if isinstance(choice, dict) and choice:  # the "auto" method's record of its choice
+        method_line += f"  [auto: {choice.get('reason', '')}]"
     print(method_line)
     print(f"  time span      t = 0 .. {solution.t[-1]:g}, {len(solution.t)} samples")
     print(f"  steps          {solution.steps} ({solution.evaluations} evaluations)")

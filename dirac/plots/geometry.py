@@ -11,7 +11,10 @@ level ``e = 1 / I_mid`` of the middle moment is the separatrix through the unsta
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = [
     "sphere_mesh",
@@ -70,7 +73,7 @@ def polhode_levels(inertia: np.ndarray, count: int = 9) -> tuple[np.ndarray, flo
 
 
 def level_curves_on_sphere(
-    inertia: np.ndarray, levels: np.ndarray, radius: float = 1.0, resolution: int = 181
+    inertia: np.ndarray, levels: ArrayLike, radius: float = 1.0, resolution: int = 181
 ) -> list[list[np.ndarray]]:
     """Level curves of ``e(n) = sum_i n_i^2 / I_i`` on a sphere, one list of polylines per level.
 
@@ -101,7 +104,8 @@ def level_curves_on_sphere(
     curves: list[list[np.ndarray]] = []
     for level in np.atleast_1d(np.asarray(levels, dtype=float)):
         polylines = []
-        for line in generator.lines(float(level)):
+        # line_type="Separate": the lines are a list of (k, 2) point arrays, one per polyline
+        for line in cast("list[np.ndarray]", generator.lines(float(level))):
             p, t = line[:, 0], line[:, 1]
             xyz = radius * np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
             polylines.append(xyz)
