@@ -16,6 +16,7 @@ import argparse
 import importlib
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from dirac.errors import DiracError, install_warning_printer
 
@@ -33,7 +34,7 @@ COMMANDS: dict[str, str] = {
 class _ErrorExitParser(argparse.ArgumentParser):
     """argparse with the project's error format: one ``error:`` line, exit status 2."""
 
-    def error(self, message: str) -> None:  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         print(f"error: {message} (see '{self.prog} --help')", file=sys.stderr)
         raise SystemExit(2)
 

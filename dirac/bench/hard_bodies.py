@@ -26,7 +26,12 @@ __all__ = ["HardBody", "HARD_BODIES", "HARD_BODY_METHODS", "exact_tolerance", "h
 
 def _unit(v: Sequence[float]) -> tuple[float, float, float]:
     x = np.asarray(v, dtype=float)
-    return tuple(float(c) for c in x / np.linalg.norm(x))  # type: ignore[return-value]
+    a, b, c = x / np.linalg.norm(x)
+    return float(a), float(b), float(c)
+
+
+def _scaled(factor: float, v: tuple[float, float, float]) -> tuple[float, float, float]:
+    return factor * v[0], factor * v[1], factor * v[2]
 
 
 @dataclass(frozen=True)
@@ -68,7 +73,7 @@ HARD_BODIES: tuple[HardBody, ...] = (
     HardBody("near-symmetric", (1.0 + 1e-9, 1.0, 0.5), _GENERIC, "I_1 = I_2 (1 + 1e-9): modulus m ~ 1e-9"),
     HardBody("needle", (1e-4, 1.0, 1.0), _GENERIC, "I = (1e-4, 1, 1): spin 6000 times faster than the tumbling"),
     HardBody("flat", (1.0, 2.0, 3.0), _GENERIC, "I_3 = I_1 + I_2: the plane-body limit"),
-    HardBody("fast spin", STANDARD_INERTIA, tuple(1e3 * c for c in _unit([1e-3, 2e-3, 1.0])),  # type: ignore[arg-type]
+    HardBody("fast spin", STANDARD_INERTIA, _scaled(1e3, _unit([1e-3, 2e-3, 1.0])),
              "|M| = 1000 nearly along the axis of smallest moment (I_3 = 2/3)"),
 )
 

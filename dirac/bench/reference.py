@@ -31,11 +31,14 @@ import json
 import math
 import os
 import tempfile
+from collections.abc import Iterable, Sequence
 from fractions import Fraction
 from operator import mul
 from pathlib import Path
+from typing import SupportsFloat
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = [
     "FRACTION_BITS",
@@ -73,7 +76,11 @@ def _fixed(x: float | Fraction) -> int:
     return (f.numerator * _ONE * 2 + f.denominator) // (2 * f.denominator)
 
 
-def _exact(x: object) -> Fraction:
+# an input taken exactly: a float (or anything float() takes), a Fraction, or a string of decimal digits
+_ExactInput = SupportsFloat | Fraction | str
+
+
+def _exact(x: _ExactInput) -> Fraction:
     """An exact rational: floats exactly, strings as exact decimals, Fractions as they are."""
     if isinstance(x, (Fraction, str)):
         return Fraction(x)
@@ -114,7 +121,8 @@ def _taylor_step(y: list[int], a: list[int], order: int) -> list[list[int]]:
 
 
 def taylor_rigid_body(
-    inertia: np.ndarray, M0: np.ndarray, R0: np.ndarray, times: list[float], order: int = 30, tol: float = 1e-28
+    inertia: Iterable[_ExactInput], M0: Iterable[_ExactInput], R0: Iterable[Iterable[_ExactInput]],
+    times: list[float], order: int = 30, tol: float = 1e-28,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Integrate (250)–(251) by fixed-point Taylor series and return ``M``, ``R`` at ``times``.
 
@@ -141,8 +149,8 @@ def taylor_rigid_body(
     y = [_fixed(_exact(v)) for v in M0] + [_fixed(_exact(v)) for row in R0 for v in row]
     t = Fraction(0)
     M_out, R_out = [], []
-    for target in times:
-        target = Fraction(float(target))
+    for time_point in times:
+        target = Fraction(float(time_point))
         while t < target:
             coeffs = _taylor_step(y, a, order)
             # the last two terms set h; coefficients that fall below the fixed-point grid
@@ -188,14 +196,15 @@ def _cached(kind: str, key: dict, compute) -> dict:
     return value
 
 
-def rigid_body_reference(inertia: np.ndarray, M0: np.ndarray, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+def rigid_body_reference(inertia: ArrayLike, M0: ArrayLike, t_end: float) -> tuple[np.ndarray, np.ndarray]:
     """``M(t_end)``, ``R(t_end)`` of the body with ``R(0) = 1`` (cached Taylor reference)."""
-    inertia = [float(v) for v in np.asarray(inertia, dtype=float)]
-    M0 = [float(v) for v in np.asarray(M0, dtype=float)]
-    key = {"inertia": [v.hex() for v in inertia], "M0": [v.hex() for v in M0], "t_end": float(t_end).hex()}
+    inertia_values = [float(v) for v in np.asarray(inertia, dtype=float)]
+    M0_values = [float(v) for v in np.asarray(M0, dtype=float)]
+    key = {"inertia": [v.hex() for v in inertia_values], "M0": [v.hex() for v in M0_values],
+           "t_end": float(t_end).hex()}
 
     def compute() -> dict:
-        M, R = taylor_rigid_body(inertia, M0, np.eye(3), [float(t_end)])
+        M, R = taylor_rigid_body(inertia_values, M0_values, np.eye(3), [float(t_end)])
         return {"M": M[0].tolist(), "R": R[0].tolist()}
 
     value = _cached("rigid_body", key, compute)
@@ -236,9 +245,11 @@ def _double_pendulum_angles_rhs(t: float, y: np.ndarray, m1: float, m2: float, l
 
 
 def double_pendulum_reference(
-    angles: tuple[float, float], rates: tuple[float, float], t_end: float, params: dict[str, float]
+    angles: Sequence[float], rates: Sequence[float], t_end: float, params: dict[str, float]
 ) -> tuple[np.ndarray, float]:
     """Cartesian positions ``(x1, y1, x2, y2)`` at ``t_end`` and an estimate of their error.
+
+    ``angles`` and ``rates`` are the two initial angles and angular velocities.
 
     Integrates the angle equations with DOP853 at ``rtol = 1e-13`` (and ``1e-12`` for the
     error estimate); ``y`` points up, the angles are measured from the downward vertical.

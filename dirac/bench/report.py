@@ -188,6 +188,7 @@ def format_markdown(document: dict, problems: list[str] | None = None) -> str:
         if not subset:
             continue
         rigid = any("error_M" in r for r in subset)
+        keys: tuple[str, ...]
         lines.append(f"\n#### {problem} (T = {subset[0]['t_end']:.6g})\n")
         if rigid:
             lines.append("| method | dt / tol | CPU ms | steps | f-evals | err M | err R | energy | \\|M\\|² | \\|RᵀR−1\\| |")

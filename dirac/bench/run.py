@@ -6,6 +6,10 @@ import sys
 import time
 import warnings
 from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from dirac.bench.targets import Target
 
 __all__ = ["run_benchmark"]
 
@@ -54,13 +58,14 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         warnings.simplefilter("ignore")  # e.g. the standard body's inertia warning, once per run
         for case in rigid_body_cases(quick):
             rows += run_rigid_body_case(case, repeats, say)
-        for case in constrained_cases(quick):
+        for constrained in constrained_cases(quick):
             try:
-                rows += run_constrained_case(case, repeats, say)
+                rows += run_constrained_case(constrained, repeats, say)
             except Exception as exc:  # a system that cannot be built is reported, not fatal
-                rows.append({"problem": case.name, "method": "-", "parameter": "", "value": None, "t_end": 0.0,
+                rows.append({"problem": constrained.name, "method": "-", "parameter": "", "value": None, "t_end": 0.0,
                              "failed": f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}"})
-    measured, notes = ([], [])
+    measured: list[Target] = []
+    notes: list[str] = []
     if targets:
         from dirac.bench.targets import measure_targets
 

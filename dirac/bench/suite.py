@@ -113,7 +113,7 @@ def rigid_body_cases(quick: bool) -> list[RigidBodyCase]:
             "separatrix",
             "I = (1, 2, 3), M(0) = (1e-3, 1, 1e-3)/|.| (near the separatrix), T = 100",
             (1.0, 2.0, 3.0),
-            tuple(float(v) for v in near),
+            (float(near[0]), float(near[1]), float(near[2])),
             100.0,
             grids,
         ),
@@ -123,6 +123,8 @@ def rigid_body_cases(quick: bool) -> list[RigidBodyCase]:
 
 def constrained_cases(quick: bool) -> list[ConstrainedCase]:
     """The pendulum (10 periods) and the double pendulum (``T = 10``)."""
+    pendulum_grids: tuple[MethodGrid, ...]
+    double_grids: tuple[MethodGrid, ...]
     if quick:
         # no scipy baseline here: its first use compiles the Dirac vector field of each
         # system, too slow for a first --quick run on a fresh install (the full run has it)

@@ -189,11 +189,12 @@ def splitting_skip_target(repeats: int, n_steps: int) -> Target:
 
         run(["M"])
         run(["M", "R"])
-        both, only = [], []
+        both_runs: list[float] = []
+        only_runs: list[float] = []
         for _ in range(repeats):  # interleaved, so slow drifts of the machine hit both alike
-            both.append(run(["M", "R"]))
-            only.append(run(["M"]))
-        both, only = median_of(both), median_of(only)
+            both_runs.append(run(["M", "R"]))
+            only_runs.append(run(["M"]))
+        both, only = median_of(both_runs), median_of(only_runs)
     finally:
         quiet.__exit__(None, None, None)
     return Target("skipping: lie-poisson-2, M only vs M and R", both / only, "x", 1.1, ">=",
@@ -368,22 +369,28 @@ def startup_targets(repeats: int, cold: bool) -> list[Target]:
     return targets
 
 
+# what one measurement returns: a target or several, optionally with a note for the report
+_Measured = Target | list[Target] | tuple[Target, str] | tuple[list[Target], str]
+
+
 def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], None]) -> tuple[list[Target], list[str]]:
     """Every performance target of docs/performance.md (smaller sizes in ``quick`` mode, scaled where said)."""
     notes: list[str] = []
     targets: list[Target] = []
     repeats = 5 if quick else 9
 
-    def attempt(label: str, function: Callable[[], object]) -> None:
+    def attempt(label: str, function: Callable[[], _Measured]) -> None:
         progress(label)
         try:
-            result = function()
+            outcome = function()
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"{label}: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
             return
-        if isinstance(result, tuple):
-            result, note = result
+        if isinstance(outcome, tuple):
+            result, note = outcome
             notes.append(note)
+        else:
+            result = outcome
         targets.extend(result if isinstance(result, list) else [result])
 
     attempt("kernel against the C reference", lambda: kernel_against_c(repeats, 100_000 if quick else 1_000_000))

@@ -12,9 +12,11 @@ import statistics
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar, overload
 
 __all__ = ["Timing", "time_call", "median_of"]
+
+_Input = TypeVar("_Input")
 
 
 @dataclass(frozen=True)
@@ -34,7 +36,17 @@ def median_of(values: list[float]) -> float:
     return float(statistics.median(values))
 
 
+@overload
 def time_call(function: Callable[[], Any], repeats: int, warm_up: bool = True,
+              setup: None = None) -> Timing: ...
+
+
+@overload
+def time_call(function: Callable[[_Input], Any], repeats: int, warm_up: bool = True, *,
+              setup: Callable[[], _Input]) -> Timing: ...
+
+
+def time_call(function: Callable[..., Any], repeats: int, warm_up: bool = True,
               setup: Callable[[], Any] | None = None) -> Timing:
     """Time ``function()`` ``repeats`` times after one untimed warm-up call.
 

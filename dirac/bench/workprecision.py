@@ -21,6 +21,7 @@ import numpy as np
 
 from dirac.bench.suite import ConstrainedCase, MethodGrid, RigidBodyCase
 from dirac.bench.timing import median_of
+from dirac.errors import InputError
 
 __all__ = ["run_rigid_body_case", "run_constrained_case"]
 
@@ -138,7 +139,9 @@ def run_rigid_body_case(case: RigidBodyCase, repeats: int, progress: Progress) -
         for value in grid.values:
             progress(f"{case.name}: {grid.method} {grid.parameter} {value if value is not None else ''}".rstrip())
             if grid.method.startswith("scipy-"):
-                run = _rigid_scipy_run(case, grid, float(value), refs)  # type: ignore[arg-type]
+                if value is None:  # a scipy grid lists tolerances; None belongs to the exact flow only
+                    raise InputError(f"{case.name}: {grid.method} needs a tolerance, the grid gives None")
+                run = _rigid_scipy_run(case, grid, float(value), refs)
                 runner = "solve_ivp, lean float RHS"
             else:
                 run = _rigid_package_run(case, grid, value, problem, refs)

@@ -29,7 +29,7 @@ import importlib.util
 import os
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -59,7 +59,7 @@ class GeneratedFunction:
 
     name: str
     arguments: tuple[sympy.Symbol, ...]
-    expressions: object
+    expressions: Iterable[object]
     doc: str = ""
 
 

@@ -12,7 +12,7 @@ matrices at sampled points).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any, TypeAlias
 
 import numpy as np
@@ -32,7 +32,7 @@ def _shape(expressions: object, size: int) -> tuple[int, ...]:
     return (size,)
 
 
-def array_function(arguments: Sequence[Argument], expressions: object, cse: bool = True) -> Callable[..., np.ndarray]:
+def array_function(arguments: Sequence[Argument], expressions: Iterable[object], cse: bool = True) -> Callable[..., np.ndarray]:
     """Compile ``expressions`` into ``f(*values) -> ndarray``.
 
     Parameters
@@ -58,7 +58,7 @@ def array_function(arguments: Sequence[Argument], expressions: object, cse: bool
     groups: list[int | None] = []  # None: a single symbol; k: a group of k symbols
     for item in arguments:
         if isinstance(item, sympy.Basic):
-            symbols.append(item)  # type: ignore[arg-type]  # a Symbol
+            symbols.append(item)
             groups.append(None)
         else:
             members = list(item)
@@ -99,7 +99,7 @@ def array_function(arguments: Sequence[Argument], expressions: object, cse: bool
 
 def numpy_function(
     arguments: Sequence[sympy.Symbol],
-    expressions: object,
+    expressions: Iterable[object],
     parameters: Sequence[sympy.Symbol] = (),
     parameter_values: Sequence[float] | Mapping[str, float] = (),
 ) -> Callable[[np.ndarray], np.ndarray]:

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import builtins
 import keyword
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -145,14 +145,14 @@ def input_name(symbol: sympy.Symbol, index: int, taken: set[str]) -> str:
     return f"a{index}_"
 
 
-def flat_expressions(expressions: object) -> list[sympy.Expr]:
+def flat_expressions(expressions: Iterable[object]) -> list[sympy.Expr]:
     """The expressions as a flat list (a matrix in C order, i.e. row by row)."""
-    return [sympy.sympify(e) for e in expressions]  # type: ignore[attr-defined]  # Matrix or sequence
+    return [sympy.sympify(e) for e in expressions]
 
 
 def straight_line(
     inputs: Mapping[sympy.Symbol, str],
-    expressions: object,
+    expressions: Iterable[object],
     target: Target = "math",
     sharing: Sharing = "cse",
     label: str = "expressions",
@@ -250,9 +250,9 @@ def _dag_code(
                 stack.extend((a, False) for a in node.args if atom(a) is None)
                 continue
             parts = [atom(a) for a in node.args]
-            if any(part is None for part in parts):  # only a symbol that is not an input is left
+            operands = [part for part in parts if part is not None]
+            if len(operands) < len(parts):  # only a symbol that is not an input is left
                 raise UnsupportedExpression(f"cannot compile {node}: it is not an input")
-            operands: list[str] = parts  # type: ignore[assignment]  # checked just above
             if node.is_Add:
                 code = " + ".join(operands)
             elif node.is_Mul:

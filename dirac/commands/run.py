@@ -14,6 +14,10 @@ import argparse
 import signal
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
+
+if TYPE_CHECKING:
+    from dirac.flows.solution import Solution
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -92,14 +96,15 @@ def main(args: argparse.Namespace) -> int:
     previous = signal.signal(signal.SIGTERM, terminate)
     try:
         try:
-            solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]
+            solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]  # scene.run: the keywords load_scene checked, typed dict[str, object]
         except IntegrationError as exc:
-            partial = exc.partial
+            # integrate's errors carry a dirac.flows.Solution; errors.py imports no other layer to say so
+            partial = cast("Solution | None", exc.partial)
             if partial is None:
                 raise
-            target = write_results(partial, _partial_path(out), extra_meta=scene.meta)  # type: ignore[arg-type]
-            note = (f"{len(partial.t)} samples up to t = {partial.t[-1]:.6g} saved in {target} (meta complete = false)"  # type: ignore[attr-defined]
-                    if len(partial.t) else f"no samples were computed; {target} records the failure (meta complete = false)")  # type: ignore[attr-defined]
+            target = write_results(partial, _partial_path(out), extra_meta=scene.meta)
+            note = (f"{len(partial.t)} samples up to t = {partial.t[-1]:.6g} saved in {target} (meta complete = false)"
+                    if len(partial.t) else f"no samples were computed; {target} records the failure (meta complete = false)")
             if isinstance(exc, IntegrationInterrupted):
                 print(f"error: {exc}; {note}", file=sys.stderr)
                 return 130

@@ -20,10 +20,17 @@ import warnings
 import numba
 import numpy as np
 
-try:  # first-class function types are flagged experimental by numba; they are what we need
-    from numba.core.errors import NumbaExperimentalFeatureWarning
-except ImportError:  # pragma: no cover
-    NumbaExperimentalFeatureWarning = Warning
+
+def _experimental_feature_warning() -> type[Warning]:
+    """First-class function types are flagged experimental by numba; they are what we need."""
+    try:
+        from numba.core.errors import NumbaExperimentalFeatureWarning
+    except ImportError:  # pragma: no cover
+        return Warning
+    return NumbaExperimentalFeatureWarning
+
+
+NumbaExperimentalFeatureWarning = _experimental_feature_warning()
 
 
 class quiet(warnings.catch_warnings):

@@ -218,7 +218,7 @@ def integrate(
         method_object, dt = get_method(choice.method), choice.dt
         extra["auto"] = {"chosen": choice.method, "reason": choice.reason, "estimated_error": choice.estimated_error}
     else:
-        method_object = get_method(method)  # type: ignore[arg-type]
+        method_object = get_method(method)
     if not method_object.accepts(kind):
         usable = [m for m in _names_for(kind)]
         raise InputError(
@@ -376,7 +376,7 @@ class _Loop:
         # at least MIN_CHUNK_STEPS steps per call, so that large batches are not advanced
         # (and checked) one step at a time
         chunk = max(MIN_CHUNK_STEPS, CHUNK_STEPS // max(1, batch))
-        dt = float(self.dt)  # type: ignore[arg-type]
+        dt = float(self.dt)
         for index, (a, _b, n_steps) in enumerate(intervals):
             done = 0
             while done < n_steps:

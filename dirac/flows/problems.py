@@ -20,12 +20,16 @@ problem.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
 from dirac.errors import InputError
 from dirac.validate import validate_array, validate_non_negative
+
+if TYPE_CHECKING:
+    from dirac.flows.mechanics import MechanicalSystem
+    from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
 
@@ -200,7 +204,7 @@ class ConstrainedProblem:
         Wrong shapes, non-finite values, or initial data off the constraint surface.
     """
 
-    mechanics: object
+    mechanics: MechanicalSystem | Lagrangian  # a MechanicalSystem once constructed
     q0: np.ndarray
     p0: np.ndarray
     surface_tolerance: float = 1e-9
@@ -212,11 +216,13 @@ class ConstrainedProblem:
     def __post_init__(self) -> None:
         from dirac.model.lagrangian import Lagrangian
 
-        if isinstance(self.mechanics, Lagrangian):
+        mechanics = self.mechanics
+        if isinstance(mechanics, Lagrangian):
             from dirac.flows.mechanics import MechanicalSystem
 
-            self.mechanics = MechanicalSystem.from_lagrangian(self.mechanics)
-        n = self.mechanics.dimension  # type: ignore[attr-defined]
+            mechanics = MechanicalSystem.from_lagrangian(mechanics)
+        self.mechanics = mechanics
+        n = mechanics.dimension
         q0, self.batched = _batched(validate_array(self.q0, "initial q", finite=False), 1, "q")
         p0, _ = _batched(validate_array(self.p0, "initial p", finite=False), 1, "p")
         for name, value in (("q", q0), ("p", p0)):
@@ -226,9 +232,9 @@ class ConstrainedProblem:
                 raise InputError(f"initial {name} has non-finite entries; give finite numbers")
         if q0.shape[0] != p0.shape[0]:
             raise InputError(f"{q0.shape[0]} initial q but {p0.shape[0]} initial p: give one p per q")
-        names = self.mechanics.coordinate_names  # type: ignore[attr-defined]
+        names = mechanics.coordinate_names
         for b in range(q0.shape[0]):
-            position, velocity = self.mechanics.residuals(q0[b], p0[b])  # type: ignore[attr-defined]
+            position, velocity = mechanics.residuals(q0[b], p0[b])
             scale = 1.0 + float(q0[b] @ q0[b])
             if np.any(np.abs(position) > self.surface_tolerance * scale):
                 worst = int(np.argmax(np.abs(position)))
@@ -248,7 +254,7 @@ class ConstrainedProblem:
     @property
     def system(self) -> str:
         """Name of the mechanical system."""
-        return self.mechanics.name  # type: ignore[attr-defined, no-any-return]
+        return self.mechanics.name
 
     @property
     def batch(self) -> int:
@@ -257,5 +263,5 @@ class ConstrainedProblem:
 
     def parameters(self) -> dict[str, object]:
         """Parameter values of the mechanical system, for the result file's ``meta``."""
-        return dict(self.mechanics.parameter_values)  # type: ignore[attr-defined]
+        return dict(self.mechanics.parameter_values)
 

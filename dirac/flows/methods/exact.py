@@ -39,8 +39,8 @@ class ExactStepper(Stepper):
         M = np.empty((n, batch, 3))
         R = np.empty((n, batch, 3, 3)) if self.with_R else None
         for b, flow in enumerate(self.flows):
-            if self.with_R:
-                M[:, b], R[:, b] = flow.state(times)  # type: ignore[index]
+            if R is not None:  # with_R
+                M[:, b], R[:, b] = flow.state(times)
             else:
                 M[:, b] = flow.M(times)
         self.evaluations += n * batch

@@ -10,12 +10,28 @@ does not shorten the steps. Neither method preserves any invariant.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Protocol
+
 import numpy as np
 
 from dirac.flows.dirac_field import ConstrainedField
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.rigid_body_stepper import gravity_weight, needs_attitude, rigid_body_outputs
 from dirac.rigidbody.euler_poisson import lean_rhs_full, lean_rhs_M
+
+
+class _OdeSolver(Protocol):
+    """What is used of a ``scipy.integrate.OdeSolver`` (scipy ships no type information)."""
+
+    t: float
+    y: np.ndarray
+    status: str
+    nfev: int
+
+    def step(self) -> str | None: ...
+
+    def dense_output(self) -> Callable[[float], np.ndarray]: ...
 
 __all__ = ["ScipyStepper", "METHODS"]
 
@@ -48,9 +64,9 @@ class ScipyStepper(Stepper):
             self._fun, self._args = self.field.scipy_rhs, ()
             states = [np.concatenate([q, p]) for q, p in zip(problem.q0, problem.p0)]
         self.y = np.array(states)
-        self._solvers: list[object] | None = None
+        self._solvers: list[_OdeSolver] | None = None
 
-    def _make_solvers(self) -> list[object]:
+    def _make_solvers(self) -> list[_OdeSolver]:
         from scipy import integrate
 
         solver_class = {"scipy-RK45": integrate.RK45, "scipy-DOP853": integrate.DOP853}[self.method.name]
@@ -72,16 +88,16 @@ class ScipyStepper(Stepper):
         if self._solvers is None:
             self._solvers = self._make_solvers()
         for b, solver in enumerate(self._solvers):
-            while solver.t < t and solver.status == "running":  # type: ignore[attr-defined]
-                message = solver.step()  # type: ignore[attr-defined]
+            while solver.t < t and solver.status == "running":
+                message = solver.step()
                 self.steps += 1
-                if solver.status == "failed":  # type: ignore[attr-defined]
+                if solver.status == "failed":
                     raise StepFailure(f"scipy {self.method.name} failed: {message}")
-            if solver.t == t:  # type: ignore[attr-defined]
-                self.y[b] = solver.y  # type: ignore[attr-defined]
+            if solver.t == t:
+                self.y[b] = solver.y
             else:
-                self.y[b] = solver.dense_output()(t)  # type: ignore[attr-defined]
-        self.evaluations = sum(s.nfev for s in self._solvers)  # type: ignore[attr-defined]
+                self.y[b] = solver.dense_output()(t)
+        self.evaluations = sum(s.nfev for s in self._solvers)
         self.t = t
 
     def finite(self) -> bool:
