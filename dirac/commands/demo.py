@@ -55,8 +55,7 @@ def main(args: argparse.Namespace) -> int:
     progress = (not args.no_progress) and sys.stderr.isatty()
     problem = scene.problem
     assert isinstance(problem, RigidBodyProblem)  # the flagship scene is the free rigid body
-    # the scene parser checked the type of each [run] option; Scene.run keeps them as objects
-    solution = integrate(problem, progress=progress, **scene.run)  # type: ignore[arg-type]
+    solution = integrate(problem, progress=progress, **scene.run)
     if args.out:
         from dirac.io.results import write_results
 

@@ -96,7 +96,7 @@ def main(args: argparse.Namespace) -> int:
     previous = signal.signal(signal.SIGTERM, terminate)
     try:
         try:
-            solution = integrate(scene.problem, progress=progress, **scene.run)  # type: ignore[arg-type]  # scene.run: the keywords load_scene checked, typed dict[str, object]
+            solution = integrate(scene.problem, progress=progress, **scene.run)
         except IntegrationError as exc:
             # integrate's errors carry a dirac.flows.Solution; errors.py imports no other layer to say so
             partial = cast("Solution | None", exc.partial)

@@ -22,6 +22,7 @@ import math
 import sys
 import time
 from collections.abc import Sequence
+from typing import Required, TypedDict
 
 import numpy as np
 
@@ -32,7 +33,21 @@ from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 from dirac.validate import is_real_number, validate_integer, validate_positive
 
-__all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS"]
+__all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS", "RunOptions"]
+
+
+class RunOptions(TypedDict, total=False):
+    """The keyword arguments of :func:`integrate` that a scene's ``[run]`` table sets."""
+
+    t_end: Required[float]
+    method: str
+    dt: float
+    samples: int
+    outputs: list[str]
+    tolerance: float
+    drift_limit: float
+    newton_tolerance: float
+    max_newton_iterations: int
 
 #: Steps per call into a compiled kernel between checks (divided by the batch size).
 CHUNK_STEPS = 20_000

@@ -62,6 +62,7 @@ from dirac.validate import (
 
 if TYPE_CHECKING:
     from dirac.flows.analysed import AnalysedProblem
+    from dirac.flows.integration import RunOptions
     from dirac.flows.problems import ConstrainedProblem, RigidBodyProblem
     from dirac.model.lagrangian import Lagrangian
 
@@ -103,7 +104,7 @@ class Scene:
     """A parsed scene: the problem and the arguments of :func:`dirac.flows.integrate`."""
 
     problem: SceneProblem
-    run: dict[str, object]
+    run: RunOptions
     source: str
     system: str
     meta: dict[str, object] = field(default_factory=dict)
@@ -254,11 +255,11 @@ def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None)
     return Scene(problem=problem, run=run, source=source, system=str(problem.system), meta=meta)
 
 
-def _run_options(table: dict, source: str) -> dict[str, object]:
+def _run_options(table: dict, source: str) -> RunOptions:
     warn_unknown_keys(table, _RUN_KEYS, "[run]", source)
     if "t_end" not in table:
         raise InputError(f"{source}: [run] lacks the required key 't_end' (the final time)")
-    run: dict[str, object] = {"t_end": scene_number(table["t_end"], "[run] t_end", source, positive=True)}
+    run: RunOptions = {"t_end": scene_number(table["t_end"], "[run] t_end", source, positive=True)}
     method = table.get("method", "auto")
     if not isinstance(method, str):
         raise InputError(f"{source}: [run] method must be a name (a string), e.g. \"auto\"")
@@ -268,9 +269,10 @@ def _run_options(table: dict, source: str) -> dict[str, object]:
     for key in ("tolerance", "drift_limit", "newton_tolerance"):
         if key in table:
             run[key] = scene_number(table[key], f"[run] {key}", source, positive=True)
-    for key in ("samples", "max_newton_iterations"):
-        if key in table:
-            run[key] = scene_integer(table[key], f"[run] {key}", source)
+    if "samples" in table:
+        run["samples"] = scene_integer(table["samples"], "[run] samples", source)
+    if "max_newton_iterations" in table:
+        run["max_newton_iterations"] = scene_integer(table["max_newton_iterations"], "[run] max_newton_iterations", source)
     if "outputs" in table:
         outputs = table["outputs"]
         if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
