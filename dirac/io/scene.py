@@ -314,7 +314,7 @@ def _rigid_problem(name: str, system: dict, initial: dict, source: str) -> Rigid
 def _general_problem(system: dict, initial: dict, source: str, base: Path) -> ConstrainedProblem | AnalysedProblem:
     from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
     from dirac.flows.problems import ConstrainedProblem
-    from dirac.model.lagrangian import lagrangian_from_table
+    from dirac.model.system_file import lagrangian_from_table
     from dirac.model.systems import load_system
 
     warn_unknown_keys(system, _LAGRANGIAN_KEYS, "[system]", source)

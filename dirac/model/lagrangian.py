@@ -8,7 +8,7 @@ dynamical variables, as in the paper's extended Lagrangian (1):
     L_ext = L(q, q_dot) - sum_a lambda_a chi_a(q).
 
 Lagrangians come from the Python API (:meth:`Lagrangian.from_strings` or sympy
-expressions directly), from a system file (docs/file_formats.md, :func:`read_system_file`), or
+expressions directly), from a system file (docs/file_formats.md, :func:`dirac.model.system_file.read_system_file`), or
 from a built-in factory (:func:`dirac.load_system`).
 """
 
@@ -17,21 +17,18 @@ from __future__ import annotations
 import keyword
 import math
 import re
-import tomllib
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import sympy
 
-from dirac.errors import DiracError, InputError, warn
+from dirac.errors import InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
 from dirac.validate import is_real_number, validate_finite
 
-__all__ = ["Lagrangian", "read_system_file", "velocity_name", "momentum_name", "multiplier_name"]
+__all__ = ["Lagrangian", "velocity_name", "momentum_name", "multiplier_name"]
 
 _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-_SYSTEM_KEYS = {"name", "coordinates", "parameters", "lagrangian", "constraints", "description"}
 
 
 def velocity_name(coordinate: str) -> str:
@@ -313,84 +310,3 @@ def _check_names(
                 f"{role} name {label!r} clashes with a name the engine generates "
                 "(momenta p_<q>, multipliers lambda_<k>): rename it"
             )
-
-
-def read_system_file(path: str | Path) -> Lagrangian:
-    """Read a system file: TOML as in docs/file_formats.md, or a ``.py`` file defining ``system()``.
-
-    Unknown keys in ``[system]`` are warned about (by name) and ignored.
-
-    Raises
-    ------
-    InputError
-        If the file is missing, malformed, lacks a required key, or describes an invalid
-        Lagrangian; the message names the file and the item.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"system file {str(path)!r} does not exist")
-    if path.suffix == ".py":
-        return _read_python_system(path)
-    if path.suffix != ".toml":
-        raise InputError(f"system file {str(path)!r} must end in .toml or .py")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"system file {str(path)!r} is not valid TOML: {exc}") from None
-    return lagrangian_from_table(data.get("system"), source=str(path))
-
-
-def lagrangian_from_table(table: object, source: str = "system table") -> Lagrangian:
-    """Build a :class:`Lagrangian` from the ``[system]`` table of a system file."""
-    if not isinstance(table, dict):
-        raise InputError(f"{source}: missing [system] table (with name, coordinates and lagrangian; see docs/file_formats.md)")
-    unknown = sorted(set(table) - _SYSTEM_KEYS)
-    if unknown:
-        warn(f"{source}: unknown key(s) in [system] ignored: {', '.join(unknown)}")
-    for key in ("name", "coordinates", "lagrangian"):
-        if key not in table:
-            raise InputError(f"{source}: [system] lacks the required key {key!r}")
-    name, coordinates, lagrangian = table["name"], table["coordinates"], table["lagrangian"]
-    constraints = table.get("constraints", [])
-    parameters = table.get("parameters", {})
-    if not isinstance(name, str):
-        raise InputError(f"{source}: [system] name must be a string")
-    if not isinstance(coordinates, list) or not all(isinstance(c, str) for c in coordinates):
-        raise InputError(f"{source}: [system] coordinates must be a list of names, e.g. [\"x\", \"y\"]")
-    if not isinstance(lagrangian, str):
-        raise InputError(f"{source}: [system] lagrangian must be a string expression")
-    if not isinstance(constraints, list) or not all(isinstance(c, str) for c in constraints):
-        raise InputError(f"{source}: [system] constraints must be a list of string expressions")
-    if not isinstance(parameters, dict):
-        raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ m = 1.0 }}")
-    try:
-        return Lagrangian.from_strings(
-            name, coordinates, lagrangian, constraints, parameters, str(table.get("description", ""))
-        )
-    except InputError as exc:
-        raise InputError(f"{source}: {exc}") from None
-
-
-def _read_python_system(path: Path) -> Lagrangian:
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location(f"_dirac_user_system_{abs(hash(path))}", path)
-    if spec is None or spec.loader is None:
-        raise InputError(f"system file {str(path)!r} cannot be imported")
-    module = importlib.util.module_from_spec(spec)
-    try:
-        spec.loader.exec_module(module)
-    except Exception as exc:  # the user's own code failed: report it, do not crash
-        raise InputError(f"system file {str(path)!r} failed to import: {type(exc).__name__}: {exc}") from exc
-    factory = getattr(module, "system", None)
-    if not callable(factory):
-        raise InputError(f"system file {str(path)!r} must define a function system() returning a dirac.Lagrangian")
-    try:
-        result = factory()
-    except DiracError:
-        raise
-    except Exception as exc:  # the user's own code failed: report it, do not crash
-        raise InputError(f"system() in {str(path)!r} failed: {type(exc).__name__}: {exc}") from exc
-    if not isinstance(result, Lagrangian):
-        raise InputError(f"system() in {str(path)!r} returned {type(result).__name__}, not a dirac.Lagrangian")
-    return result

@@ -14,7 +14,8 @@ from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 
 from dirac.errors import InputError
-from dirac.model.lagrangian import Lagrangian, read_system_file
+from dirac.model.lagrangian import Lagrangian
+from dirac.model.system_file import read_system_file
 
 __all__ = ["load_system", "builtin_systems", "ENTRY_POINT_GROUP"]
 

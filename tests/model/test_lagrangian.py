@@ -9,7 +9,8 @@ import pytest
 import sympy
 
 from dirac.errors import DiracWarning, InputError
-from dirac.model.lagrangian import Lagrangian, read_system_file
+from dirac.model.lagrangian import Lagrangian
+from dirac.model.system_file import read_system_file
 
 PENDULUM = dict(
     name="pendulum",
