@@ -36,6 +36,14 @@ On the separatrix (``1 - m = 0``, also when it underflows for perturbations belo
 ``~1e-154 |M|``) ``sn = tanh``, ``cn = dn = sech`` and
 ``Pi(n; am u | 1) = (u + sqrt(-n) atan(sqrt(-n) tanh u)) / (1 - n)``.
 
+Evaluation: ``u0 = q0 K + x0`` with ``|x0| <= K/2`` and ``u = q0 K + (x0 + lam t)``, so the
+rounding of ``u`` is that of ``x0 + lam t``, not of a ``u0`` of size ``~K`` (``~ln(1/|1 - m|)``,
+large near the separatrix). ``Pi`` is split as ``u / (1 - n) + B(u)``: the first part enters
+``psi`` as ``lam t / (1 - n)``, exactly, and ``B`` (``_phase_excess``) is anchored at the
+nearest multiple of ``K``, where it is ``q D`` with ``D = Pi(n|m) - K/(1 - n) = O(1)``, and
+changes only where ``cn^2 u`` is not small. A difference of two values of ``Pi`` of size
+``~K``, which cost ``~|Pi| eps`` in the phase however short the time, is never formed.
+
 Accuracy: about ``1e-13`` in ``M`` and ``R`` over ``t <= 50`` for ordinary bodies, including
 ``m -> 1`` (``cn``, ``dn`` stay relatively accurate at the turning points). For bodies within
 ``~1e-9`` (relative) of an axial symmetry with ``M`` near the plane of the two almost equal
@@ -54,13 +62,7 @@ import math
 import numpy as np
 from numba import njit
 
-from dirac.rigidbody.elliptic import (
-    agm_sequence,
-    carlson_rf,
-    carlson_rf_rj,
-    complete_pi,
-    reduced_sncndn,
-)
+from dirac.rigidbody.elliptic import agm_sequence, carlson_rf, carlson_rj, complete_pi, sncndn
 from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
 
 __all__ = ["ExactRigidBodyFlow"]
@@ -206,52 +208,60 @@ class ExactRigidBodyFlow:
             b, a_b, a_o, n_char = p3, a3, a1, n_p3
         else:
             b, a_b, a_o, n_char = p1, a1, a3, n_p1
-        if mc > 0.0:
-            K = carlson_rf(0.0, mc, 1.0)
-            pi_complete = complete_pi(n_char, mc)
-        else:
-            K = math.inf
-            pi_complete = 0.0
+        K = carlson_rf(0.0, mc, 1.0) if mc > 0.0 else math.inf
         if mc == 0.0:
             # separatrix: F(phi | 1) = asinh(tan phi); cn = dn there, and whichever of the
             # two did not underflow carries the phase
             u0 = math.asinh(sn0 / max(cn0, dn0))
-            pi0 = _pi_separatrix(u0, n_char)
         else:
-            # u0 = F(am u0 | m), Pi(n; am u0 | m) from (sn0, |cn0|, dn0) (DLMF 19.25.5,
-            # 19.25.14); am u0 beyond pi/2 (cn0 < 0) by F(pi - phi) = 2K - F(phi).
+            # u0 = F(am u0 | m) from (sn0, |cn0|, dn0) (DLMF 19.25.5); am u0 beyond pi/2
+            # (cn0 < 0) by F(pi - phi) = 2K - F(phi).
             f_red = sn0 * carlson_rf(cn0 * cn0, dn0 * dn0, 1.0)
-            pi_red = _pi_of_reduced(0.0, sn0, abs(cn0), dn0, n_char, pi_complete)
-            if cn0 >= 0.0:
-                u0, pi0 = f_red, pi_red
-            else:
-                half = math.copysign(2.0, sn0)
-                u0 = half * K - f_red
-                pi0 = half * pi_complete - pi_red
+            u0 = f_red if cn0 >= 0.0 else math.copysign(2.0, sn0) * K - f_red
         G = math.sqrt(float(M @ M))  # 1 up to round-off in the scaled units of __init__
         self.m = m
         self.mc = mc
         self._perm = np.array([p1, p2, p3, b], dtype=np.int64)
         self._em, self._en = em, en
+        # u0 = q0 K + x0 with |x0| <= K/2 (q0 = 0, x0 = u0 on the separatrix): times advance
+        # x0 only, so no rounding of a large u0 + lam t enters M or psi
+        q0 = float(math.floor(u0 / K + 0.5)) if mc > 0.0 else 0.0
+        x0 = u0 - q0 * K if mc > 0.0 else u0
+        # for B at odd multiples of K (see _phase_excess): n' = (m - n)/(1 - n), with 1 - n'
+        # and n' - m = -n mc/(1 - n) >= 0 formed without cancellation
+        one_n = 1.0 - n_char
+        one_np = mc / one_n
+        n_prime = (m - n_char) / one_n
+        np_m = -n_char * mc / one_n
+        # D = Pi(n|m) - K/(1 - n): a rounding of ~eps K in it enters psi once per half period
+        D = complete_pi(n_char, mc) - K / one_n if mc > 0.0 and n_char != 0.0 else 0.0
         self._p = np.array(
             [
                 s1 * A1,
                 s2 * A2,
                 s3 * A3,
                 lam,
-                u0,
+                x0,
                 mc,
                 n_char,
-                pi_complete,
-                pi0,
-                G * a_b if n_char != 0.0 else G * a_o,  # n = 0 (symmetric top): psi' = G a_o
+                q0,
+                0.0,  # B(u0), set below
+                # psi = (G a_b + G (a_o - a_b)/(1 - n)) t + G (a_o - a_b)/lam (B(u) - B(u0))
+                G * a_b + G * (a_o - a_b) / one_n if n_char != 0.0 else G * a_o,
                 G * (a_o - a_b) / lam if n_char != 0.0 else 0.0,  # (no 1/lam: lam may underflow)
                 G,
                 K,
                 math.sqrt(mc),
                 agm,
+                n_prime,
+                one_np,
+                np_m,
+                one_n,
+                D,
+                math.sqrt(-n_char),
             ]
         )
+        self._p[8] = _phase_excess(x0, self._p, self._em, self._en)[3]
         self._Q = self.R0 @ _frame(M, b).T
 
     # ------------------------------------------------------------------ public API
@@ -337,39 +347,75 @@ def _uniform_rotation(R0: np.ndarray, omega: np.ndarray, t: np.ndarray) -> np.nd
 
 
 @njit(cache=True)
-def _reduced_jacobi(u, p, em, en):
-    return reduced_sncndn(u, em, en, p[14], p[12], p[13])
+def _jacobi_anchored(y, p, em, en):
+    """``u = q0 K + y`` as ``q K + x`` (``|x| <= K/2``, ``q`` an integer in a float) and
+    ``sn, cn, dn (u)`` from ``s, c, d = sn, cn, dn (x)`` by the quarter-period shifts
+    (``sn(K + x) = cd x``, ``cn(K + x) = -k' sd x``, ``dn(K + x) = k' nd x``), which keep
+    ``cn`` and ``dn`` relatively accurate where they are small (the near-separatrix turning
+    points). Returns ``q, x, s, c, d, sn, cn, dn``."""
+    if p[5] == 0.0:  # separatrix: no period
+        s, c, d = sncndn(y, em, en, p[14])
+        return 0.0, y, s, c, d, s, c, d
+    K = p[12]
+    k = math.floor(y / K + 0.5)
+    x = y - k * K
+    s, c, d = sncndn(x, em, en, p[14])
+    q = p[7] + k
+    r = q - 4.0 * math.floor(q / 4.0)
+    if r == 0.0:
+        return q, x, s, c, d, s, c, d
+    if r == 2.0:
+        return q, x, s, c, d, -s, -c, d
+    kp = p[13]
+    sign = 1.0 if r == 1.0 else -1.0
+    return q, x, s, c, d, sign * c / d, -sign * kp * s / d, kp / d
 
 
 @njit(cache=True)
-def _pi_of_reduced(j, sn, cn, dn, n, pi_complete):
-    """``Pi(n; am u | m)`` from ``u = 2 j K + w`` and ``sn, cn, dn (w)`` (DLMF 19.25.14)."""
+def _phase_excess(y, p, em, en):
+    """``B(u) = Pi(n; am u | m) - u / (1 - n)`` at ``u = q0 K + y = q K + x``, and
+    ``sn, cn, dn (u)``.
+
+    ``psi`` takes the part ``u / (1 - n)`` of ``Pi`` as ``lam t / (1 - n)``, exactly; ``B`` has
+    derivative ``1/(1 - n sn^2) - 1/(1 - n) = -n cn^2 / ((1 - n)(1 - n sn^2))``, which is small
+    at the turning points ``u = K (mod 2K)``, where a near-separatrix body spends its time,
+    and ``B(q K) = q D``, ``D = Pi(n|m) - K/(1 - n)``, stays ``O(1)`` however large ``K`` grows.
+    Neither the size of ``Pi`` (``~ K``) nor the rounding of a large ``u`` reaches the phase.
+    With ``|x| <= K/2`` (DLMF 19.25.14):
+
+    - ``q`` even: ``Pi(n; am u) = q Pi(n) + x + (n/3) s^3 R_J(c^2, d^2, 1, 1 - n s^2)``;
+    - ``q`` odd: ``sn^2 u = cd^2 x`` and ``1 - n cd^2 = (1 - n)(1 - n' s^2) / d^2`` with
+      ``n' = (m - n)/(1 - n)``, so ``Pi(n; am u) = q Pi(n) + (x + (n' - m) int_0^x sn^2 /
+      (1 - n' sn^2)) / (1 - n)``, the integral ``s^3 R_J(c^2, d^2, 1, 1 - n' s^2) / 3`` and
+      ``n' - m = -n (1 - m)/(1 - n) >= 0``. Its integrand is about ``|n| k'`` at most for
+      ``|x| <= K/2``, so it is dropped for ``1 - m < 1e-40`` (``|term| < K |n| 1e-20``).
+
+    On the separatrix ``B = sqrt(-n) atan(sqrt(-n) tanh u) / (1 - n)``.
+    """
+    q, x, s, c, d, sn, cn, dn = _jacobi_anchored(y, p, em, en)
+    n = p[6]
     if n == 0.0:
-        value = sn * carlson_rf(cn * cn, dn * dn, 1.0)
-    else:
-        rf, rj = carlson_rf_rj(cn * cn, dn * dn, 1.0, 1.0 - n * sn * sn)
-        value = sn * rf + n / 3.0 * sn * sn * sn * rj
-    if j != 0.0:
-        value += 2.0 * j * pi_complete
-    return value
-
-
-@njit(cache=True)
-def _pi_separatrix(u, n):
-    """``Pi(n; am u | 1)`` for ``n <= 0``: ``sin am u = tanh u``, ``atanh(tanh u) = u``, and
-    ``1/((1 - n s^2)(1 - s^2)) = (1/(1 - s^2) - n/(1 - n s^2)) / (1 - n)`` give
-    ``(u + sqrt(-n) atan(sqrt(-n) tanh u)) / (1 - n)``."""
-    r = math.sqrt(-n)
-    return (u + r * math.atan(r * math.tanh(u))) / (1.0 - n)
+        return sn, cn, dn, 0.0
+    if p[5] == 0.0:
+        r = p[20]
+        return sn, cn, dn, r * math.atan(r * s) / p[18]
+    value = q * p[19]
+    if q - 2.0 * math.floor(q / 2.0) == 0.0:
+        rj = carlson_rj(c * c, d * d, 1.0, 1.0 - n * s * s)
+        value += n / 3.0 * s * s * s * rj - n / p[18] * x
+    elif p[5] >= 1e-40:
+        c2 = c * c
+        rj = carlson_rj(c2, d * d, 1.0, p[16] + p[15] * c2)
+        value += p[17] / 3.0 * s * s * s * rj / p[18]
+    return sn, cn, dn, value
 
 
 @njit(cache=True)
 def _eval_M(times, p, perm, em, en, out):
     for i in range(times.shape[0]):
-        j, sn, cn, dn = _reduced_jacobi(p[3] * times[i] + p[4], p, em, en)
-        parity = 1.0 - 2.0 * (j % 2.0)
-        out[i, perm[0]] = p[0] * parity * cn
-        out[i, perm[1]] = p[1] * parity * sn
+        q, x, s, c, d, sn, cn, dn = _jacobi_anchored(p[3] * times[i] + p[4], p, em, en)
+        out[i, perm[0]] = p[0] * cn
+        out[i, perm[1]] = p[1] * sn
         out[i, perm[2]] = p[2] * dn
 
 
@@ -382,19 +428,14 @@ def _eval_state(times, p, perm, em, en, Q, M_out, R_out):
     A = np.empty((3, 3))
     for i in range(times.shape[0]):
         t = times[i]
-        j, sn, cn, dn = _reduced_jacobi(p[3] * t + p[4], p, em, en)
-        parity = 1.0 - 2.0 * (j % 2.0)
-        M_out[i, perm[0]] = p[0] * parity * cn
-        M_out[i, perm[1]] = p[1] * parity * sn
+        sn, cn, dn, excess = _phase_excess(p[3] * t + p[4], p, em, en)
+        M_out[i, perm[0]] = p[0] * cn
+        M_out[i, perm[1]] = p[1] * sn
         M_out[i, perm[2]] = p[2] * dn
         M0 = M_out[i, 0]
         M1 = M_out[i, 1]
         M2 = M_out[i, 2]
-        if p[5] == 0.0:
-            pi_t = _pi_separatrix(p[3] * t + p[4], p[6])
-        else:
-            pi_t = _pi_of_reduced(j, sn, cn, dn, p[6], p[7])
-        psi = p[9] * t + p[10] * (pi_t - p[8])
+        psi = p[9] * t + p[10] * (excess - p[8])
         # frame A(M): r3 = M/G, r1 = e_p3 x r3 / rho, r2 = r3 x r1
         mu0 = M0 / G
         mu1 = M1 / G
