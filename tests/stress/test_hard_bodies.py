@@ -89,9 +89,9 @@ def test_every_method_reports_an_error_and_never_a_silent_nan(name):
 def test_exact_matches_the_reference_on_random_bodies(inertia, M0, radians):
     """Any positive inertia (physical or not, equal moments included) and any M(0).
 
-    Components are 0 or at least 1e-9: closer to an axis is the named hard bodies' job, and
-    within ~1e-150 of the separatrix the phase ``u0 ~ ln(1/delta)`` alone costs ~400 eps
-    (a limit the stress tests found; docs/stress.md)."""
+    Components are 0 or at least 1e-9: closer to an axis is the named hard bodies' job.
+    Regression: this search found the short-time phase error near the separatrix
+    (``tests/rigidbody/test_exact_flow.py::test_short_time_phase_near_the_separatrix_meets_the_contract``)."""
     from hypothesis import assume
 
     assume(np.linalg.norm(M0) > 1e-3)
