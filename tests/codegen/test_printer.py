@@ -61,6 +61,6 @@ def test_dag_code_refuses_what_it_cannot_print():
 
 def test_unknown_target_and_sharing_are_named():
     with pytest.raises(ValueError, match="target"):
-        straight_line(INPUTS, [x], "fortran", "cse")  # type: ignore[arg-type]
+        straight_line(INPUTS, [x], "fortran", "cse")  # type: ignore[arg-type]  # an unknown target, on purpose
     with pytest.raises(ValueError, match="sharing"):
-        straight_line(INPUTS, [x], "math", "global")  # type: ignore[arg-type]
+        straight_line(INPUTS, [x], "math", "global")  # type: ignore[arg-type]  # an unknown sharing mode, on purpose
