@@ -11,8 +11,9 @@ as 1 and 0, so a scene with ``M = [false, 0.2, 0.1]`` would run a body nobody as
 
 from __future__ import annotations
 
+import difflib
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import TypeGuard
 
 import numpy as np
@@ -28,6 +29,9 @@ __all__ = [
     "validate_integer",
     "validate_boolean",
     "validate_array",
+    "did_you_mean",
+    "unknown_name_error",
+    "check_known_keys",
 ]
 
 
@@ -207,3 +211,49 @@ def validate_array(value: object, name: str, shape: Sequence[int] | None = None,
     if finite and not np.all(np.isfinite(array)):
         raise InputError(f"{name} = {array.tolist()} has non-finite entries; give finite numbers")
     return array
+
+
+def did_you_mean(name: str, known: Iterable[str]) -> str:
+    """`` (did you mean 'a' or 'b'?)`` with the names of ``known`` closest to ``name``
+    (:func:`difflib.get_close_matches`), or ``""`` when none is close."""
+    close = difflib.get_close_matches(str(name), sorted(set(map(str, known))), n=3)
+    if not close:
+        return ""
+    return f" (did you mean {' or '.join(map(repr, close))}?)"
+
+
+def _prefixed(source: str, message: str) -> str:
+    return f"{source}: {message}" if source else message
+
+
+def unknown_name_error(kind: str, name: str, known: Iterable[str], source: str = "", hint: str = "",
+                       plural: str | None = None) -> InputError:
+    """The error for a name that is not one of ``known``, with the closest known names.
+
+    ``kind`` says what the name is (``"method"``, ``"system"``, ``"output"``...), ``source``
+    the file it comes from (put in front), ``hint`` a last sentence; the known names are
+    listed sorted, e.g. ``unknown method 'rattle2' (did you mean 'rattle'?); known methods:
+    ...``. The caller raises it.
+    """
+    names = sorted(set(map(str, known)))
+    listed = ", ".join(names) or "(none)"
+    message = f"unknown {kind} {name!r}{did_you_mean(name, names)}; known {plural or kind + 's'}: {listed}"
+    return InputError(_prefixed(source, f"{message}; {hint}" if hint else message))
+
+
+def check_known_keys(table: dict, known: Iterable[str], where: str, source: str = "", kind: str = "key") -> None:
+    """Raise :class:`InputError` when ``table`` has keys outside ``known``.
+
+    The message names the file (``source``), the table (``where``, e.g. ``"[run]"``), each
+    unknown key with the closest known ones, and the known keys sorted, e.g.
+    ``scene.toml: [run] has an unknown key 'sample' (did you mean 'samples'?); known keys:
+    dt, method, ...``. ``kind`` is ``"key"`` or, for the tables of a file, ``"section"``.
+    """
+    names = sorted(set(map(str, known)))
+    unknown = sorted(str(key) for key in table if str(key) not in names)
+    if not unknown:
+        return
+    each = ", ".join(f"{key!r}{did_you_mean(key, names)}" for key in unknown)
+    what = f"an unknown {kind}" if len(unknown) == 1 else f"unknown {kind}s"
+    listed = ", ".join(names) or "(none)"
+    raise InputError(_prefixed(source, f"{where} has {what} {each}; known {kind}s: {listed}"))

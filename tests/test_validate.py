@@ -153,3 +153,34 @@ def pendulum_problem_parts():
     from dirac.model.systems import load_system
 
     return MechanicalSystem.from_lagrangian(load_system("pendulum")), [0.0, -1.0], [0.0, 0.0]
+
+
+def test_did_you_mean_offers_the_closest_known_names_or_nothing():
+    from dirac.validate import did_you_mean
+
+    assert did_you_mean("samples", ["dt", "samples"]) == " (did you mean 'samples'?)"
+    assert did_you_mean("sample", ["dt", "samples", "sample_rate"]) == " (did you mean 'samples' or 'sample_rate'?)"
+    assert did_you_mean("colour", ["dt", "samples"]) == ""
+
+
+def test_unknown_name_error_names_the_source_suggests_and_sorts_the_known_names():
+    from dirac.validate import unknown_name_error
+
+    error = unknown_name_error("method", "rattle2", ["rattle-4", "auto", "rattle-2"], source="s.toml: [run] method")
+    assert isinstance(error, InputError)
+    assert str(error) == (
+        "s.toml: [run] method: unknown method 'rattle2' (did you mean 'rattle-2' or 'rattle-4'?); "
+        "known methods: auto, rattle-2, rattle-4"
+    )
+    assert str(unknown_name_error("system", "xyzzy", ["pendulum"], hint="or give a path")) == (
+        "unknown system 'xyzzy'; known systems: pendulum; or give a path"
+    )
+
+
+def test_check_known_keys_refuses_unknown_keys_with_suggestions():
+    from dirac.validate import check_known_keys
+
+    check_known_keys({"dt": 1}, {"dt", "samples"}, "[run]", "s.toml")  # all known: nothing raised
+    with pytest.raises(InputError) as error:
+        check_known_keys({"sample": 1, "dt": 1}, {"dt", "samples"}, "[run]", "s.toml")
+    assert str(error.value) == "s.toml: [run] has an unknown key 'sample' (did you mean 'samples'?); known keys: dt, samples"

@@ -47,6 +47,11 @@ def main(args: argparse.Namespace) -> int:
     run = data["run"]
     assert isinstance(run, dict)
     if args.method:
+        from dirac.flows.methods.registry import method_names
+        from dirac.validate import unknown_name_error
+
+        if args.method not in method_names():
+            raise unknown_name_error("method", args.method, method_names(), "--method")
         run["method"] = args.method
     if args.t_end is not None:
         run["t_end"] = args.t_end

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dirac.errors import InputError, warn
-from dirac.validate import validate_array, validate_positive
+from dirac.errors import InputError
+from dirac.validate import check_known_keys, unknown_name_error, validate_array, validate_positive
 
 __all__ = [
     "Distribution",
@@ -217,10 +217,9 @@ def parse_distribution(
     name = table.get("distribution", "fixed")
     choices = sorted(d for q, d in _KEYS if q == quantity)
     if (quantity, name) not in _KEYS:
-        raise InputError(f"{where}.distribution = {name!r} is unknown; choose one of {choices}")
+        raise unknown_name_error("distribution", name, choices, f"{where}.distribution")
     allowed = _KEYS[(quantity, name)] | {"distribution"}
-    for key in sorted(set(table) - allowed):
-        warn(f"{where}: key '{key}' is not used by distribution {name!r} (it takes {sorted(allowed - {'distribution'})}); ignoring it")
+    check_known_keys(table, allowed, f"{where} (distribution {name!r})")
     shape = (3, 3) if quantity == "R" else (3,)
     if name == "fixed":
         if "value" in table:

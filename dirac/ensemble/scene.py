@@ -36,7 +36,7 @@ distribution = "fixed"                       # fixed (default: [system] inertia)
 ```
 
 :func:`load_ensemble_scene` validates everything up front (``InputError`` naming the key
-and the fix; unknown keys warned) and returns an :class:`EnsembleScene`.
+and the fix; unknown keys are errors that suggest the closest known key) and returns an :class:`EnsembleScene`.
 """
 
 from __future__ import annotations
@@ -60,13 +60,14 @@ from dirac.ensemble.sampling import MemberSource, open_member_file
 from dirac.errors import InputError, warn
 from dirac.io.scene import (
     read_scene_file,
+    reject_unknown_keys,
     scene_inertia,
     scene_integer,
     scene_number,
     scene_table,
     scene_vector,
-    warn_unknown_keys,
 )
+from dirac.validate import unknown_name_error
 
 __all__ = [
     "TRAJECTORY_OUTPUTS",
@@ -219,10 +220,10 @@ def load_ensemble_scene(path: str | Path) -> EnsembleScene:
     return parse_ensemble_scene(data, base_dir=path.resolve().parent, path=str(path))
 
 
-def _section(data: dict, name: str, required: bool) -> dict:
+def _section(data: dict, name: str, required: bool, source: str = "") -> dict:
     section = scene_table(data, name, required=required,
                           hint="an ensemble scene needs [system], [run] and [ensemble]; see docs/ensembles.md")
-    warn_unknown_keys(section, _SECTION_KEYS[name], f"[{name}]", reader="ensemble scenes")
+    reject_unknown_keys(section, _SECTION_KEYS[name], f"[{name}]", source)
     return section
 
 
@@ -260,7 +261,8 @@ def _names(section: dict, key: str, where: str, allowed: dict) -> tuple[str, ...
         raise InputError(f"{where} {key} must be a list of names from {sorted(allowed)}")
     for name in value:
         if name not in allowed:
-            raise InputError(f"{where} {key}: {name!r} is unknown; choose from {sorted(allowed)}")
+            kind = "output" if key == "outputs" else "reduction" if key == "reductions" else "name"
+            raise unknown_name_error(kind, name, allowed, f"{where} {key}")
     return tuple(dict.fromkeys(value))
 
 
@@ -354,11 +356,12 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
         validate_rotation,
     )
 
-    warn_unknown_keys(data, set(_SECTION_KEYS), "the scene", reader="ensemble scenes")
-    system = _section(data, "system", required=True)
-    initial = _section(data, "initial", required=False)
-    run = _section(data, "run", required=True)
-    ensemble = _section(data, "ensemble", required=True)
+    source = path or ""
+    reject_unknown_keys(data, set(_SECTION_KEYS), "the ensemble scene", source, kind="section")
+    system = _section(data, "system", required=True, source=source)
+    initial = _section(data, "initial", required=False, source=source)
+    run = _section(data, "run", required=True, source=source)
+    ensemble = _section(data, "ensemble", required=True, source=source)
 
     if system.get("name", "rigid_body") != "rigid_body":
         raise InputError(f"[system] name = {system.get('name')!r}: ensembles support the free rigid body only; use name = \"rigid_body\"")

@@ -31,7 +31,7 @@ from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, get_method, method_names
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
-from dirac.validate import is_real_number, validate_integer, validate_positive
+from dirac.validate import is_real_number, unknown_name_error, validate_integer, validate_positive
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS", "RunOptions"]
 
@@ -151,12 +151,10 @@ def _validate_outputs(outputs: Sequence[str] | None, kind: str, available: Seque
     chosen = tuple(dict.fromkeys(outputs))
     if not chosen:
         raise InputError("outputs is empty: request at least one output, e.g. [\"M\"]")
-    unknown = [name for name in chosen if name not in available]
-    if unknown:
-        raise InputError(
-            f"output(s) {', '.join(map(repr, unknown))} not available for a {kind.replace('_', ' ')} problem; "
-            f"choose from {', '.join(available)}"
-        )
+    for name in chosen:
+        if name not in available:
+            raise unknown_name_error("output", name, available,
+                                     hint=f"these are the outputs of a {kind.replace('_', ' ')} problem")
     return chosen
 
 

@@ -31,12 +31,12 @@ integrated on the full phase space of its Dirac–Bergmann analysis (``midpoint`
 scipy baselines; the multipliers are completed on the constraint surface, outputs ``z``,
 ``q``, ``p``, ``energy``, ``constraint_residual``). Parameters of a Lagrangian are
 overridden under ``[system] parameters``. Optional ``[run]`` keys: ``drift_limit``,
-``newton_tolerance``, ``max_newton_iterations``. Unknown keys are warned about and ignored.
+``newton_tolerance``, ``max_newton_iterations``. Unknown keys are errors that suggest the closest known key.
 
 This module is the one scene reader: reading the file (:func:`read_scene_file`), its
 tables (:func:`scene_table`), numbers, vectors and the rigid body's inertia
 (:func:`scene_number`, :func:`scene_integer`, :func:`scene_vector`,
-:func:`scene_inertia`) and unknown-key warnings (:func:`warn_unknown_keys`).
+:func:`scene_inertia`) and unknown-key errors (:func:`reject_unknown_keys`).
 :mod:`dirac.ensemble.scene` reads ensemble scenes with the same helpers and adds only
 what is particular to ensembles.
 """
@@ -51,8 +51,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from dirac.errors import InputError, warn
+from dirac.errors import InputError
 from dirac.validate import (
+    check_known_keys,
+    unknown_name_error,
     validate_array,
     validate_boolean,
     validate_finite,
@@ -163,9 +165,8 @@ def scene_table(data: dict, key: str, source: str = "", required: bool = True,
     return value
 
 
-def warn_unknown_keys(table: dict, known: set[str], where: str, source: str = "",
-                      reader: str | None = None) -> None:
-    """Warn about the keys of ``table`` outside ``known``; they are ignored.
+def reject_unknown_keys(table: dict, known: set[str], where: str, source: str = "", kind: str = "key") -> None:
+    """Refuse the keys of ``table`` outside ``known`` with "did you mean" suggestions.
 
     Parameters
     ----------
@@ -177,18 +178,16 @@ def warn_unknown_keys(table: dict, known: set[str], where: str, source: str = ""
         The table in messages, e.g. ``"[run]"``.
     source : str
         The scene, named in front of the message when given.
-    reader : str, optional
-        The kind of scene, e.g. ``"ensemble scenes"``: then one warning per key, listing
-        the keys that kind of scene knows; otherwise one warning for all of them.
+    kind : str
+        ``"key"``, or ``"section"`` for the tables of the scene itself.
+
+    Raises
+    ------
+    InputError
+        Naming the file, the table, each unknown key with the closest known ones, and
+        the known keys (:func:`dirac.validate.check_known_keys`).
     """
-    unknown = sorted(set(table) - set(known))
-    if not unknown:
-        return
-    if reader is None:
-        warn(scene_label(source, f"unknown key(s) in {where} ignored: {', '.join(unknown)}"))
-        return
-    for key in unknown:
-        warn(scene_label(source, f"{where} key '{key}' is unknown to {reader} (known: {sorted(known)}); ignoring it"))
+    check_known_keys(table, known, where, source, kind)
 
 
 def scene_number(value: object, name: str, source: str = "", positive: bool = False) -> float:
@@ -241,7 +240,7 @@ def load_scene(path: str | Path) -> Scene:
 
 def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None) -> Scene:
     """Build a :class:`Scene` from the parsed TOML tables (see the module docstring)."""
-    warn_unknown_keys(data, _TOP_KEYS, "the scene", source)
+    reject_unknown_keys(data, _TOP_KEYS, "the scene", source, kind="section")
     system = scene_table(data, "system", source)
     initial = scene_table(data, "initial", source)
     run_table = scene_table(data, "run", source)
@@ -251,18 +250,27 @@ def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None)
         problem: SceneProblem = _rigid_problem(str(name), system, initial, source)
     else:
         problem = _general_problem(system, initial, source, base or Path("."))
+    available: tuple[str, ...] = problem.outputs
+    for output in run.get("outputs", []):
+        if output not in available:
+            raise unknown_name_error("output", output, available, scene_label(source, "[run] outputs"),
+                                     hint=f"these are the outputs of a {problem.kind.replace('_', ' ')} problem")
     meta: dict[str, object] = {"scene": source}
     return Scene(problem=problem, run=run, source=source, system=str(problem.system), meta=meta)
 
 
 def _run_options(table: dict, source: str) -> RunOptions:
-    warn_unknown_keys(table, _RUN_KEYS, "[run]", source)
+    reject_unknown_keys(table, _RUN_KEYS, "[run]", source)
     if "t_end" not in table:
         raise InputError(f"{source}: [run] lacks the required key 't_end' (the final time)")
     run: RunOptions = {"t_end": scene_number(table["t_end"], "[run] t_end", source, positive=True)}
     method = table.get("method", "auto")
     if not isinstance(method, str):
         raise InputError(f"{source}: [run] method must be a name (a string), e.g. \"auto\"")
+    from dirac.flows.methods.registry import method_names
+
+    if method not in method_names():
+        raise unknown_name_error("method", method, method_names(), scene_label(source, "[run] method"))
     run["method"] = method
     if "dt" in table:
         run["dt"] = scene_number(table["dt"], "[run] dt", source, positive=True)
@@ -284,8 +292,8 @@ def _run_options(table: dict, source: str) -> RunOptions:
 def _rigid_problem(name: str, system: dict, initial: dict, source: str) -> RigidBodyProblem:
     from dirac.flows.problems import HeavyTopProblem, RigidBodyProblem
 
-    warn_unknown_keys(system, _HEAVY_KEYS if name == "heavy_top" else _RIGID_KEYS, "[system]", source)
-    warn_unknown_keys(initial, _RIGID_INITIAL, "[initial]", source)
+    reject_unknown_keys(system, _HEAVY_KEYS if name == "heavy_top" else _RIGID_KEYS, "[system]", source)
+    reject_unknown_keys(initial, _RIGID_INITIAL, "[initial]", source)
     inertia = scene_inertia(system, source)
     R = scene_vector(initial["R"], "[initial] R", source, (3, 3)) if "R" in initial else np.eye(3)
     given = [key for key in ("M", "omega", "m") if key in initial]
@@ -317,8 +325,15 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
     from dirac.model.system_file import lagrangian_from_table
     from dirac.model.systems import load_system
 
-    warn_unknown_keys(system, _LAGRANGIAN_KEYS, "[system]", source)
-    warn_unknown_keys(initial, _GENERAL_INITIAL, "[initial]", source)
+    if isinstance(system.get("name"), str) and not ({"file", "lagrangian"} & set(system)):
+        from dirac.model.systems import builtin_systems
+
+        known = (*SCENE_SYSTEMS, *builtin_systems())
+        if system["name"] not in known and not system["name"].endswith((".toml", ".py")) and "/" not in system["name"]:
+            raise unknown_name_error("system", system["name"], known, scene_label(source, "[system] name"),
+                                     hint="or give file = a system file")
+    reject_unknown_keys(system, _LAGRANGIAN_KEYS, "[system]", source)
+    reject_unknown_keys(initial, _GENERAL_INITIAL, "[initial]", source)
     if "file" in system:
         file = Path(str(system["file"]))
         if not file.is_absolute():
@@ -338,6 +353,10 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
     overrides = system.get("parameters", {})
     if not isinstance(overrides, dict):
         raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ l = 2.0 }}")
+    for key in overrides:
+        if key not in lagrangian.parameter_symbols:
+            raise unknown_name_error("parameter", key, lagrangian.parameter_symbols,
+                                     scene_label(source, f"[system] parameters of {lagrangian.name!r}"))
     try:
         mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides)
     except NotMechanicalError:

@@ -24,7 +24,7 @@ import sympy
 
 from dirac.errors import InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
-from dirac.validate import is_real_number, validate_finite
+from dirac.validate import is_real_number, unknown_name_error, validate_finite
 
 __all__ = ["Lagrangian", "velocity_name", "momentum_name", "multiplier_name"]
 
@@ -243,8 +243,7 @@ class Lagrangian:
         remaining = dict(self.parameters)
         for label, value in values.items():
             if label not in symbols:
-                known = ", ".join(sorted(symbols)) or "(none)"
-                raise InputError(f"{self.name!r} has no parameter {label!r}; its parameters are: {known}")
+                raise unknown_name_error("parameter", label, symbols, source=f"system {self.name!r}")
             substitution[symbols[label]] = _as_rational(validate_finite(value, f"parameter {label!r}"))
             remaining.pop(symbols[label])
         merged = {**self.fixed_values, **{k: float(v) for k, v in values.items()}}

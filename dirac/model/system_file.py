@@ -11,8 +11,9 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from dirac.errors import DiracError, InputError, warn
+from dirac.errors import DiracError, InputError
 from dirac.model.lagrangian import Lagrangian
+from dirac.validate import check_known_keys
 
 __all__ = ["read_system_file", "lagrangian_from_table"]
 
@@ -22,7 +23,7 @@ _SYSTEM_KEYS = {"name", "coordinates", "parameters", "lagrangian", "constraints"
 def read_system_file(path: str | Path) -> Lagrangian:
     """Read a system file: TOML as in docs/file_formats.md, or a ``.py`` file defining ``system()``.
 
-    Unknown keys in ``[system]`` are warned about (by name) and ignored.
+    Unknown keys in ``[system]`` are errors that name them and suggest the closest known keys.
 
     Raises
     ------
@@ -48,9 +49,7 @@ def lagrangian_from_table(table: object, source: str = "system table") -> Lagran
     """Build a :class:`Lagrangian` from the ``[system]`` table of a system file."""
     if not isinstance(table, dict):
         raise InputError(f"{source}: missing [system] table (with name, coordinates and lagrangian; see docs/file_formats.md)")
-    unknown = sorted(set(table) - _SYSTEM_KEYS)
-    if unknown:
-        warn(f"{source}: unknown key(s) in [system] ignored: {', '.join(unknown)}")
+    check_known_keys(table, _SYSTEM_KEYS, "[system]", source)
     for key in ("name", "coordinates", "lagrangian"):
         if key not in table:
             raise InputError(f"{source}: [system] lacks the required key {key!r}")

@@ -13,9 +13,9 @@ from collections.abc import Callable
 from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 
-from dirac.errors import InputError
 from dirac.model.lagrangian import Lagrangian
 from dirac.model.system_file import read_system_file
+from dirac.validate import unknown_name_error
 
 __all__ = ["load_system", "builtin_systems", "ENTRY_POINT_GROUP"]
 
@@ -39,10 +39,7 @@ def builtin_systems() -> dict[str, str]:
 def _factory(name: str) -> Callable[..., Lagrangian]:
     eps = _entry_points()
     if name not in eps:
-        known = ", ".join(sorted(eps)) or "(none installed)"
-        raise InputError(
-            f"unknown system {name!r}: give a built-in name ({known}) or a path to a .toml or .py system file"
-        )
+        raise unknown_name_error("system", name, eps, hint="give a built-in name or a path to a .toml or .py system file")
     return eps[name].load()
 
 

@@ -56,7 +56,7 @@ def test_latex_and_param(run_cli):
     [
         (("analyze", "pendulum", "--param", "l"), "NAME=VALUE"),
         (("analyze", "pendulum", "--param", "l=abc"), "not a number"),
-        (("analyze", "pendulum", "--param", "mass=2"), "no parameter 'mass'"),
+        (("analyze", "pendulum", "--param", "mass=2"), "unknown parameter 'mass'; known parameters: g, l, m"),
         (("analyze", "no_such_system"), "unknown system"),
     ],
 )

@@ -95,13 +95,16 @@ def test_bad_scene_exits_2_with_one_error_line_and_writes_nothing(tmp_path, run_
     assert not (tmp_path / "bad.npz").exists()
 
 
-def test_unknown_keys_warn_and_the_run_goes_on(tmp_path, run_cli):
+def test_an_unknown_key_is_an_error_that_suggests_the_known_key_and_runs_nothing(tmp_path, run_cli):
+    """Guards against a typo running silently with a default (``sample = 5`` used to run 101 samples)."""
+    from cli_output import one_error_line
+
     scene = _write(tmp_path / "s.toml", '[system]\nname = "rigid_body"\ninertia = [1, 2, 3]\n[initial]\n'
-                   'M = [1, 0, 0]\n[run]\nt_end = 1.0\nmethod = "exact"\nsamples = 3\ncolor = "blue"\n')
-    status, _stdout, stderr = run_cli("run", str(scene), "--no-progress")
-    assert status == 0
-    assert "warning: " in stderr and "unknown key(s) in [run] ignored: color" in stderr
-    assert (tmp_path / "s.npz").exists()  # default output: next to the scene
+                   'M = [1, 0, 0]\n[run]\nt_end = 1.0\nmethod = "exact"\nsample = 3\n')
+    status, stdout, stderr = run_cli("run", str(scene), "--no-progress")
+    line = one_error_line(status, stderr)
+    assert line.startswith(f"error: {scene}: [run] has an unknown key 'sample' (did you mean 'samples'?); known keys: ")
+    assert stdout == "" and not (tmp_path / "s.npz").exists()
 
 
 def test_help_lists_every_method(run_cli):

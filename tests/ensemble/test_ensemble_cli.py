@@ -19,7 +19,9 @@ def test_cli_bad_input_exits_2_with_one_error_line(write_scene, tmp_path, run_cl
     cases = [
         (write_scene("a.toml", method="rattle-2"), "method = 'rattle-2' is not available for ensembles"),
         (write_scene("b.toml", outputs="[]", reductions="[]"), "the scene asks for nothing"),
-        (write_scene("c.toml", reductions='["flip_count"]'), "reductions: 'flip_count' is unknown"),
+        (write_scene("c.toml", reductions='["flip_count"]'), "reductions: unknown reduction 'flip_count' (did you mean"),
+        (write_scene("e.toml", extra="colour = \"red\""), "e.toml: [ensemble] has an unknown key 'colour'; known keys: "),
+        (write_scene("f.toml", extra="cont = 3"), "f.toml: [ensemble] has an unknown key 'cont' (did you mean 'count'?)"),
         (write_scene("d.toml", members='[ensemble.M]\ndistribution = "sphere"\n'), "needs 'norm'"),
         (tmp_path / "missing.toml", "cannot read scene file"),
     ]
@@ -33,11 +35,10 @@ def test_cli_bad_input_exits_2_with_one_error_line(write_scene, tmp_path, run_cl
 
 
 def test_scene_warnings(write_scene, tmp_path, run_cli):
-    scene = write_scene(count=5, dt=0.03, extra="colour = \"red\"", reductions='["final_state"]', outputs="[]")
+    scene = write_scene(count=5, dt=0.03, reductions='["final_state"]', outputs="[]")
     status, _, stderr = run_cli("ensemble", str(scene), "--out", str(tmp_path / "out"), "--no-progress")
     assert status == 0
     warnings = [line for line in stderr.splitlines() if line.startswith("warning:")]
-    assert any("[ensemble] key 'colour' is unknown" in line for line in warnings)
     assert any("dt = 0.03 does not divide the sample spacing 0.1; using dt = 0.025" in line for line in warnings)
 
 

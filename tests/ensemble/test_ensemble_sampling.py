@@ -85,7 +85,9 @@ def test_uniform_inertia_bounds():
 @pytest.mark.parametrize(
     ("quantity", "table", "fragment"),
     [
-        ("M", {"distribution": "cube"}, "distribution = 'cube' is unknown"),
+        ("M", {"distribution": "cube"}, "distribution: unknown distribution 'cube'; known distributions: fixed, gaussian, sphere"),
+        ("M", {"distribution": "sphre"}, "unknown distribution 'sphre' (did you mean 'sphere'?)"),
+        ("M", {"distribution": "sphere", "nrom": 1.0}, "has an unknown key 'nrom' (did you mean 'norm'?)"),
         ("M", {"distribution": "sphere"}, "needs 'norm'"),
         ("M", {"distribution": "sphere", "norm": -1.0}, "norm = -1.0 must be"),
         ("M", {"distribution": "gaussian", "mean": [0, 1, 0]}, "needs 'std'"),

@@ -42,9 +42,14 @@ def test_method_names_put_the_contract_names_first_then_the_extras_sorted():
     assert extras == sorted(extras) and set(extras) == set(METHODS) - set(CONTRACT_NAMES)
 
 
-def test_unknown_name_lists_the_known_ones():
-    with pytest.raises(InputError, match=r"unknown method 'leapfrog'; choose one of: auto, exact, lie-poisson-2"):
-        get_method("leapfrog")
+def test_unknown_name_lists_the_known_ones_sorted_and_suggests_the_closest():
+    from dirac.flows.methods.registry import method_names
+
+    with pytest.raises(InputError) as error:
+        get_method("leapfrog")  # nothing close: no suggestion
+    assert str(error.value) == f"unknown method 'leapfrog'; known methods: {', '.join(sorted(method_names()))}"
+    with pytest.raises(InputError, match=r"^unknown method 'rattle2' \(did you mean 'rattle-2'"):
+        get_method("rattle2")
 
 
 def test_lie_poisson_methods_integrate_the_free_body_and_the_heavy_top():

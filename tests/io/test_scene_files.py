@@ -43,13 +43,45 @@ def test_angular_velocity_and_lab_momentum_are_accepted():
     assert np.allclose(np.array(R) @ lab.problem.M0[0], [1.0, 0.0, 0.0])
 
 
-def test_unknown_keys_are_warned_about_and_listed():
-    data = _with(RIGID, run={"colour": "red", "speed": 3}, system={"mass": 2.0})
-    with pytest.warns(DiracWarning) as record:
+@pytest.mark.parametrize(
+    "data, message",
+    [
+        (_with(RIGID, run={"sample": 5}),
+         "s.toml: [run] has an unknown key 'sample' (did you mean 'samples'?); known keys: drift_limit, dt, "
+         "max_newton_iterations, method, newton_tolerance, outputs, samples, t_end, tolerance"),
+        (_with(RIGID, system={"inertai": [1.0, 2.0, 3.0]}),
+         "s.toml: [system] has an unknown key 'inertai' (did you mean 'inertia'?); known keys: description, inertia, name"),
+        (_with(RIGID, initial={"RR": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}),
+         "s.toml: [initial] has an unknown key 'RR' (did you mean 'R'?); known keys: M, R, m, omega"),
+        (_with(RIGID) | {"intial": {}},
+         "s.toml: the scene has an unknown section 'intial' (did you mean 'initial'?); known sections: description, "
+         "initial, run, system"),
+        (_with(RIGID, run={"colour": "red"}),  # nothing close: no suggestion
+         "s.toml: [run] has an unknown key 'colour'; known keys: drift_limit, dt, max_newton_iterations, method, "
+         "newton_tolerance, outputs, samples, t_end, tolerance"),
+    ],
+)
+def test_unknown_keys_and_sections_are_errors_with_the_closest_known_names(data, message):
+    with pytest.raises(InputError) as error:
         scene_from_dict(data, source="s.toml")
-    messages = " | ".join(str(w.message) for w in record)
-    assert "unknown key(s) in [run] ignored: colour, speed" in messages
-    assert "unknown key(s) in [system] ignored: mass" in messages
+    assert str(error.value) == message
+
+
+def test_unknown_methods_outputs_systems_and_parameters_suggest_the_closest_names():
+    with pytest.raises(InputError, match=r"^s.toml: \[run\] method: unknown method 'rattle2' \(did you mean "
+                                         r"'rattle-2'.*\?\); known methods: .*auto"):
+        scene_from_dict(_with(RIGID, run={"method": "rattle2"}), source="s.toml")
+    with pytest.raises(InputError, match=r"^s.toml: \[run\] outputs: unknown output 'enrgy' \(did you mean "
+                                         r"'energy'\?\); known outputs: M, R, casimir, energy, lab_momentum"):
+        scene_from_dict(_with(RIGID, run={"outputs": ["M", "enrgy"]}), source="s.toml")
+    with pytest.raises(InputError, match=r"^s.toml: \[system\] name: unknown system 'pendulm' \(did you mean "
+                                         r"'pendulum'.*\?\); known systems: .*heavy_top, pendulum, .*rigid_body,"):
+        scene_from_dict({"system": {"name": "pendulm"}, "initial": {}, "run": {"t_end": 1.0}}, source="s.toml")
+    with pytest.raises(InputError, match=r"^s.toml: \[system\] parameters of 'pendulum': unknown parameter 'll' "
+                                         r"\(did you mean 'l'\?\); known parameters: g, l, m$"):
+        scene_from_dict({"system": {"name": "pendulum", "parameters": {"ll": 2.0}}, "initial": {},
+                         "run": {"t_end": 1.0}},
+                        source="s.toml")
 
 
 @pytest.mark.parametrize(

@@ -1,5 +1,5 @@
 """The reading helpers every scene reader shares (:mod:`dirac.io.scene`): the file, its
-tables, numbers, vectors and unknown-key warnings; single-run and ensemble scenes read
+tables, numbers, vectors and unknown-key errors; single-run and ensemble scenes read
 a file the same way."""
 
 from __future__ import annotations
@@ -7,16 +7,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dirac.errors import DiracWarning, InputError
+from dirac.errors import InputError
 from dirac.io.scene import (
     load_scene,
     read_scene_file,
+    reject_unknown_keys,
     scene_inertia,
     scene_integer,
     scene_number,
     scene_table,
     scene_vector,
-    warn_unknown_keys,
 )
 
 
@@ -60,20 +60,20 @@ def test_scene_table_is_a_table_or_missing_with_a_hint():
         scene_table(data, "initial", "s.toml")
 
 
-def test_unknown_keys_are_warned_about_in_one_line_or_one_line_each():
-    with pytest.warns(DiracWarning, match=r"^s.toml: unknown key\(s\) in \[run\] ignored: colour, speed$"):
-        warn_unknown_keys({"t_end": 1.0, "speed": 3, "colour": "red"}, {"t_end"}, "[run]", "s.toml")
-    with pytest.warns(DiracWarning) as record:
-        warn_unknown_keys({"count": 3, "b": 1, "a": 2}, {"count"}, "[ensemble]", reader="ensemble scenes")
-    assert [str(w.message) for w in record] == [
-        "[ensemble] key 'a' is unknown to ensemble scenes (known: ['count']); ignoring it",
-        "[ensemble] key 'b' is unknown to ensemble scenes (known: ['count']); ignoring it",
-    ]
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        warn_unknown_keys({"t_end": 1.0}, {"t_end", "dt"}, "[run]", "s.toml")  # nothing unknown: no warning
+def test_unknown_keys_are_errors_naming_the_file_each_key_and_the_closest_known_keys():
+    with pytest.raises(InputError) as error:
+        reject_unknown_keys({"t_end": 1.0, "speed": 3, "sample": 5}, {"t_end", "samples", "dt"}, "[run]", "s.toml")
+    assert str(error.value) == (
+        "s.toml: [run] has unknown keys 'sample' (did you mean 'samples'?), 'speed'; known keys: dt, samples, t_end"
+    )
+    with pytest.raises(InputError) as error:
+        reject_unknown_keys({"runn": {}}, {"run", "system", "initial"}, "the scene", "s.toml", kind="section")
+    assert str(error.value) == (
+        "s.toml: the scene has an unknown section 'runn' (did you mean 'run'?); known sections: initial, run, system"
+    )
+    with pytest.raises(InputError, match=r"^\[ensemble\] has an unknown key 'colour'; known keys: count$"):
+        reject_unknown_keys({"count": 3, "colour": 2}, {"count"}, "[ensemble]")  # no close match: no suggestion
+    reject_unknown_keys({"t_end": 1.0}, {"t_end", "dt"}, "[run]", "s.toml")  # nothing unknown: nothing raised
 
 
 def test_numbers_vectors_and_inertia_are_named_with_the_scene_and_key():

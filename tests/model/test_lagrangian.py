@@ -8,7 +8,7 @@ import textwrap
 import pytest
 import sympy
 
-from dirac.errors import DiracWarning, InputError
+from dirac.errors import InputError
 from dirac.model.lagrangian import Lagrangian
 from dirac.model.system_file import read_system_file
 
@@ -64,8 +64,10 @@ def test_bad_lagrangians_are_refused_naming_the_item(change, fragment):
 
 def test_fix_refuses_unknown_parameter_and_non_finite_value():
     lag = Lagrangian.from_strings(**PENDULUM)
-    with pytest.raises(InputError, match="no parameter 'q'"):
+    with pytest.raises(InputError, match=r"^system 'pendulum': unknown parameter 'q'; known parameters: g, l, m$"):
         lag.fix(q=1.0)
+    with pytest.raises(InputError, match=r"unknown parameter 'gg' \(did you mean 'g'\?\); known parameters: g, l, m$"):
+        lag.fix(gg=1.0)
     with pytest.raises(InputError, match="finite"):
         lag.fix(l=float("nan"))
 
@@ -92,7 +94,7 @@ def test_toml_system_file_round_trip(tmp_path):
     assert lag.name == "pendulum" and len(lag.constraints) == 1
 
 
-def test_toml_unknown_keys_are_warned_and_listed(tmp_path):
+def test_toml_unknown_keys_are_errors_naming_the_file_and_the_closest_keys(tmp_path):
     path = write(
         tmp_path,
         """
@@ -101,11 +103,15 @@ def test_toml_unknown_keys_are_warned_and_listed(tmp_path):
         coordinates = ["x"]
         lagrangian = "x_dot**2/2"
         colour = "red"
-        mass = 2
+        constraint = []
         """,
     )
-    with pytest.warns(DiracWarning, match="colour, mass"):
+    with pytest.raises(InputError) as error:
         read_system_file(path)
+    assert str(error.value) == (
+        f"{path}: [system] has unknown keys 'colour', 'constraint' (did you mean 'constraints'?); "
+        "known keys: constraints, coordinates, description, lagrangian, name, parameters"
+    )
 
 
 @pytest.mark.parametrize(

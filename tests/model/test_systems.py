@@ -23,8 +23,19 @@ def test_unknown_system_lists_the_builtin_names():
 
 
 def test_unknown_option_is_refused():
-    with pytest.raises(InputError, match="no parameter 'mass'"):
-        dirac.load_system("pendulum", mass=1.0)
+    with pytest.raises(InputError, match=r"unknown parameter 'll' \(did you mean 'l'\?\); known parameters: g, l, m$"):
+        dirac.load_system("pendulum", ll=1.0)
+    with pytest.raises(InputError, match=r"^system 'pendulum': unknown parameter 'colour'; known parameters: g, l, m$"):
+        dirac.load_system("pendulum", colour=1.0)
+
+
+def test_unknown_system_suggests_the_closest_built_in_names():
+    with pytest.raises(InputError, match=r"^unknown system 'pendulm' \(did you mean 'pendulum' or 'double_pendulum'\?\); "
+                                         r"known systems: double_pendulum, .*, spherical_pendulum; give a built-in name"):
+        dirac.load_system("pendulm")
+    with pytest.raises(InputError) as error:
+        dirac.load_system("xyzzy")
+    assert "did you mean" not in str(error.value) and "known systems: double_pendulum" in str(error.value)
 
 
 def test_load_by_path(tmp_path):

@@ -12,9 +12,9 @@ factories are joined here, so neither of those modules imports the other.
 
 from __future__ import annotations
 
-from dirac.errors import InputError
 from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
 from dirac.flows.methods.base import Method
+from dirac.validate import unknown_name_error
 
 __all__ = ["METHODS", "CONTRACT_NAMES", "get_method", "method_names"]
 
@@ -65,5 +65,5 @@ def get_method(name: str | Method) -> Method:
     if isinstance(name, Method):
         return name
     if name not in METHODS:
-        raise InputError(f"unknown method {name!r}; choose one of: {', '.join(method_names())}")
+        raise unknown_name_error("method", name, method_names())
     return METHODS[name]
