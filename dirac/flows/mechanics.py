@@ -27,7 +27,7 @@ import sympy
 
 from dirac.errors import InputError
 from dirac.model.lagrangian import Lagrangian
-from dirac.validate import validate_finite
+from dirac.validate import unknown_name_error, validate_finite
 
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
@@ -53,8 +53,7 @@ def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] |
     values = dict(lagrangian.parameter_values)
     for key, value in (parameters or {}).items():
         if key not in values:
-            known = ", ".join(sorted(values)) or "(none)"
-            raise InputError(f"system {lagrangian.name!r} has no parameter {key!r}; its parameters are: {known}")
+            raise unknown_name_error("parameter", key, values, source=f"system {lagrangian.name!r}")
         values[key] = validate_finite(value, f"parameter {key!r}")
     missing = sorted(k for k, v in values.items() if v is None)
     if missing:

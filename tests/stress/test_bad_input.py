@@ -232,7 +232,9 @@ def test_good_scene_runs_and_writes_a_complete_file(scene, run_scene):
 @SETTINGS
 @given(keys=st.lists(st.text(alphabet="abcdefghij_", min_size=3, max_size=8), min_size=1, max_size=3, unique=True),
        table=st.sampled_from(["system", "initial", "run"]))
-def test_unknown_keys_are_warned_about_by_name_and_the_run_goes_on(keys, table, run_scene):
+def test_unknown_keys_are_one_error_naming_the_file_the_table_and_every_key(keys, table, run_scene):
+    from cli_output import one_error_line
+
     scene = good_scene()
     known = {"system": {"name", "inertia", "description"}, "initial": {"M", "omega", "m", "R"},
              "run": {"t_end", "method", "dt", "tolerance", "samples", "outputs", "drift_limit",
@@ -240,11 +242,12 @@ def test_unknown_keys_are_warned_about_by_name_and_the_run_goes_on(keys, table, 
     assume(not set(keys) & known[table])
     for key in keys:
         scene[table][key] = 1.0
-    status, err, _ = run_scene(toml_document(scene))
-    assert status == 0, err
-    warnings = [line for line in err.splitlines() if line.startswith("warning:")]
-    assert len(warnings) == 1, err
-    assert all(key in warnings[0] for key in keys)
+    status, err, out = run_scene(toml_document(scene))
+    line = one_error_line(status, err)
+    assert line.startswith(f"error: {out.parent / 'scene.toml'}: [{table}] has "), line
+    assert all(repr(key) in line for key in keys)
+    assert line.endswith(f"known keys: {', '.join(sorted(known[table]))}")
+    assert not out.exists()
 
 
 # ----------------------------------------------------------------------------- system files
