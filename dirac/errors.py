@@ -7,7 +7,9 @@ internal failure (exit status 1). Messages name the offending item and say what 
 
 from __future__ import annotations
 
+import os
 import sys
+import types
 import warnings
 
 __all__ = [
@@ -69,7 +71,34 @@ def warn(message: str) -> None:
         One line that names the suspicious item and why it is suspicious.
     """
     line = " ".join(str(message).split())
-    warnings.warn(line, DiracWarning, stacklevel=2)
+    warnings.warn(line, DiracWarning, stacklevel=_user_stacklevel())
+
+
+#: folder of the ``dirac`` package; frames of files under it are the package's own
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def _in_package(frame) -> bool:
+    """Whether ``frame`` runs code of the package: a file in it, or code it generated
+    (dataclass methods, whose file is ``<string>`` but whose globals are a package module)."""
+    module = str(frame.f_globals.get("__name__", ""))
+    if module == "dirac" or module.startswith("dirac."):
+        return True
+    return os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE_DIR)
+
+
+def _user_stacklevel() -> int:
+    """``stacklevel`` for :func:`warnings.warn` called in :func:`warn`: the first frame outside the package.
+
+    Frame 1 is :func:`warn` itself; walking outwards past every frame of a file in the
+    ``dirac`` package finds the user's line (a script, a notebook cell, a test).
+    """
+    level = 1
+    frame: types.FrameType | None = sys._getframe(1)
+    while frame is not None and _in_package(frame):
+        frame = frame.f_back
+        level += 1
+    return level
 
 
 def install_warning_printer() -> None:

@@ -13,7 +13,7 @@ from typing import Any, Protocol
 
 import sympy
 
-from dirac.model.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian, latex_names
 
 __all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
 
@@ -121,9 +121,10 @@ def shared_form(exprs: dict) -> tuple[dict, dict]:
 def _latex(expr: sympy.Expr) -> str:
     if tree_size(expr) > TREE_LIMIT:
         return rf"\text{{(an expression of {tree_size(expr)} tree nodes; see --json)}}"
+    names = latex_names(expr)
     if len(sympy.sstr(expr, order="none")) <= ORDERED_LIMIT:
-        return sympy.latex(expr)
-    return sympy.latex(expr, order="none")
+        return sympy.latex(expr, symbol_names=names)
+    return sympy.latex(expr, order="none", symbol_names=names)
 
 
 def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:

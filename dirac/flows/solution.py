@@ -38,7 +38,7 @@ class Solution:
         Numerical parameters of the problem.
     """
 
-    t: np.ndarray
+    t: np.ndarray = field(repr=False)
     outputs: dict[str, np.ndarray]
     system: str
     method: str
@@ -63,6 +63,38 @@ class Solution:
 
     def __contains__(self, name: object) -> bool:
         return name == "t" or name in self.outputs
+
+    def _shapes(self) -> dict[str, tuple[int, ...]]:
+        shapes = {"t": tuple(np.shape(self.t))}
+        shapes.update({name: tuple(np.shape(value)) for name, value in self.outputs.items()})
+        return shapes
+
+    def __repr__(self) -> str:
+        """The fields, with the shapes of the arrays instead of their values."""
+        shapes = ", ".join(f"{name}{list(shape)}" for name, shape in self._shapes().items())
+        status = "complete" if self.complete else f"incomplete: {self.message}"
+        return (
+            f"Solution(system={self.system!r}, method={self.method!r}, order={self.order}, dt={self.dt!r}, "
+            f"steps={self.steps}, evaluations={self.evaluations}, cpu_seconds={self.cpu_seconds:.3g}, "
+            f"{status}, outputs: {shapes})"
+        )
+
+    def _repr_html_(self) -> str:
+        """A small table for Jupyter: system, method, steps, CPU time, outputs with their shapes."""
+        from html import escape
+
+        rows = [
+            ("system", self.system),
+            ("method", f"{self.method} (order {self.order})"),
+            ("dt", "(none: not a fixed-step method)" if self.dt is None else f"{self.dt:.6g}"),
+            ("steps", str(self.steps)),
+            ("evaluations", str(self.evaluations)),
+            ("CPU", f"{self.cpu_seconds:.3g} s"),
+            ("status", "complete" if self.complete else f"incomplete: {self.message}"),
+        ]
+        rows += [(f"output {name}", " × ".join(map(str, shape)) or "scalar") for name, shape in self._shapes().items()]
+        body = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td>{escape(v)}</td></tr>" for k, v in rows)
+        return f"<table><caption>dirac Solution</caption>{body}</table>"
 
     def meta(self) -> dict[str, object]:
         """The ``meta`` record of the result file (docs/file_formats.md)."""

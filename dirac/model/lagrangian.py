@@ -24,9 +24,10 @@ import sympy
 
 from dirac.errors import InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
+from dirac.model.from_sympy import plain_parts
 from dirac.validate import is_real_number, unknown_name_error, validate_finite
 
-__all__ = ["Lagrangian", "velocity_name", "momentum_name", "multiplier_name"]
+__all__ = ["Lagrangian", "velocity_name", "momentum_name", "multiplier_name", "latex_name", "latex_names"]
 
 _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
@@ -44,6 +45,28 @@ def momentum_name(coordinate: str) -> str:
 def multiplier_name(index: int) -> str:
     """Name of the multiplier of constraint ``index`` (1-based): ``lambda_1``, …"""
     return f"lambda_{index}"
+
+
+def latex_name(name: str) -> str:
+    """LaTeX of a symbol name, reading the generated names (docs/conventions.md).
+
+    ``x_dot`` -> ``\\dot{x}``, ``p_x`` -> ``p_{x}``, ``lambda_1`` -> ``\\lambda_{1}``,
+    ``p_lambda_1`` -> ``p_{\\lambda_{1}}``; other names as sympy writes them. The
+    symbols keep their names: only LaTeX renderings use this.
+    """
+    if name.endswith("_dot") and len(name) > 4:
+        return rf"\dot{{{latex_name(name[:-4])}}}"
+    if name.startswith("p_") and len(name) > 2:
+        return rf"p_{{{latex_name(name[2:])}}}"
+    return sympy.latex(sympy.Symbol(name))
+
+
+def latex_names(*exprs: sympy.Basic) -> dict[sympy.Symbol, str]:
+    """``symbol_names=`` for :func:`sympy.latex`: every free symbol of ``exprs`` -> :func:`latex_name`."""
+    found: set[sympy.Symbol] = set()
+    for e in exprs:
+        found |= {s for s in sympy.sympify(e).free_symbols if isinstance(s, sympy.Symbol)}
+    return {s: latex_name(s.name) for s in found}
 
 
 def _as_rational(value: float | int) -> sympy.Rational:
@@ -206,6 +229,35 @@ class Lagrangian:
                 raise InputError(f"parameter {label!r} = {value!r} is not a number")
         return cls(name, q, v, expr, chis, values, description)
 
+    @classmethod
+    def from_sympy(
+        cls,
+        L: sympy.Expr,
+        coordinates: Sequence[sympy.Basic],
+        constraints: Iterable[sympy.Expr] = (),
+        parameters: Mapping[sympy.Symbol | str, float | None] | Iterable[sympy.Symbol | str] | None = None,
+        name: str = "system",
+        description: str = "",
+    ) -> Lagrangian:
+        """Build a Lagrangian from sympy expressions: plain symbols or ``dynamicsymbols``.
+
+        Coordinates are symbols ``q`` (velocities written as symbols named ``q_dot``) or
+        functions of time ``q(t)`` from ``sympy.physics.mechanics.dynamicsymbols``
+        (velocities written as ``q(t).diff(t)``, replaced by ``q_dot``; ``q(t)`` by ``q``).
+        ``parameters=None`` makes every other symbol a parameter without a default. See
+        :func:`dirac.model.from_sympy.plain_parts`.
+
+        Examples
+        --------
+        >>> import sympy
+        >>> from sympy.physics.mechanics import dynamicsymbols
+        >>> x = dynamicsymbols("x")
+        >>> t, m, k = sympy.symbols("t m k")
+        >>> print(Lagrangian.from_sympy(m / 2 * x.diff(t) ** 2 - k / 2 * x**2, [x], name="oscillator"))
+        oscillator: L = -k*x**2/2 + m*x_dot**2/2
+        """
+        return cls(name, *plain_parts(L, coordinates, constraints, parameters, velocity_name), description)
+
     # ----------------------------------------------------------------- derived views
     @property
     def parameter_symbols(self) -> dict[str, sympy.Symbol]:
@@ -264,6 +316,18 @@ class Lagrangian:
     def with_defaults(self) -> Lagrangian:
         """All parameters that have a default value fixed to it (for numerical work)."""
         return self.fix(**{p.name: v for p, v in self.parameters.items() if v is not None})
+
+    def to_latex(self) -> str:
+        """``L`` and the constraints ``chi_k = 0`` as one ``aligned`` block (velocities as ``\\dot{q}``)."""
+        names = latex_names(self.expression, *self.constraints)
+        rows = [rf"L &= {sympy.latex(self.expression, symbol_names=names)}"]
+        rows += [
+            rf"\chi_{{{k}}} &= {sympy.latex(c, symbol_names=names)} = 0" for k, c in enumerate(self.constraints, start=1)
+        ]
+        return "\\begin{aligned}\n" + " \\\\\n".join(rows) + "\n\\end{aligned}"
+
+    def _repr_latex_(self) -> str:
+        return f"$${self.to_latex()}$$"
 
     def __str__(self) -> str:
         lines = [f"{self.name}: L = {self.expression}"]

@@ -136,7 +136,7 @@ def test_hamiltonians(analysis):
 
 def test_reports_render(analysis):
     latex = analysis._repr_latex_()
-    assert latex.startswith("$$") and r"\begin{aligned}" in latex and "p_{\\lambda 1} = 0" in latex
+    assert latex.startswith("$$") and r"\begin{aligned}" in latex and "p_{\\lambda_{1}} = 0" in latex
     text = analysis.to_text()
     assert "stage 4: 1 constraint(s)" in text and "physical degrees of freedom" in text
     data = analysis.to_json()

@@ -1,0 +1,136 @@
+"""Lagrangians written as sympy expressions: plain symbols or ``sympy.physics.mechanics.dynamicsymbols``.
+
+:func:`plain_parts` (behind :meth:`dirac.Lagrangian.from_sympy`) turns
+``L``, the coordinates and the constraints into the symbols the engine uses
+(docs/conventions.md): every coordinate becomes a real symbol ``q`` and its velocity the
+real symbol ``q_dot``. A coordinate may be
+
+- a plain :class:`sympy.Symbol` ``q``: ``L`` then writes its velocity as a symbol named
+  ``q_dot``;
+- a function of time ``q(t)`` (``dynamicsymbols("q")``): ``L`` writes its velocity as the
+  time derivative ``q(t).diff(t)``, which becomes ``q_dot``, and ``q(t)`` becomes ``q``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping, Sequence
+
+import sympy
+from sympy.core.function import AppliedUndef
+
+from dirac.errors import InputError
+
+__all__ = ["plain_parts", "Parts"]
+
+#: (coordinates, velocities, L, constraints, parameter -> default), in the engine's symbols
+Parts = tuple[
+    tuple[sympy.Symbol, ...], tuple[sympy.Symbol, ...], sympy.Expr, tuple[sympy.Expr, ...], dict[sympy.Symbol, float | None]
+]
+
+
+def _time_of(coordinate: sympy.Basic) -> sympy.Symbol | None:
+    """The time symbol of a coordinate ``q(t)``, ``None`` for a plain symbol."""
+    if isinstance(coordinate, sympy.Symbol):
+        return None
+    if isinstance(coordinate, AppliedUndef) and len(coordinate.args) == 1 and isinstance(coordinate.args[0], sympy.Symbol):
+        return coordinate.args[0]
+    raise InputError(
+        f"coordinate {coordinate!r} must be a sympy Symbol or a function of time such as "
+        "dynamicsymbols('x') (x(t))"
+    )
+
+
+def _name_of(coordinate: sympy.Basic) -> str:
+    return coordinate.name if isinstance(coordinate, sympy.Symbol) else type(coordinate).__name__
+
+
+def plain_parts(
+    L: sympy.Expr,
+    coordinates: Sequence[sympy.Basic],
+    constraints: Iterable[sympy.Expr],
+    parameters: Mapping[sympy.Symbol | str, float | None] | Iterable[sympy.Symbol | str] | None,
+    velocity_name: Callable[[str], str],
+) -> Parts:
+    """The parts of a :class:`~dirac.model.lagrangian.Lagrangian` from sympy expressions.
+
+    Parameters
+    ----------
+    L
+        The Lagrangian ``L(q, q_dot)``.
+    coordinates
+        Plain symbols ``q`` (velocities written as symbols named ``q_dot``) or functions
+        of one time symbol ``q(t)`` (velocities written as ``q(t).diff(t)``); not mixed
+        over different time symbols.
+    constraints
+        Holonomic constraints ``chi(q)`` (expressions that should be zero).
+    parameters
+        Parameter -> default value (``None`` for none), or just the parameters; ``None``
+        makes every other symbol of ``L`` and the constraints a parameter without default.
+    velocity_name
+        The name of the velocity of a coordinate (``x`` -> ``x_dot``).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> from sympy.physics.mechanics import dynamicsymbols
+    >>> x = dynamicsymbols("x")
+    >>> t, m, k = sympy.symbols("t m k")
+    >>> plain_parts(m / 2 * x.diff(t) ** 2 - k / 2 * x**2, [x], (), None, lambda q: q + "_dot")[1]
+    (x_dot,)
+    """
+    if isinstance(coordinates, (str, sympy.Basic)) or not isinstance(coordinates, Sequence):
+        raise InputError("coordinates must be a list of sympy symbols or dynamicsymbols, e.g. [x, y]")
+    if isinstance(constraints, (str, sympy.Basic)):
+        raise InputError("constraints must be a list of sympy expressions, e.g. [x**2 + y**2 - l**2]")
+    expr = sympy.sympify(L)
+    chis = [sympy.sympify(c) for c in constraints]
+    times = {_time_of(c) for c in coordinates} - {None}
+    if len(times) > 1:
+        raise InputError(f"the coordinates depend on different time symbols {sorted(map(str, times))}: use one")
+    labels = [_name_of(c) for c in coordinates]
+    duplicates = sorted({label for label in labels if labels.count(label) > 1})
+    if duplicates:
+        raise InputError(f"coordinate(s) {', '.join(duplicates)} listed twice")
+    q = {label: sympy.Symbol(label, real=True) for label in labels}
+    v = {label: sympy.Symbol(velocity_name(label), real=True) for label in labels}
+
+    # dynamicsymbols: q(t).diff(t) -> q_dot first, then q(t) -> q
+    derivatives = {c.diff(_time_of(c)): v[label] for c, label in zip(coordinates, labels) if _time_of(c) is not None}
+    functions = {c: q[label] for c, label in zip(coordinates, labels) if _time_of(c) is not None}
+
+    def plain(e: sympy.Expr) -> sympy.Expr:
+        return e.subs(derivatives).subs(functions) if derivatives else e
+
+    expr = plain(expr)
+    chis = [plain(c) for c in chis]
+    for e in (expr, *chis):
+        left = sorted(str(d) for d in e.atoms(sympy.Derivative, AppliedUndef))
+        if left:
+            raise InputError(
+                f"{', '.join(left)} is not a coordinate or the first time derivative of one: "
+                "list every coordinate, and use velocities only (no accelerations)"
+            )
+
+    # every symbol by name -> the engine's real symbol of that name
+    own = {s.name: s for s in (*q.values(), *v.values())}
+    if parameters is None:
+        found = set().union(*(e.free_symbols for e in (expr, *chis)))
+        values: dict[str, float | None] = {
+            label: None for label in sorted(s.name for s in found if s.name not in own and s not in times)
+        }
+    elif isinstance(parameters, Mapping):
+        values = {str(p): value for p, value in parameters.items()}
+    else:
+        values = {str(p): None for p in parameters}
+    params = {label: sympy.Symbol(label, real=True) for label in values}
+    by_name = {**own, **params}
+    renaming = {s: by_name[s.name] for e in (expr, *chis) for s in e.free_symbols if s.name in by_name}
+    expr = expr.xreplace(renaming)
+    chis = [c.xreplace(renaming) for c in chis]
+    return (
+        tuple(q.values()),
+        tuple(v.values()),
+        expr,
+        tuple(chis),
+        {params[label]: value for label, value in values.items()},
+    )

@@ -1,0 +1,77 @@
+"""`Lagrangian.from_sympy`: plain symbols and `sympy.physics.mechanics.dynamicsymbols` give the
+same Lagrangian, and the same Dirac-Bergmann analysis, as the string form."""
+
+from __future__ import annotations
+
+import pytest
+import sympy
+from sympy.physics.mechanics import dynamicsymbols
+
+import dirac
+from dirac.errors import InputError
+from dirac.model.lagrangian import Lagrangian
+
+PARAMETERS = {"m": 1.0, "g": 9.81, "l": 1.0}
+
+
+def string_pendulum() -> Lagrangian:
+    return Lagrangian.from_strings("pendulum", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",
+                                   constraints=["x**2 + y**2 - l**2"], parameters=PARAMETERS)
+
+
+def dynamic_pendulum() -> Lagrangian:
+    x, y = dynamicsymbols("x y")
+    t = dynamicsymbols._t
+    m, g, l = sympy.symbols("m g l", positive=True)
+    L = m / 2 * (x.diff(t) ** 2 + y.diff(t) ** 2) - m * g * y
+    return Lagrangian.from_sympy(L, [x, y], constraints=[x**2 + y**2 - l**2],
+                                 parameters={m: 1.0, g: 9.81, l: 1.0}, name="pendulum")
+
+
+def test_dynamicsymbols_give_the_string_form():
+    assert dynamic_pendulum() == string_pendulum()
+
+
+def test_plain_symbols_give_the_string_form():
+    x, y, x_dot, y_dot, m, g, l = sympy.symbols("x y x_dot y_dot m g l")  # no assumptions: made real
+    L = m / 2 * (x_dot**2 + y_dot**2) - m * g * y
+    built = Lagrangian.from_sympy(L, [x, y], [x**2 + y**2 - l**2], parameters=PARAMETERS, name="pendulum")
+    assert built == string_pendulum()
+
+
+def test_dynamicsymbols_pendulum_has_the_same_analysis_as_the_string_form():
+    # pendulum of docs/conventions.md: four second-class constraints in four stages
+    # (p_lambda = 0, chi = 0, its time derivative, its second derivative), no gauge freedom
+    a, b = dirac.analyze(dynamic_pendulum()), dirac.analyze(string_pendulum())
+    assert [len(s) for s in a.stages] == [1, 1, 1, 1]
+    assert [[sympy.simplify(c - d) for c, d in zip(s, r)] for s, r in zip(a.stages, b.stages)] == [[0]] * 4
+    assert len(a.first_class) == 0 and len(a.second_class) == 4
+    assert a.physical_degrees_of_freedom == 1
+    x, y, px, py = (a.symbols[n] for n in ("x", "y", "p_x", "p_y"))
+    for f, g in [(x, px), (x, y), (px, py), (x, py)]:
+        assert sympy.simplify(a.dirac_bracket(f, g) - b.dirac_bracket(f, g)) == 0
+    # by hand: {x, p_x}* = 1 - x^2/(x^2+y^2) = y^2/l^2 on the circle; {x, y}* = 0
+    assert sympy.simplify(a.dirac_bracket(x, px).subs(y**2, 1 - x**2) - (1 - x**2)) == 0
+    assert a.dirac_bracket(x, y) == 0
+
+
+def test_parameters_none_makes_the_other_symbols_parameters_without_default():
+    q = dynamicsymbols("q")
+    t = dynamicsymbols._t
+    m, k = sympy.symbols("m k")
+    L = Lagrangian.from_sympy(m / 2 * q.diff(t) ** 2 - k / 2 * q**2, [q], name="oscillator")
+    assert [s.name for s in L.coordinates] == ["q"] and [s.name for s in L.velocities] == ["q_dot"]
+    assert L.parameter_values == {"k": None, "m": None}
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda q, t: (q.diff(t, 2) + q.diff(t) ** 2, [q]), "no accelerations"),
+    (lambda q, t: (q.diff(t) ** 2 + t * q, [q]), "unknown names: t"),
+    (lambda q, t: (q.diff(t) ** 2, [q, q]), "listed twice"),
+    (lambda q, t: (q.diff(t) ** 2, [q**2]), "must be a sympy Symbol or a function of time"),
+])
+def test_refusals_say_what_to_do(make, message):
+    q = dynamicsymbols("q")
+    L, coordinates = make(q, dynamicsymbols._t)
+    with pytest.raises(InputError, match=message):
+        Lagrangian.from_sympy(L, coordinates)
