@@ -45,6 +45,7 @@ __all__ = [
     "load_scene",
     "write_results",
     "read_results",
+    "plot",
 ]
 
 #: public name -> module that defines it (imported on first access)
@@ -61,6 +62,7 @@ _LAZY: dict[str, str] = {
     "load_scene": "dirac.io.scene",
     "write_results": "dirac.io.results",
     "read_results": "dirac.io.results",
+    "plot": "dirac.plots.results",
 }
 
 

@@ -23,8 +23,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser.add_argument("--t-end", type=float, default=None, help="final time (default 1000)")
     parser.add_argument("--dt", type=float, default=None, help="step size for fixed-step methods (default 0.01)")
     parser.add_argument("--out", metavar="FILE.npz", default=None, help="also write the results")
-    parser.add_argument("--plot", metavar="FILE.png", default=None,
-                        help="also draw the run: polhode, body axes, M(t), conserved-quantity errors (needs matplotlib)")
+    parser.add_argument("--plot", metavar="FILE", default=None,
+                        help="also draw the run (png, pdf, svg, ...: the suffix names the format): polhode, body axes, "
+                        "M(t), conserved-quantity errors (needs matplotlib)")
     parser.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     return parser
 
@@ -40,9 +41,9 @@ def main(args: argparse.Namespace) -> int:
 
     plot_path = None
     if args.plot:  # checked before the run, so that a bad name fails fast
-        from dirac.plots.canvas import check_png_path
+        from dirac.plots.canvas import check_plot_path
 
-        plot_path = check_png_path(args.plot)
+        plot_path = check_plot_path(args.plot)
     data = copy.deepcopy(FLAGSHIP_SCENE)
     run = data["run"]
     assert isinstance(run, dict)

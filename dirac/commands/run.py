@@ -1,4 +1,4 @@
-"""``dirac run SCENE.toml [--out FILE.npz] [--plot FILE.png] [--no-progress]``: run a scene, write its results.
+"""``dirac run SCENE.toml [--out FILE.npz] [--plot FILE] [--no-progress]``: run a scene, write its results.
 
 The results (docs/file_formats.md) are written atomically. When the integration stops early
 (non-finite state, Newton non-convergence, constraint drift, Ctrl-C or SIGTERM) the
@@ -30,9 +30,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
     parser.add_argument("--out", metavar="FILE.npz", help="result file (default: the scene's name with .npz)")
-    parser.add_argument("--plot", metavar="FILE.png", default=None,
-                        help="also draw the run (rigid body: polhode, body axes, errors; other systems: path, "
-                        "coordinates, errors); needs matplotlib")
+    parser.add_argument("--plot", metavar="FILE", default=None,
+                        help="also draw the run, in the format of FILE's suffix (png, pdf, svg, ...): each system "
+                        "with the errors of its own conserved quantities; needs matplotlib")
     parser.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     return parser
 
@@ -84,9 +84,9 @@ def main(args: argparse.Namespace) -> int:
         raise InputError(f"--out {str(out)!r}: directory {str(out.parent)!r} does not exist")
     plot_path = None
     if args.plot:  # checked before the run, so that a bad name fails fast
-        from dirac.plots.canvas import check_png_path
+        from dirac.plots.canvas import check_plot_path
 
-        plot_path = check_png_path(args.plot)
+        plot_path = check_plot_path(args.plot)
     scene = load_scene(scene_path)
     progress = (not args.no_progress) and sys.stderr.isatty()
 
@@ -124,7 +124,6 @@ def main(args: argparse.Namespace) -> int:
     if plot_path is not None:
         from dirac.plots import plot_result
 
-        names = getattr(getattr(scene.problem, "mechanics", None), "coordinate_names", None)
-        plot_result(solution, plot_path, coordinates=names)
+        plot_result(solution, plot_path, problem=scene.problem)
         print(f"picture written to {plot_path}")
     return 0

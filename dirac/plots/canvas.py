@@ -13,7 +13,7 @@ from typing import Any
 
 from dirac.errors import InputError
 
-__all__ = ["new_figure", "save_png", "check_png_path"]
+__all__ = ["new_figure", "plot_formats", "check_plot_path", "save_figure", "save_png", "check_png_path"]
 
 
 def _require_matplotlib() -> None:
@@ -37,23 +37,53 @@ def new_figure(width: float, height: float) -> Any:
     return fig
 
 
-def check_png_path(path: str | Path) -> Path:
-    """Validate the target of a ``--plot FILE.png`` option and return it as a :class:`Path`.
+def plot_formats() -> dict[str, str]:
+    """The file formats matplotlib writes here, by suffix (``{"png": "Portable Network Graphics", ...}``)."""
+    _require_matplotlib()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    return dict(sorted(FigureCanvasAgg.get_supported_filetypes().items()))
+
+
+def check_plot_path(path: str | Path) -> Path:
+    """Validate the target of a ``--plot FILE`` option and return it as a :class:`Path`.
+
+    The suffix chooses the format: any that matplotlib writes (png, pdf, svg, eps, ...).
 
     Raises
     ------
     dirac.errors.InputError
-        If the name does not end in ``.png``, its folder does not exist, or matplotlib is
-        not installed (so that a run with ``--plot`` fails before it starts, not after).
+        If the suffix is not a format matplotlib writes (the message lists them), the
+        folder does not exist, or matplotlib is not installed (so that a run with
+        ``--plot`` fails before it starts, not after).
     """
     target = Path(path)
-    if target.suffix.lower() != ".png":
-        raise InputError(f"plot file {str(path)!r} must end in .png (for example --plot motion.png)")
+    formats = plot_formats()
+    suffix = target.suffix.lower().lstrip(".")
+    if suffix not in formats:
+        known = ", ".join(f".{name}" for name in formats)
+        what = f"suffix .{suffix}" if suffix else "no suffix"
+        raise InputError(f"plot file {str(path)!r} has {what}, not a picture format matplotlib writes; "
+                         f"use one of {known} (for example --plot motion.png or --plot motion.pdf)")
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise InputError(f"folder {str(folder)!r} of the plot file {str(path)!r} does not exist: create it first")
-    _require_matplotlib()
     return target
+
+
+def save_figure(fig: Any, path: str | Path, dpi: int = 110) -> Path:
+    """Write ``fig`` in the format its suffix names (validated by :func:`check_plot_path`)."""
+    target = check_plot_path(path)
+    fig.savefig(target, dpi=dpi, format=target.suffix.lower().lstrip("."))
+    return target
+
+
+def check_png_path(path: str | Path) -> Path:
+    """Like :func:`check_plot_path`, for a file that must be a PNG."""
+    target = Path(path)
+    if target.suffix.lower() != ".png":
+        raise InputError(f"plot file {str(path)!r} must end in .png (for example --plot motion.png)")
+    return check_plot_path(target)
 
 
 def save_png(fig: Any, path: str | Path, dpi: int = 110) -> Path:

@@ -8,7 +8,7 @@ constraint residual over time.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -18,6 +18,9 @@ from dirac.plots.canvas import new_figure
 from dirac.plots.rigid_body import draw_conservation
 
 __all__ = ["draw_configuration", "draw_coordinates", "constrained_errors", "constrained_figure"]
+
+#: a general system has no fixed units: every axis says "system units"
+_TIME = "time $t$ (system units)"
 
 
 def _names(names: Sequence[str] | None, n: int) -> list[str]:
@@ -50,17 +53,24 @@ def draw_coordinates(ax: Any, t: np.ndarray, q: np.ndarray, names: Sequence[str]
     """Draw every coordinate ``q_i(t)`` against time."""
     for k, name in enumerate(names):
         ax.plot(t, q[:, k], linewidth=1.3, label=_math(name))
-    ax.set_xlabel("time $t$ [s]")
+    ax.set_xlabel(_TIME)
     ax.set_ylabel("coordinate value (system units)")
     ax.grid(True, alpha=0.3)
     ax.set_title("Coordinates over time", fontsize=11)
     ax.legend(fontsize=8, loc="best", ncol=min(4, len(names)))
 
 
-def constrained_errors(energy: Any | None, constraint_residual: Any | None) -> dict[str, np.ndarray]:
-    """Relative energy error ``|E - E0| / |E0|`` and the constraint residual, by legend label.
+def constrained_errors(
+    energy: Any | None,
+    constraint_residual: Any | None,
+    constraints: Mapping[str, Any] | None = None,
+) -> dict[str, np.ndarray]:
+    """Energy error and constraint residuals, by legend label.
 
-    A zero initial energy is measured absolutely (``|E - E0|``) and labelled so.
+    The energy error is relative, ``|E - E0| / |E0|`` (absolute, and labelled so, when
+    ``E0 = 0``). With ``constraints`` (name -> residual samples) every constraint gets its
+    own curve ``|chi_a|``; otherwise the run's ``constraint_residual`` output
+    (``max_a |chi_a|`` over the constraints) is drawn as one curve.
     """
     errors: dict[str, np.ndarray] = {}
     if energy is not None:
@@ -70,8 +80,12 @@ def constrained_errors(energy: Any | None, constraint_residual: Any | None) -> d
             errors[r"energy $|E-E_0|/|E_0|$"] = np.abs(E - E[0]) / scale
         else:
             errors[r"energy $|E-E_0|$ ($E_0=0$)"] = np.abs(E - E[0])
-    if constraint_residual is not None:
-        errors[r"constraint residual $|\chi(q)|$"] = np.abs(np.asarray(constraint_residual, dtype=float).reshape(-1))
+    if constraints:
+        for name, values in constraints.items():
+            errors[f"constraint {name}"] = np.abs(np.asarray(values, dtype=float).reshape(-1))
+    elif constraint_residual is not None:
+        errors[r"largest constraint residual $\max_a|\chi_a|$"] = np.abs(
+            np.asarray(constraint_residual, dtype=float).reshape(-1))
     return errors
 
 
@@ -83,6 +97,7 @@ def constrained_figure(
     constraint_residual: Any | None = None,
     names: Sequence[str] | None = None,
     title: str | None = None,
+    constraints: Mapping[str, Any] | None = None,
 ) -> Any:
     """The three-panel picture of a constrained-system run.
 
@@ -93,6 +108,9 @@ def constrained_figure(
         Coordinates at the sample times.
     energy, constraint_residual : array_like, shape (n,), optional
         Outputs of the run; drawn as errors over time (:func:`constrained_errors`).
+    constraints : mapping of str to array_like, shape (n,), optional
+        The residual of each constraint by name; one curve each, in place of
+        ``constraint_residual``.
     names : sequence of str, optional
         Coordinate names (default ``q_1 … q_d``).
     title : str, optional
@@ -108,7 +126,7 @@ def constrained_figure(
     if q.ndim != 2 or q.shape[0] != t.size or t.size == 0:
         raise InputError(f"q must have shape ({t.size}, d) to match t; got {q.shape}")
     labels = _names(names, q.shape[1])
-    errors = constrained_errors(energy, constraint_residual)
+    errors = constrained_errors(energy, constraint_residual, constraints)
     fig = new_figure(13.0, 9.5)
     grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=0.12, top=0.93, wspace=0.2, hspace=0.3)
     if q.shape[1] >= 2:
@@ -118,6 +136,6 @@ def constrained_figure(
         draw_coordinates(fig.add_subplot(grid[0, :]), t, q, labels)
     if errors:
         draw_conservation(fig.add_subplot(grid[1, :]), t, errors,
-                          ylabel="largest error so far (see legend)")
+                          ylabel="error (see legend)", time_label=_TIME)
     fig.suptitle(title or "Constrained system", fontsize=12)
     return fig

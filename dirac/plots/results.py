@@ -1,9 +1,9 @@
-"""Draw a run's result -- a :class:`dirac.flows.Solution` or a result file -- as one PNG.
+"""Draw a run's result -- a :class:`dirac.flows.Solution` or a result file -- as one picture.
 
-This is what ``dirac run SCENE --plot FILE.png`` and ``dirac demo --plot FILE.png`` call.
-The picture is chosen from the outputs present (docs/file_formats.md): ``M`` (and ``R``) give
-the rigid-body picture (:func:`dirac.plots.rigid_body.rigid_body_figure`), ``q`` the
-constrained-system picture (:func:`dirac.plots.constrained.constrained_figure`).
+This is what ``dirac.plot``, ``dirac run SCENE --plot FILE`` and ``dirac demo --plot FILE``
+call (FILE in any format matplotlib writes: png, pdf, svg, ...). The picture is chosen by the
+kind of system, from the outputs present and the ``meta`` record (docs/file_formats.md):
+see :func:`result_figure`.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 
 from dirac.errors import InputError
-from dirac.plots.canvas import check_png_path, save_png
+from dirac.plots.canvas import check_plot_path, save_figure
 
-__all__ = ["result_figure", "plot_result", "load_result"]
+__all__ = ["plot", "result_figure", "plot_result", "load_result"]
 
 
 def load_result(path: str | Path) -> dict[str, Any]:
@@ -79,8 +79,56 @@ def _title(meta: Mapping[str, Any], default: str) -> str:
     return ",  ".join(parts)
 
 
-def result_figure(result: Any, coordinates: Sequence[str] | None = None) -> Any:
-    """The picture of one run (see the module docstring); returns a matplotlib Figure.
+def _constraint_residuals(result: Any, problem: Any) -> dict[str, np.ndarray] | None:
+    """Each constraint's residual along the run, by mathtext label, when ``problem`` can tell.
+
+    ``problem.mechanics`` (a compiled holonomic system, duck-typed so that this layer imports
+    no engine module) gives ``residuals(q, p) -> (chi(q), G M^{-1} p)``: the position
+    constraints ``chi_a`` and their tangency conditions ``dchi_a/dt`` (the second-stage
+    constraints of the Dirac analysis, Sect. X), one curve each; the latter only when the run
+    kept the momenta ``p``.
+    """
+    mechanics = getattr(problem, "mechanics", None)
+    if mechanics is None or not hasattr(mechanics, "residuals") or not _has(result, "q"):
+        return None
+    q = _first_body(_get(result, "q"), 2)
+    with_momenta = _has(result, "p")  # without p only the position constraints chi_a can be formed
+    p = _first_body(_get(result, "p"), 2) if with_momenta else np.zeros_like(q)
+    pairs = [mechanics.residuals(a, b) for a, b in zip(q, p)]
+    if not pairs or np.asarray(pairs[0][0]).size == 0:
+        return None
+    chi = np.array([np.asarray(c, dtype=float) for c, _ in pairs])
+    tangent = np.array([np.asarray(v, dtype=float) for _, v in pairs])
+    expressions = list(getattr(mechanics, "symbolic", {}).get("constraints", []))
+    residuals: dict[str, np.ndarray] = {}
+    for a in range(chi.shape[1]):
+        text = f", $\\chi_{{{a + 1}}} = {expressions[a]}$".replace("**", "^") if a < len(expressions) else ""
+        residuals[f"$|\\chi_{{{a + 1}}}|${text}"] = np.abs(chi[:, a])
+    for a in range(tangent.shape[1] if with_momenta else 0):
+        residuals[f"$|\\dot\\chi_{{{a + 1}}}|$ (velocity)"] = np.abs(tangent[:, a])
+    return residuals
+
+
+def _kind(result: Any, meta: Mapping[str, Any]) -> str:
+    if _has(result, "M"):
+        parameters = meta.get("parameters") or {}
+        heavy = meta.get("system") == "heavy_top" or "mass_gravity" in parameters or _has(result, "lab_momentum_z")
+        return "heavy_top" if heavy else "rigid_body"
+    if _has(result, "q"):
+        return "constrained"
+    raise InputError("the result has neither 'M' (rigid body) nor 'q' (constrained system) among its outputs: "
+                     "add \"M\" or \"q\" to outputs in the scene's [run] table to draw it")
+
+
+def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem: Any | None = None) -> Any:
+    """The picture of one run, chosen by the kind of system; returns a matplotlib Figure.
+
+    - free rigid body (``M``): polhode, body axes, ``M(t)`` and the errors of ``H_0``,
+      ``|M|^2``, ``m = R M`` and ``R^T R`` (:func:`dirac.plots.rigid_body.rigid_body_figure`);
+    - heavy top (``M`` with gravity): body axes, ``M(t)`` and the errors of the total
+      energy, ``m_z`` and ``R^T R`` (:func:`dirac.plots.rigid_body.heavy_top_figure`);
+    - constrained system (``q``): path, coordinates, the energy error and every
+      constraint's residual (:func:`dirac.plots.constrained.constrained_figure`).
 
     Parameters
     ----------
@@ -89,7 +137,11 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None) -> Any:
         ``q``/``energy``/``constraint_residual``) and a ``meta`` record (dict, JSON
         string, or a ``meta()`` method). A batched result is drawn for its first state.
     coordinates : sequence of str, optional
-        Names of the coordinates ``q`` (default: ``meta["coordinates"]``, else ``q_1 …``).
+        Names of the coordinates ``q`` (default: ``meta["coordinates"]``, the problem's
+        names, else ``q_1 …``).
+    problem : optional
+        The problem that was integrated; for a constrained system it gives one residual
+        curve per constraint (otherwise the run's largest residual is drawn).
 
     Raises
     ------
@@ -100,35 +152,77 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None) -> Any:
         raise InputError("the result has no sample times 't'; nothing to draw")
     t = np.asarray(_get(result, "t"), dtype=float)
     meta = _meta(result)
-    if _has(result, "M"):
-        from dirac.plots.rigid_body import rigid_body_figure
+    kind = _kind(result, meta)
+    if kind in ("rigid_body", "heavy_top"):
+        from dirac.plots.rigid_body import heavy_top_figure, rigid_body_figure
 
-        inertia = (meta.get("parameters") or {}).get("inertia")
+        parameters = meta.get("parameters") or {}
+        inertia = parameters.get("inertia")
         if inertia is None:
             raise InputError("the result's meta has no parameters.inertia: cannot draw the energy ellipsoid")
         M = _first_body(_get(result, "M"), 2)
         R = _first_body(_get(result, "R"), 3) if _has(result, "R") else None
-        return rigid_body_figure(t, M, R, inertia, title=_title(meta, "rigid body"))
-    if _has(result, "q"):
-        from dirac.plots.constrained import constrained_figure
-
-        q = _first_body(_get(result, "q"), 2)
+        if kind == "rigid_body":
+            return rigid_body_figure(t, M, R, inertia, title=_title(meta, "rigid body"))
+        weight = None
+        if "center_of_mass" in parameters:
+            weight = float(parameters.get("mass_gravity", 1.0)) * np.asarray(parameters["center_of_mass"], dtype=float)
         energy = _first_body(_get(result, "energy"), 1) if _has(result, "energy") else None
-        residual = (
-            _first_body(_get(result, "constraint_residual"), 1) if _has(result, "constraint_residual") else None
-        )
-        names = list(coordinates) if coordinates is not None else meta.get("coordinates")
-        return constrained_figure(t, q, energy=energy, constraint_residual=residual, names=names,
-                                  title=_title(meta, "constrained system"))
-    raise InputError("the result has neither 'M' (rigid body) nor 'q' (constrained system) among its outputs: "
-                     "add \"M\" or \"q\" to outputs in the scene's [run] table to draw it")
+        m_z = _first_body(_get(result, "lab_momentum_z"), 1) if _has(result, "lab_momentum_z") else None
+        return heavy_top_figure(t, M, R, inertia, weight, energy=energy, lab_momentum_z=m_z,
+                                title=_title(meta, "heavy top"))
+    from dirac.plots.constrained import constrained_figure
+
+    q = _first_body(_get(result, "q"), 2)
+    energy = _first_body(_get(result, "energy"), 1) if _has(result, "energy") else None
+    residual = _first_body(_get(result, "constraint_residual"), 1) if _has(result, "constraint_residual") else None
+    names = list(coordinates) if coordinates is not None else meta.get("coordinates")
+    if names is None:
+        names = getattr(getattr(problem, "mechanics", None), "coordinate_names", None)
+    return constrained_figure(t, q, energy=energy, constraint_residual=residual, names=names,
+                              title=_title(meta, "constrained system"),
+                              constraints=_constraint_residuals(result, problem))
 
 
-def plot_result(result: Any, path: str | Path, coordinates: Sequence[str] | None = None) -> Path:
-    """Draw ``result`` (see :func:`result_figure`) and write it to the PNG file ``path``.
+def plot(solution: Any, problem: Any | None = None, *, coordinates: Sequence[str] | None = None) -> Any:
+    """Draw a run as a matplotlib Figure (``dirac.plot``), chosen by the kind of system.
+
+    The panels show each system's own conserved quantities as errors against time on
+    logarithmic axes (see :func:`result_figure`). Save the figure with
+    ``fig.savefig("motion.pdf")`` (any format matplotlib writes) or show it in a notebook.
+
+    Parameters
+    ----------
+    solution : dirac.Solution or mapping
+        What :func:`dirac.integrate` returned, or a result file read by
+        :func:`dirac.read_results` / :func:`load_result`.
+    problem : optional
+        The problem that was integrated (gives one residual curve per constraint).
+    coordinates : sequence of str, optional
+        Names of the coordinates of a constrained system.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import dirac
+    >>> problem = dirac.RigidBodyProblem(inertia=[2.0, 1.5, 1.0], M0=[0.3, 0.2, 1.0])
+    >>> fig = dirac.plot(dirac.integrate(problem, t_end=1.0, dt=0.1, method="lie-poisson-2"))
+    >>> type(fig).__name__
+    'Figure'
+    """
+    return result_figure(solution, coordinates, problem)
+
+
+def plot_result(
+    result: Any, path: str | Path, coordinates: Sequence[str] | None = None, problem: Any | None = None
+) -> Path:
+    """Draw ``result`` (see :func:`result_figure`) and write it to ``path``, in the format its suffix names.
 
     ``path`` is checked before any drawing, so a bad name fails fast.
     """
-    target = check_png_path(path)
-    fig = result_figure(result, coordinates)
-    return save_png(fig, target)
+    target = check_plot_path(path)
+    fig = result_figure(result, coordinates, problem)
+    return save_figure(fig, target)

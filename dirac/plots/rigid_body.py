@@ -39,6 +39,8 @@ __all__ = [
     "draw_conservation",
     "draw_momentum",
     "rigid_body_figure",
+    "heavy_top_errors",
+    "heavy_top_figure",
 ]
 
 #: colours of the three principal axes (x, y, z convention: red, green, blue)
@@ -225,25 +227,33 @@ def draw_body_axes(ax: Any, R: Any, M: Any | None = None) -> None:
 
 
 def draw_conservation(
-    ax: Any, t: Any, errors: dict[str, np.ndarray], ylabel: str = "largest relative error so far (dimensionless)"
+    ax: Any,
+    t: Any,
+    errors: dict[str, np.ndarray],
+    ylabel: str = "relative error (dimensionless)",
+    time_label: str = "time $t$ [s]",
 ) -> None:
     """Draw the errors of conserved quantities against time on a logarithmic axis.
 
-    Each curve is the running maximum ``max_{s <= t} err(s)`` (the largest error so far),
-    which keeps round-off-level noise readable; a bounded error shows as a plateau, a
-    drift as a rising line. Errors of exactly zero are drawn at :data:`ERROR_FLOOR`; the
-    double-precision round-off level ``2.2e-16`` is marked for reference.
+    Each quantity is drawn twice in its own colour: the error itself at every sample (solid
+    line), so that a bounded oscillation can be told from a drift, and its running maximum
+    ``max_{s <= t} err(s)`` (thin dashed line), the envelope a user quotes. Errors of
+    exactly zero are drawn at :data:`ERROR_FLOOR`; the double-precision round-off level
+    ``2.2e-16`` is marked for reference.
     """
     t = np.asarray(t, dtype=float)
-    styles = ("-", "--", "-.", ":")
     for k, (label, values) in enumerate(errors.items()):
-        running = np.maximum.accumulate(np.maximum(np.asarray(values, dtype=float), ERROR_FLOOR))
-        ax.semilogy(t, running, linestyle=styles[k % 4], linewidth=1.6, label=label)
+        colour = f"C{k % 10}"
+        error = np.maximum(np.asarray(values, dtype=float), ERROR_FLOOR)
+        ax.semilogy(t, error, color=colour, linewidth=1.2, label=label)
+        ax.semilogy(t, np.maximum.accumulate(error), color=colour, linewidth=0.8, linestyle="--", alpha=0.7)
+    if errors:
+        ax.plot([], [], color="0.3", linewidth=0.8, linestyle="--", label="(dashed: largest error so far)")
     eps = np.finfo(float).eps
     ax.axhline(eps, color="0.5", linewidth=0.8, linestyle=(0, (1, 3)))
     ax.annotate("double-precision round-off $2.2\\times10^{-16}$", (1.0, eps), xycoords=("axes fraction", "data"),
                 xytext=(-4, 3), textcoords="offset points", ha="right", fontsize=7, color="0.35")
-    ax.set_xlabel("time $t$ [s]")
+    ax.set_xlabel(time_label)
     ax.set_ylabel(ylabel)
     ax.set_title("Conserved quantities: error over time", fontsize=11)
     low, high = ax.get_ylim()
@@ -317,4 +327,105 @@ def rigid_body_figure(
     M_text = ", ".join(f"{v + 0.0:.4g}" for v in M[0])
     fig.suptitle(f"{heading}\n$I = ({I_text})$ kg m$^2$,  $M(0) = ({M_text})$ "
                  f"{_MOMENTUM_UNIT},  {t.size} samples", fontsize=12)
+    return fig
+
+
+def _relative(values: np.ndarray, scale: float) -> np.ndarray:
+    return np.abs(values - values[0]) / max(scale, np.finfo(float).tiny)
+
+
+def heavy_top_errors(
+    t: Any,
+    M: Any,
+    R: Any | None,
+    inertia: Any,
+    weight: Any | None = None,
+    *,
+    energy: Any | None = None,
+    lab_momentum_z: Any | None = None,
+) -> dict[str, np.ndarray]:
+    """Errors of the quantities a heavy top conserves, by legend label.
+
+    A top with a fixed point in uniform gravity conserves its total energy
+    ``H = sum_i M_i^2 / (2 I_i) + (m g chi) . Gamma`` and the vertical component
+    ``m_z = Gamma . M`` of the lab angular momentum, where ``Gamma = R^T e_z`` is the lab
+    vertical in the body frame (the third row of ``R``); ``R^T R = 1`` holds for any
+    rotation (81). The kinetic energy ``H_0`` (247) and ``|M|^2`` are *not* conserved once
+    gravity acts, so they are not drawn.
+
+    Parameters
+    ----------
+    t, M, R, inertia
+        As for :func:`conserved_quantity_errors`.
+    weight : array_like, shape (3,), optional
+        ``m g chi`` in the body frame; needed to form ``H`` from ``M`` and ``R``.
+    energy, lab_momentum_z : array_like, shape (n,), optional
+        The run's own outputs; used as they are when given.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``|H - H0| / |H0|`` (absolute when ``H0 = 0``), ``|m_z - m_z0| / |M0|`` and
+        ``||R^T R - 1||_F``, each present when its data are.
+    """
+    t, M, R, inertia = _validate(t, M, R, inertia)
+    errors: dict[str, np.ndarray] = {}
+    if energy is None and R is not None and weight is not None:
+        energy = 0.5 * np.sum(M * M / inertia, axis=1) + R[:, 2, :] @ np.asarray(weight, dtype=float)
+    if energy is not None:
+        H = np.asarray(energy, dtype=float).reshape(-1)
+        if H[0] != 0.0:
+            errors[r"total energy $|H-H_0|/|H_0|$"] = _relative(H, abs(float(H[0])))
+        else:
+            errors[r"total energy $|H-H_0|$ ($H_0=0$)"] = np.abs(H - H[0])
+    if lab_momentum_z is None and R is not None:
+        lab_momentum_z = np.einsum("nj,nj->n", R[:, 2, :], M)
+    if lab_momentum_z is not None:
+        m_z = np.asarray(lab_momentum_z, dtype=float).reshape(-1)
+        errors[r"vertical lab momentum $|m_z-m_{z,0}|/|M_0|$"] = _relative(m_z, float(np.linalg.norm(M[0])))
+    if R is not None:
+        gram = np.einsum("nki,nkj->nij", R, R) - np.eye(3)
+        errors[r"orthogonality $\|R^TR-1\|_F$"] = np.sqrt(np.sum(gram * gram, axis=(1, 2)))
+    return errors
+
+
+def heavy_top_figure(
+    t: Any,
+    M: Any,
+    R: Any | None,
+    inertia: Any,
+    weight: Any | None = None,
+    *,
+    energy: Any | None = None,
+    lab_momentum_z: Any | None = None,
+    title: str | None = None,
+) -> Any:
+    """The picture of a heavy-top run: body axes, ``M(t)``, errors of its own conserved quantities.
+
+    Panels: the body-axis tips on the unit sphere (:func:`draw_body_axes`, when ``R`` is
+    known), the components ``M_i(t)`` (:func:`draw_momentum`), and the errors of
+    :func:`heavy_top_errors` (total energy, ``m_z``, ``R^T R``) against time. No polhode:
+    under gravity ``M`` leaves the free body's sphere and ellipsoid, so that picture would
+    mean nothing.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    t, M, R, inertia = _validate(t, M, R, inertia)
+    errors = heavy_top_errors(t, M, R, inertia, weight, energy=energy, lab_momentum_z=lab_momentum_z)
+    fig = new_figure(13.0, 11.0 if R is not None else 9.5)
+    grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=0.12, top=0.91, wspace=0.22, hspace=0.42)
+    if R is not None:
+        draw_body_axes(fig.add_subplot(grid[0, 0], projection="3d"), R)
+        draw_momentum(fig.add_subplot(grid[0, 1]), t, M)
+    else:
+        draw_momentum(fig.add_subplot(grid[0, :]), t, M)
+    if errors:
+        draw_conservation(fig.add_subplot(grid[1, :]), t, errors, ylabel="error (see legend)")
+    heading = title or "Heavy top"
+    I_text = ", ".join(f"{v:.4g}" for v in inertia)
+    M_text = ", ".join(f"{v + 0.0:.4g}" for v in M[0])
+    w_text = "" if weight is None else ",  $mg\\chi = (" + ", ".join(f"{v:.4g}" for v in np.asarray(weight)) + ")$"
+    fig.suptitle(f"{heading}\n$I = ({I_text})${w_text},  $M(0) = ({M_text})$,  {t.size} samples", fontsize=12)
     return fig

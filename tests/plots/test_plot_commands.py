@@ -1,4 +1,4 @@
-"""``dirac run SCENE --plot FILE.png`` and ``dirac demo --plot FILE.png`` draw real PNG files.
+"""``dirac run SCENE --plot FILE`` and ``dirac demo --plot FILE`` draw real pictures (PNG, PDF, SVG, ...).
 
 (``dirac bench --plot`` is checked in tests/bench/test_bench_command.py.)
 """
@@ -65,9 +65,35 @@ def test_demo_plot_draws_the_flagship(run_cli, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("command", [["demo"], ["run", str(ROOT / "docs" / "scenes" / "pendulum.toml")]])
-def test_a_plot_name_that_is_not_png_is_refused_before_running(run_cli, tmp_path: Path, command) -> None:
-    status, out, err = run_cli(*command, "--plot", str(tmp_path / "motion.pdf"), "--out", str(tmp_path / "x.npz"),
+def test_a_plot_suffix_matplotlib_cannot_write_is_refused_before_running(run_cli, tmp_path: Path, command) -> None:
+    status, out, err = run_cli(*command, "--plot", str(tmp_path / "motion.xyz"), "--out", str(tmp_path / "x.npz"),
                                "--no-progress")
     assert status == 2
-    assert err.startswith("error:") and ".png" in err
+    assert err.startswith("error:") and ".xyz" in err
+    for known in (".png", ".pdf", ".svg"):  # the message lists the formats that work
+        assert known in err
     assert not (tmp_path / "x.npz").exists()  # failed fast: nothing was run
+
+
+#: the first bytes of each format (PDF 1.7 section 7.5.2; SVG is XML with an <svg> root)
+MAGIC = {".pdf": b"%PDF-", ".svg": b"<?xml", ".png": PNG_SIGNATURE}
+
+
+@pytest.mark.parametrize("suffix", [".pdf", ".svg"])
+def test_run_plot_writes_the_format_its_suffix_names(run_cli, tmp_path: Path, suffix: str) -> None:
+    picture = tmp_path / f"pendulum{suffix}"
+    status, out, err = run_cli("run", str(ROOT / "docs" / "scenes" / "pendulum.toml"), "--out",
+                               str(tmp_path / "pendulum.npz"), "--plot", str(picture), "--no-progress")
+    assert status == 0, err
+    data = picture.read_bytes()
+    assert data.startswith(MAGIC[suffix])
+    if suffix == ".svg":
+        assert b"<svg" in data[:2000]
+
+
+def test_demo_plot_writes_svg(run_cli, tmp_path: Path) -> None:
+    picture = tmp_path / "demo.svg"
+    status, out, err = run_cli("demo", "--t-end", "20", "--plot", str(picture), "--no-progress")
+    assert status == 0, err
+    data = picture.read_bytes()
+    assert data.startswith(MAGIC[".svg"]) and b"<svg" in data[:2000]

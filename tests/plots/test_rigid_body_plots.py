@@ -87,7 +87,7 @@ def test_constrained_result_draws_a_png(tmp_path: Path) -> None:
                  "coordinates": ["x", "y"]},
     }
     fig = result_figure(result)
-    assert [ax.get_xlabel() for ax in fig.axes[:2]] == ["$x$ (system units)", "time $t$ [s]"]
+    assert [ax.get_xlabel() for ax in fig.axes[:2]] == ["$x$ (system units)", "time $t$ (system units)"]
     _assert_png(save_png(fig, tmp_path / "pendulum.png"))
 
 
