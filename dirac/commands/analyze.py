@@ -33,7 +33,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     output = parser.add_mutually_exclusive_group()
     output.add_argument("--json", action="store_true", help="print one JSON object (stages, classes, multipliers, degrees of freedom)")
     output.add_argument("--latex", action="store_true", help="print the analysis as LaTeX")
-    parser.add_argument("--compare", metavar="SPEC", default=None, help="compare with a reference (e.g. the paper's equations)")
+    parser.add_argument("--compare", metavar="SPEC", default=None, help="compare two Poisson brackets of the system on sampled points of the constraint surface: "
+                        "FIRST,SECOND[:N], names out of dirac, canonical, chetaev, lie_poisson_so3, N points "
+                        "(default 20); e.g. --compare dirac,chetaev")
     return parser
 
 
