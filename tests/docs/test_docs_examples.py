@@ -74,3 +74,35 @@ def test_readme_links_point_at_files_that_exist() -> None:
     assert targets
     missing = [t for t in targets if not (ROOT / t).exists()]
     assert not missing, f"README.md links to missing files: {missing}"
+
+
+def test_readme_names_the_paper_in_its_introduction() -> None:
+    intro = (ROOT / "README.md").read_text(encoding="utf-8").split("## ")[0]
+    assert "A. A. Deriglazov" in intro
+    assert "Lagrangian and\nHamiltonian formulations of asymmetric rigid body, considered as a constrained system" in intro
+    assert "(2024)" in intro
+
+
+def test_every_option_of_analyze_is_in_the_cli_page(run_cli) -> None:
+    import re
+
+    status, help_text, _ = run_cli("analyze", "--help")
+    assert status == 0
+    # the help of --compare gives its syntax, not a vague "e.g. the paper's equations"
+    assert "dirac,chetaev" in help_text and "paper's equations" not in help_text
+    page = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
+    options = set(re.findall(r"(--[a-z][a-z-]+)", help_text)) - {"--help"}
+    assert "--compare" in options
+    for option in options:
+        assert f"`{option}" in page, option
+    assert "dirac analyze rigid_body_momentum --compare dirac,chetaev" in page
+
+
+def test_no_page_writes_into_the_repository() -> None:
+    import re
+
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        for line in text.splitlines():
+            if line.startswith(("$ ", "dirac ", "python ")):  # commands a reader types
+                assert not re.search(r"(--out|--json|--plot)\s+docs/", line), (page.name, line)
