@@ -102,7 +102,8 @@ def _constraint_residuals(result: Any, problem: Any) -> dict[str, np.ndarray] | 
     expressions = list(getattr(mechanics, "symbolic", {}).get("constraints", []))
     residuals: dict[str, np.ndarray] = {}
     for a in range(chi.shape[1]):
-        text = f", $\\chi_{{{a + 1}}} = {expressions[a]}$".replace("**", "^") if a < len(expressions) else ""
+        formula = str(expressions[a]).replace("**", "^").replace("*", r"\,") if a < len(expressions) else ""
+        text = f", $\\chi_{{{a + 1}}} = {formula}$" if formula else ""
         residuals[f"$|\\chi_{{{a + 1}}}|${text}"] = np.abs(chi[:, a])
     for a in range(tangent.shape[1] if with_momenta else 0):
         residuals[f"$|\\dot\\chi_{{{a + 1}}}|$ (velocity)"] = np.abs(tangent[:, a])

@@ -50,6 +50,8 @@ def make_all() -> None:
             "--plot", str(IMAGES / "pendulum.png"))
         run("run", str(DOCS / "scenes" / "rigid_body_splitting.toml"), "--no-progress", "--out",
             str(work / "racket.npz"), "--plot", str(IMAGES / "tennis_racket.png"))
+        run("run", str(DOCS / "scenes" / "heavy_top.toml"), "--no-progress", "--out", str(work / "top.npz"),
+            "--plot", str(IMAGES / "heavy_top.png"))
         for name, text in page_files(DOCS / "tutorial.md").items():  # bead.toml, bead_scene.toml
             (work / name).write_text(text, encoding="utf-8")
         run("run", str(work / "bead_scene.toml"), "--no-progress", "--out", str(work / "bead.npz"),
