@@ -199,7 +199,7 @@ class Lagrangian:
         ...     "pendulum", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",
         ...     constraints=["x**2 + y**2 - l**2"], parameters={"m": 1.0, "g": 9.81, "l": 1.0})
         >>> pendulum.constraints
-        (x**2 + y**2 - l**2,)
+        (-l**2 + x**2 + y**2,)
         """
         if isinstance(coordinates, str) or not isinstance(coordinates, Sequence):
             raise InputError("coordinates must be a list of names, e.g. ['x', 'y']")
