@@ -8,6 +8,7 @@ retried by dask ``retries`` times (a dead worker's tasks are rescheduled), then 
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import time
 from collections.abc import Callable
@@ -170,7 +171,9 @@ def local_cluster(n_workers: int, dashboard_address: str | None = None):
 
 
 def _dashboard(client) -> str | None:
-    """The dashboard address, if the scheduler runs one (needs bokeh)."""
+    """The dashboard address, if the scheduler runs one; None when bokeh, which it needs, is not installed here."""
+    if importlib.util.find_spec("bokeh") is None:
+        return None
     try:
         services = client.scheduler_info(n_workers=0).get("services", {})
     except Exception:

@@ -35,6 +35,7 @@ as its flags.
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -99,23 +100,44 @@ class EnsembleReport:
 
 
 class _Progress:
-    """tqdm over members (shown from the first finished chunk on), or nothing."""
+    """tqdm over members from the start of the run, advanced as chunks complete, or nothing.
 
-    def __init__(self, enabled: bool, total: int, initial: int) -> None:
+    The bar is opened before the first chunk starts, so its elapsed time and members/s are
+    measured over the wall time of the run (a bar opened at the first finished chunk would
+    show the members of that chunk over a few milliseconds). While no chunk completes (a
+    single chunk, or a long one) a thread redraws it every ``refresh`` seconds so the elapsed
+    time keeps running.
+    """
+
+    def __init__(self, enabled: bool, total: int, initial: int, refresh: float = 0.5) -> None:
         self.enabled, self.total, self.initial = enabled, total, initial
         self.bar = None
-
-    def update(self, n: int) -> None:
-        if self.enabled and self.bar is None:
+        self._stop = threading.Event()
+        self._ticker: threading.Thread | None = None
+        if enabled:
             from tqdm import tqdm
 
             self.bar = tqdm(
-                total=self.total, initial=self.initial, unit="member", unit_scale=True, desc="ensemble", file=sys.stderr
+                total=total, initial=initial, unit="member", unit_scale=True, desc="ensemble", file=sys.stderr,
+                smoothing=0,  # the rate is members done in this call over its wall time
             )
+            self._ticker = threading.Thread(target=self._tick, args=(refresh,), daemon=True)
+            self._ticker.start()
+
+    def _tick(self, refresh: float) -> None:
+        while not self._stop.wait(refresh):
+            bar = self.bar
+            if bar is not None:
+                bar.refresh()
+
+    def update(self, n: int) -> None:
         if self.bar is not None:
             self.bar.update(n)
 
     def close(self) -> None:
+        self._stop.set()
+        if self._ticker is not None:
+            self._ticker.join()
         if self.bar is not None:
             self.bar.close()
 

@@ -37,9 +37,21 @@ def run_local(work: ChunkWork) -> None:
         else:
             record(marker, index, None)
 
+    def attempts(start: int, stop: int, members) -> tuple[dict | None, dict, int, str | None]:
+        error = None
+        for attempt in range(retries + 1):
+            try:
+                wall, cpu = time.perf_counter(), time.process_time()
+                arrays = compute_chunk(scene, start, stop, members if attempt == 0 else None)
+                return arrays, {"seconds": time.perf_counter() - wall, "cpu_seconds": time.process_time() - cpu}, attempt, None
+            except Exception as exc:
+                error = f"{type(exc).__name__}: {exc} (after {attempt + 1} attempts)"
+        return None, {}, retries, error
+
     pending: tuple[int, Future[dict]] | None = None
     bounds = [work.bounds(index) for index in missing]
-    with ThreadPoolExecutor(max_workers=1) as writer, ThreadPoolExecutor(max_workers=1) as drawer:
+    with (ThreadPoolExecutor(max_workers=1) as writer, ThreadPoolExecutor(max_workers=1) as drawer,
+          ThreadPoolExecutor(max_workers=1) as computer):
         # draw the next chunk's members while this one is integrated (numpy's generators
         # and array operations release the GIL)
         upcoming = drawer.submit(scene.source.members, *bounds[0]) if bounds else None
@@ -50,20 +62,15 @@ def run_local(work: ChunkWork) -> None:
             except Exception:
                 members = None
             upcoming = drawer.submit(scene.source.members, *bounds[position + 1]) if position + 1 < len(bounds) else None
-            error = None
-            for attempt in range(retries + 1):
-                try:
-                    wall, cpu = time.perf_counter(), time.process_time()
-                    arrays = compute_chunk(scene, start, stop, members if attempt == 0 else None)
-                    timing = {"seconds": time.perf_counter() - wall, "cpu_seconds": time.process_time() - cpu}
-                    break
-                except Exception as exc:
-                    error = f"{type(exc).__name__}: {exc} (after {attempt + 1} attempts)"
-            else:
-                record(None, index, error)
-                continue
+            computing = computer.submit(attempts, start, stop, members)
+            # the previous chunk is reported as soon as its write is done, while this one is integrated
             if pending is not None:
                 finish(pending)
+                pending = None
+            arrays, timing, attempt, error = computing.result()
+            if arrays is None:
+                record(None, index, error)
+                continue
             info = {"run_id": work.run_id, "attempt": attempt + 1, "worker": None, **timing}
             pending = (index, writer.submit(write, index, start, stop, arrays, info))
         if pending is not None:
