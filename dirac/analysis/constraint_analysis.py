@@ -9,7 +9,7 @@ paper's (1); Sect. X for the rigid body (78), Sect. XI for (228)).
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import sympy
@@ -67,14 +67,26 @@ class ConstraintAnalysis:
         How the decisions were made (for the report).
     """
 
-    def __init__(self, lagrangian: Lagrangian, seed: int = 20240607) -> None:
+    def __init__(
+        self, lagrangian: Lagrangian, seed: int = 20240607, progress: Callable[[str], None] | None = None
+    ) -> None:
         start = time.perf_counter()
+        clock = [start]
+
+        def done(message: str) -> None:
+            """One line per stage of the algorithm, with its seconds, to ``progress``."""
+            if progress is not None:
+                now = time.perf_counter()
+                progress(f"{message} ({now - clock[0]:.2f} s)")
+                clock[0] = now
+
         self.lagrangian = lagrangian
         self.name = lagrangian.name
         rng = np.random.default_rng(seed)
         self._generic = _generic_parameter_values(lagrangian, rng)
         legendre = legendre_transform(lagrangian, rng, self._generic)
         self._legendre = legendre
+        done(f"Legendre transform: Hessian rank {legendre.rank}, {len(legendre.primary)} primary constraint(s)")
         space = legendre.phase_space
         self._space = space
         self.coordinates = space.coordinates
@@ -91,6 +103,10 @@ class ConstraintAnalysis:
         chain = ConstraintChain(space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers)
         chain.run()
         self._chain = chain
+        done(
+            f"constraint chain: {len(chain.stages)} stage(s) of sizes "
+            f"{', '.join(str(len(stage)) for stage in chain.stages) or '-'}, {len(chain.constraints)} constraint(s)"
+        )
         self.primary_constraints = list(chain.primary)
         self.total_hamiltonian = chain.total_hamiltonian
         self.stages = chain.stages
@@ -103,6 +119,7 @@ class ConstraintAnalysis:
         self.first_class = cls.first_class
         self.second_class = cls.second_class
         self.bracket_matrix_rank = cls.rank
+        done(f"classification: {len(cls.first_class)} first-class, {len(cls.second_class)} second-class")
         dim = space.dimension
         self.physical_degrees_of_freedom = (dim - 2 * len(self.first_class) - len(self.second_class)) // 2
         if (dim - 2 * len(self.first_class) - len(self.second_class)) % 2:
@@ -110,6 +127,7 @@ class ConstraintAnalysis:
         C2 = C[cls.second_indices, cls.second_indices] if cls.second_indices else sympy.zeros(0, 0)
         self._bracket = DiracBracket(space, self.second_class, C2, self._numerics, self._points, lagrangian.parameters)
         self._defaults_numerics: Numerics | None = None
+        done("Dirac bracket set up")
         s = len(self.second_class)
         if s == 0:
             self.bracket_strategy = "symbolic: no second-class constraints, the Dirac bracket is the Poisson bracket"
@@ -275,7 +293,7 @@ class ConstraintAnalysis:
         )
 
 
-def analyze(lagrangian: Lagrangian) -> ConstraintAnalysis:
+def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
     """Run the Dirac–Bergmann algorithm on ``lagrangian``.
 
     Parameters
@@ -283,6 +301,10 @@ def analyze(lagrangian: Lagrangian) -> ConstraintAnalysis:
     lagrangian
         A :class:`~dirac.model.lagrangian.Lagrangian` (quadratic in the velocities) with
         holonomic constraints; their multipliers become coordinates (the paper's (1)).
+    progress
+        Called with one line as each stage of the algorithm finishes (the Legendre
+        transform, the constraint chain, the classification, the Dirac bracket), each
+        with its seconds; ``None`` (the default) reports nothing.
 
     Returns
     -------
@@ -305,4 +327,4 @@ def analyze(lagrangian: Lagrangian) -> ConstraintAnalysis:
     """
     if not isinstance(lagrangian, Lagrangian):
         raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
-    return ConstraintAnalysis(lagrangian)
+    return ConstraintAnalysis(lagrangian, progress=progress)

@@ -8,6 +8,8 @@ surface). The comparison itself is :func:`dirac.analysis.comparison.compare_brac
 from __future__ import annotations
 
 import json
+import time
+from collections.abc import Callable
 from typing import Any
 
 from dirac.analysis.brackets import StructureBracket, analysis_variables
@@ -42,7 +44,7 @@ def parse_spec(spec: str) -> tuple[list[str], int]:
     return names, count
 
 
-def cli_compare(analysis: Any, spec: str, as_json: bool) -> str:
+def cli_compare(analysis: Any, spec: str, as_json: bool, progress: Callable[[str], None] | None = None) -> str:
     """Run ``dirac analyze SYSTEM --compare SPEC`` and return the report.
 
     SPEC is ``FIRST,SECOND`` or ``FIRST,SECOND:N``: two bracket names out of
@@ -63,6 +65,8 @@ def cli_compare(analysis: Any, spec: str, as_json: bool) -> str:
         The SPEC string.
     as_json
         Return one JSON object instead of text.
+    progress
+        Called with one line, with its seconds, as each phase of the comparison finishes.
 
     Raises
     ------
@@ -70,11 +74,22 @@ def cli_compare(analysis: Any, spec: str, as_json: bool) -> str:
         For a malformed SPEC or a bracket that does not apply to the system.
     """
     names, count = parse_spec(spec)
+    clock = [time.perf_counter()]
+
+    def done(message: str) -> None:
+        if progress is not None:
+            now = time.perf_counter()
+            progress(f"{message} ({now - clock[0]:.2f} s)")
+            clock[0] = now
+
     variables = analysis_variables(analysis)
     first = named_bracket(names[0], analysis, variables)
     second = named_bracket(names[1], analysis, variables)
+    done(f"compare: brackets {names[0]} and {names[1]} built")
     points = surface_points(analysis, count)
+    done(f"compare: {len(points)} point(s) of the constraint surface sampled")
     comparison = compare_brackets(first, second, points)
+    done("compare: brackets compared at the points")
     for bracket in (first, second):
         try:
             comparison.jacobi[bracket.name] = jacobi_residual(bracket, points[:5])
@@ -82,6 +97,7 @@ def cli_compare(analysis: Any, spec: str, as_json: bool) -> str:
             comparison.jacobi[bracket.name] = f"not checked ({exc})"
         if isinstance(bracket, StructureBracket) and bracket.is_linear:
             comparison.casimirs[bracket.name] = [str(c) for c in casimirs(bracket)]
+        done(f"compare: Jacobi identity{' and Casimirs' if bracket.name in comparison.casimirs else ''} of {bracket.name} checked")
     if as_json:
         return json.dumps(comparison.to_dict(), indent=2)
     return comparison.to_text()
