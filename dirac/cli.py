@@ -6,6 +6,10 @@ Each sub-command lives in ``dirac/commands/<name>.py`` and provides
   no sympy, numba or scipy imports at module level, so ``dirac --help`` stays fast);
 * ``main(args: argparse.Namespace) -> int`` — do the work and return the exit status.
 
+Every command takes ``-q/--quiet`` and ``-v/--verbose`` (handled here once): the
+commands read the level from ``args.verbosity`` (-1 quiet, 0 default, 1 verbose) through
+:func:`verbosity`. Warnings (``warning:`` lines) are shown at every level.
+
 Exit status (docs/cli.md): 0 success; 2 bad input, with one ``error:`` line on stderr;
 1 an internal failure.
 """
@@ -39,6 +43,30 @@ class _ErrorExitParser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+def _add_verbosity_options(parser: argparse.ArgumentParser) -> None:
+    """``-q/--quiet`` and ``-v/--verbose``; SUPPRESS so a sub-command's default keeps the top-level value."""
+    group = parser.add_argument_group("output")
+    group.add_argument(
+        "-q", "--quiet", action="count", default=argparse.SUPPRESS,
+        help="no progress bars or informational lines on stderr (warnings and errors stay); "
+        "no summary when the results go to an --out file",
+    )
+    group.add_argument(
+        "-v", "--verbose", action="count", default=argparse.SUPPRESS,
+        help="more detail on stderr: the stages of long analyses, with timings",
+    )
+
+
+def verbosity(args: argparse.Namespace) -> int:
+    """-1 with ``-q``, 1 with ``-v``, else 0 (the last of -q/-v given wins over none; -q beats -v)."""
+    level = getattr(args, "verbosity", None)
+    if level is not None:
+        return int(level)
+    if getattr(args, "quiet", 0):
+        return -1
+    return 1 if getattr(args, "verbose", 0) else 0
+
+
 def _version() -> str:
     from importlib.metadata import PackageNotFoundError, version
 
@@ -56,6 +84,7 @@ def build_parser() -> argparse.ArgumentParser:
         "Dirac brackets and structure-preserving flows.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    _add_verbosity_options(parser)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_ErrorExitParser)
     for name, module_name in COMMANDS.items():
         try:
@@ -68,6 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
             sub.set_defaults(handler=_not_available(name))
             continue
         sub = module.register(subparsers)
+        _add_verbosity_options(sub)
         sub.set_defaults(handler=module.main)
     return parser
 
@@ -85,6 +115,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     install_warning_printer()
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.verbosity = verbosity(args)
     if getattr(args, "handler", None) is None:
         parser.print_help()
         print(f"error: no command given: choose one of {', '.join(COMMANDS)}", file=sys.stderr)

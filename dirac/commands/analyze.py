@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
+from collections.abc import Callable
 
 from dirac.errors import InputError
 
@@ -59,17 +61,32 @@ def parse_params(items: list[str]) -> dict[str, float]:
     return values
 
 
+def stage_printer(level: int) -> Callable[[str], None] | None:
+    """Stage lines on stderr with ``-v``, or when stderr is a terminal (not with ``-q``); else None.
+
+    Pipes and captured output stay clean at the default level.
+    """
+    if level < 0 or (level == 0 and not sys.stderr.isatty()):
+        return None
+
+    def report(message: str) -> None:
+        print(f"analyze: {message}", file=sys.stderr, flush=True)
+
+    return report
+
+
 def main(args: argparse.Namespace) -> int:
     from dirac.analysis.constraint_analysis import analyze
     from dirac.model.systems import load_system
 
     params = parse_params(args.param)
     lagrangian = load_system(args.system, **params)
-    analysis = analyze(lagrangian)
+    report = stage_printer(getattr(args, "verbosity", 0))
+    analysis = analyze(lagrangian, progress=report)
     if args.compare is not None:
         from dirac.commands.analyze_compare import cli_compare
 
-        print(cli_compare(analysis, args.compare, as_json=args.json))
+        print(cli_compare(analysis, args.compare, as_json=args.json, progress=report))
         return 0
     if args.json:
         print(json.dumps(analysis.to_json(), indent=2))

@@ -61,5 +61,5 @@ def main(args: argparse.Namespace) -> int:
             raise InputError("--plot needs matplotlib: pip install 'dirac-mechanics[plot]'") from None
     from dirac.bench.run import run_benchmark
 
-    run_benchmark(quick=bool(args.quick), json_path=args.json, plot_path=args.plot, progress=not args.no_progress)
+    run_benchmark(quick=bool(args.quick), json_path=args.json, plot_path=args.plot, progress=not args.no_progress and getattr(args, "verbosity", 0) >= 0)
     return 0

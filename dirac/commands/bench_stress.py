@@ -19,7 +19,7 @@ def main(args: argparse.Namespace) -> int:
 
     quick = bool(getattr(args, "quick", False))
     json_path = getattr(args, "json", None)
-    show = not bool(getattr(args, "no_progress", False))
+    show = not bool(getattr(args, "no_progress", False)) and getattr(args, "verbosity", 0) >= 0
 
     def progress(message: str) -> None:
         if show:

@@ -65,7 +65,7 @@ def main(args: argparse.Namespace) -> int:
         run["t_end"] = args.t_end
     run["dt"] = args.dt if args.dt is not None else 0.01
     scene = scene_from_dict(data, source="flagship scene")
-    progress = (not args.no_progress) and sys.stderr.isatty()
+    progress = (not args.no_progress) and getattr(args, "verbosity", 0) >= 0 and sys.stderr.isatty()
     problem = scene.problem
     assert isinstance(problem, RigidBodyProblem)  # the flagship scene is the free rigid body
     solution = integrate(problem, progress=progress, **scene.run)

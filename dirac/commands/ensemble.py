@@ -53,7 +53,9 @@ def main(args: argparse.Namespace) -> int:
     if args.retries < 0:
         raise InputError(f"--retries {args.retries} must be >= 0")
     report = _run(args)
-    _print_report(report)
+    quiet = getattr(args, "verbosity", 0) < 0
+    if not quiet:  # -q: the results are in --out DIR; no summary
+        _print_report(report)
     if report.failed:
         listed = ", ".join(f"{index} ({message})" for index, message in sorted(report.failed.items())[:3])
         print(
@@ -62,7 +64,8 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    print("  complete")
+    if not quiet:
+        print("  complete")
     return 0
 
 
@@ -71,6 +74,12 @@ def _run(args: argparse.Namespace) -> EnsembleReport:
     from dirac.ensemble.arguments import ArgumentError
     from dirac.ensemble.engine import run_ensemble
     from dirac.errors import InputError
+
+    quiet = getattr(args, "verbosity", 0) < 0
+
+    def notify(message: str) -> None:
+        if not quiet:
+            print(message, file=sys.stderr, flush=True)
 
     try:
         return run_ensemble(
@@ -81,8 +90,8 @@ def _run(args: argparse.Namespace) -> EnsembleReport:
             cluster=args.cluster,
             n_workers=args.workers,
             retries=args.retries,
-            progress=not args.no_progress,
-            notify=lambda message: print(message, file=sys.stderr, flush=True),
+            progress=not args.no_progress and not quiet,
+            notify=notify,
         )
     except ArgumentError as exc:
         raise InputError(exc.spelled(flag_spelling)) from None

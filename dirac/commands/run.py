@@ -88,7 +88,8 @@ def main(args: argparse.Namespace) -> int:
 
         plot_path = check_plot_path(args.plot)
     scene = load_scene(scene_path)
-    progress = (not args.no_progress) and sys.stderr.isatty()
+    level = getattr(args, "verbosity", 0)
+    progress = (not args.no_progress) and level >= 0 and sys.stderr.isatty()
 
     def terminate(signum, frame):
         raise KeyboardInterrupt
@@ -115,7 +116,15 @@ def main(args: argparse.Namespace) -> int:
         return 130
     finally:
         signal.signal(signal.SIGTERM, previous)
+    if level > 0:
+        print(f"run: integration {solution.cpu_seconds:.3g} s CPU (compilation excluded)", file=sys.stderr)
     dt = f", dt = {solution.dt:.6g}" if solution.dt else ""
+    if level < 0:  # -q: the results are in the --out file; no summary
+        if plot_path is not None:
+            from dirac.plots import plot_result
+
+            plot_result(solution, plot_path, problem=scene.problem)
+        return 0
     print(
         f"{scene.system}: method {solution.method} (order {solution.order}{dt}), {solution.steps} steps, "
         f"{solution.evaluations} evaluations, {solution.cpu_seconds:.3g} s CPU; "
