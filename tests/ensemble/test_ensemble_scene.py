@@ -37,7 +37,8 @@ def test_member_file_supplies_the_initial_data(tmp_path, kind):
     else:
         group = zarr.open_group(str(tmp_path / "members.zarr"), mode="w")
         for key, value in data.items():
-            group.create_array(key, data=value)
+            # shape and dtype, then a write: the form zarr 3.0 accepts (create_array(data=) is 3.1+)
+            group.create_array(key, shape=value.shape, dtype=value.dtype)[...] = value
         name = "members.zarr"
     (tmp_path / "s.toml").write_text(HEAD + f'file = "{name}"\n')
     scene = load_ensemble_scene(tmp_path / "s.toml")
