@@ -14,7 +14,9 @@ Conventions of the pages (README.md and docs/*.md), all visible in the source:
   ``<!-- file: NAME -->`` writes the block to the file ``NAME`` before it is used,
   ``<!-- status: 2 -->`` is the exit status the commands of a console block must return,
   ``<!-- raises: InputError -->`` is a Python block illustrating an error: it must raise
-  that exception. Nothing is ever skipped silently.
+  that exception, ``<!-- warns: why -->`` a Python block meant to warn (a block that
+  warns without it fails, and so does a command whose page shows no ``warning:`` line
+  but which prints one). Nothing is ever skipped silently.
 """
 
 from __future__ import annotations
@@ -25,8 +27,11 @@ import io
 import re
 import shlex
 import traceback
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from dirac.errors import DiracWarning
 
 FENCE = re.compile(r"^(?P<fence>`{3,}|~{3,})\s*(?P<info>[^\s`]*)(?P<rest>.*)$")
 MARKER = re.compile(r"^<!--\s*(?P<key>[a-z-]+)\s*:\s*(?P<value>.*?)\s*-->\s*$")
@@ -171,8 +176,10 @@ def check_command(page: str, command: Command, status_expected: int) -> list[str
         problems.append(f"{where}\n  the page shows only '...' as its output: show the real output")
     elif expected_out.strip() and not matches(expected_out, out):
         problems.append(f"{where}\n  stdout differs from the page.\n--- page:\n{expected_out}--- real:\n{out}")
-    if expected_err.strip():
-        real_err = "".join(line + "\n" for line in err.splitlines() if line.startswith(("error:", "warning:")))
+    real_err = "".join(line + "\n" for line in err.splitlines() if line.startswith(("error:", "warning:")))
+    if not expected_err.strip() and real_err:
+        problems.append(f"{where}\n  prints a warning or error the page does not show:\n{real_err}")
+    elif expected_err.strip():
         if not matches(expected_err, real_err):
             problems.append(f"{where}\n  stderr differs from the page.\n--- page:\n{expected_err}--- real:\n{real_err}")
     return problems
@@ -185,7 +192,8 @@ def run_python(page: str, block: Block, namespace: dict) -> list[str]:
     out = io.StringIO()
     wanted = block.options.get("raises")
     try:
-        with contextlib.redirect_stdout(out):
+        with contextlib.redirect_stdout(out), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", DiracWarning)
             exec(code, namespace)
     except Exception as exc:
         names = {cls.__name__ for cls in type(exc).__mro__} | {
@@ -196,6 +204,10 @@ def run_python(page: str, block: Block, namespace: dict) -> list[str]:
         return [f"{where} raised {type(exc).__name__}: {exc}\n{traceback.format_exc()[-3000:]}"]
     if wanted:
         return [f"{where} is marked 'raises: {wanted}' but ran without an error"]
+    warned = [str(w.message) for w in caught if issubclass(w.category, DiracWarning)]
+    if warned and "warns" not in block.options:
+        return [f"{where} warns, and the page does not say so (give the block the option 'warns' if it is meant):\n"
+                + "\n".join(warned)]
     if block.expected is not None and is_placeholder(block.expected):
         return [f"{where}: the page shows only '...' as its output: show the real output"]
     if block.expected is not None and not matches(block.expected, out.getvalue()):
