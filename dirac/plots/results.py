@@ -63,7 +63,8 @@ def _first_body(array: np.ndarray, single_ndim: int) -> np.ndarray:
     return array[:, 0] if array.ndim == single_ndim + 1 else array
 
 
-def _title(meta: Mapping[str, Any], default: str) -> str:
+def _title(meta: Mapping[str, Any], default: str, time_unit: str = "s") -> str:
+    """The figure's title line; ``time_unit`` is that of the figure's time axes (empty: none)."""
     parts = [str(meta.get("system", default))]
     if meta.get("method"):
         method = str(meta["method"])
@@ -71,7 +72,7 @@ def _title(meta: Mapping[str, Any], default: str) -> str:
             method += f" (order {meta['order']})"
         parts.append(f"method {method}")
     if meta.get("dt"):
-        parts.append(f"dt = {float(meta['dt']):.3g} s")
+        parts.append(f"dt = {float(meta['dt']):.3g}" + (f" {time_unit}" if time_unit else ""))
     if meta.get("steps"):
         parts.append(f"{int(meta['steps'])} steps")
     if meta.get("complete") is False:
@@ -181,7 +182,7 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem
     if names is None:
         names = getattr(getattr(problem, "mechanics", None), "coordinate_names", None)
     return constrained_figure(t, q, energy=energy, constraint_residual=residual, names=names,
-                              title=_title(meta, "constrained system"),
+                              title=_title(meta, "constrained system", time_unit=""),
                               constraints=_constraint_residuals(result, problem))
 
 

@@ -141,3 +141,14 @@ def test_plot_returns_a_matplotlib_figure() -> None:
 
     assert isinstance(dirac.plot(_sleeping_top()), Figure)
     assert "plot" in dirac.__all__
+
+
+def test_constrained_picture_speaks_of_one_kind_of_unit() -> None:
+    """A general system has no fixed units: its axes say "system units", and its title gives dt without seconds."""
+    scene = dirac.load_scene(SCENES / "double_pendulum.toml")
+    run = dict(scene.run, t_end=0.2, samples=11)
+    figure = dirac.plot(dirac.integrate(scene.problem, **run), scene.problem)
+    title = figure.texts[0].get_text() if figure.texts else figure._suptitle.get_text()
+    assert "dt = " in title and " s," not in title.split("dt = ")[1]
+    labels = [ax.get_xlabel() for ax in figure.axes if ax.get_xlabel()]
+    assert labels and all("[s]" not in label for label in labels)
