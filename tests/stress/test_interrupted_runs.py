@@ -68,9 +68,13 @@ def _interrupt_run(tmp_path: Path, out: Path, signum: int) -> tuple[int, str]:
     master, slave = pty.openpty()
     # a terminal of zero columns would get an empty bar from tqdm: give it a real size
     fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 160, 0, 0))
+    # A terminal's Ctrl-C reaches a process whose SIGINT is at its default; a test runner
+    # started in the background of a non-interactive shell passes SIGINT on as ignored, and
+    # Python would then never raise KeyboardInterrupt. Give the child the terminal's default.
     child = subprocess.Popen(
         [sys.executable, "-m", "dirac", "run", str(scene), "--out", str(out)],
         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=slave, cwd=tmp_path,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     os.close(slave)
     try:
