@@ -32,13 +32,28 @@ from dirac.validate import unknown_name_error, validate_finite
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
 
-__all__ = ["MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
+__all__ = ["MechanicalSystem", "NotMechanicalError", "TimeDependentSystemError", "refuse_time_dependent", "resolve_parameters"]
 
 
 class NotMechanicalError(InputError):
     """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
     velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
     flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
+
+
+class TimeDependentSystemError(InputError):
+    """The Lagrangian or a constraint depends explicitly on the time ``t``: the compiled
+    flows integrate autonomous systems only, so they refuse it instead of freezing ``t``."""
+
+
+def refuse_time_dependent(lagrangian: Lagrangian) -> None:
+    """Raise :class:`TimeDependentSystemError` when ``lagrangian`` depends explicitly on ``t``."""
+    if lagrangian.is_time_dependent:
+        raise TimeDependentSystemError(
+            f"system {lagrangian.name!r} depends explicitly on the time t (a rheonomic system): the "
+            "numerical flows integrate only systems without explicit time dependence; analyse it with "
+            "dirac analyze (or dirac.analyze), which includes the partial time derivatives"
+        )
 
 
 def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
@@ -150,8 +165,10 @@ class MechanicalSystem:
         ------
         InputError
             Unknown or missing parameter values, velocity-linear terms, a kinetic energy
-            that is not quadratic in the velocities, or a mass matrix that is singular.
+            that is not quadratic in the velocities, a mass matrix that is singular, or
+            (:class:`TimeDependentSystemError`) an explicit dependence on the time ``t``.
         """
+        refuse_time_dependent(lagrangian)
         values = resolve_parameters(lagrangian, parameters)
         q = list(lagrangian.coordinates)
         v = list(lagrangian.velocities)

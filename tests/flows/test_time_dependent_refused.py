@@ -1,0 +1,37 @@
+"""The compiled flows integrate autonomous systems only: a Lagrangian or constraint with the
+explicit time ``t`` is refused with a clear error instead of being integrated with ``t``
+frozen (which would drop the partial time derivative of the constraints)."""
+
+from __future__ import annotations
+
+import pytest
+
+from dirac.errors import DiracError
+from dirac.flows import MechanicalSystem
+from dirac.flows.analysed import AnalysedSystem
+from dirac.flows.mechanics import TimeDependentSystemError
+from dirac.model.lagrangian import Lagrangian
+
+GROWING = Lagrangian.from_strings(
+    "growing_pendulum",
+    ["x", "y"],
+    "(x_dot**2 + y_dot**2)/2 - g*y",
+    ["x**2 + y**2 - (1 + a*t)**2"],
+    parameters={"g": 9.81, "a": 0.1},
+)
+
+
+def test_mechanical_system_refuses_explicit_time():
+    with pytest.raises(TimeDependentSystemError, match=r"'growing_pendulum' depends explicitly on the time t"):
+        MechanicalSystem.from_lagrangian(GROWING)
+
+
+def test_analysed_system_refuses_explicit_time_before_analysing():
+    with pytest.raises(DiracError, match="depends explicitly on the time t"):
+        AnalysedSystem.from_lagrangian(GROWING)
+
+
+def test_t_as_a_coordinate_is_not_time_dependence():
+    """A coordinate named t (no explicit time): the free particle L = (t_dot^2 + x_dot^2)/2 compiles."""
+    free = Lagrangian.from_strings("free", ["t", "x"], "(t_dot**2 + x_dot**2)/2")
+    assert MechanicalSystem.from_lagrangian(free).name == "free"
