@@ -63,7 +63,8 @@ class DiracBracket:
         self.defaults = dict(defaults)
         self._compiled: dict = {}
         self._c_values: np.ndarray | None = None
-        self._args = (*phase_space.variables, *phase_space.parameters)
+        self.time = numerics.time  # a time-dependent system's t: an argument, not a variable
+        self._args = (*phase_space.variables, *([self.time] if self.time is not None else []), *phase_space.parameters)
 
     # ------------------------------------------------------------------ exact
     def exact(self, f: sympy.Expr, g: sympy.Expr, time_limit: float | None = None) -> sympy.Expr:
@@ -123,8 +124,9 @@ class DiracBracket:
         f, g
             Phase-space functions (sympy expressions, or names of variables).
         point
-            Name -> value for the phase-space variables the bracket needs; parameter
-            values may be given too (else their defaults are used).
+            Name -> value for the phase-space variables the bracket needs (and the time
+            ``t`` when the constraints depend on it); parameter values may be given too
+            (else their defaults are used).
         """
         f, g = self._sympify(f), self._sympify(g)
         pb = self.space.poisson_bracket
@@ -172,7 +174,8 @@ class DiracBracket:
     def _arguments(self, point: Mapping[str, float], needed: set) -> list[float]:
         symbols = self.space.symbols
         params = {p.name: p for p in self.space.parameters}
-        unknown = sorted(set(point) - set(symbols) - set(params))
+        timed = [self.time] if self.time is not None else []
+        unknown = sorted(set(point) - set(symbols) - set(params) - {t.name for t in timed})
         if unknown:
             raise InputError(f"point has unknown name(s) {', '.join(unknown)}; the phase-space variables are {', '.join(symbols)}")
         args = []
@@ -181,6 +184,13 @@ class DiracBracket:
                 args.append(float(point[s.name]))
             elif s in needed:
                 raise InputError(f"point lacks a value for {s.name!r}, which the bracket needs")
+            else:
+                args.append(0.0)
+        for t in timed:
+            if t.name in point:
+                args.append(float(point[t.name]))
+            elif t in needed:
+                raise InputError(f"point lacks a value for the time {t.name!r}, which the bracket needs")
             else:
                 args.append(0.0)
         for p in self.space.parameters:

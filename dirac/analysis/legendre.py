@@ -165,12 +165,13 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     p = sympy.Matrix(momenta[:n])
     shifted = p - sympy.Matrix(a)
     # numerical rank and pivots of W at generic configurations
-    args = (*q, *lagrangian.parameters)
+    time = [lagrangian.time] if lagrangian.is_time_dependent else []  # sampled with q
+    args = (*q, *time, *lagrangian.parameters)
     w_fn = array_function(args, W, cse=False)
     pvals = [float(parameter_values[s]) for s in lagrangian.parameters]
     samples = []
     for _ in range(3):
-        z = rng.uniform(0.5, 1.5, n) * rng.choice([-1.0, 1.0], n)
+        z = rng.uniform(0.5, 1.5, n + len(time)) * rng.choice([-1.0, 1.0], n + len(time))
         with np.errstate(all="ignore"):
             samples.append(np.array(w_fn(*z, *pvals), dtype=float).reshape(n, n))
     pivots = independent_rows(samples, list(range(n)))
@@ -193,11 +194,11 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
             a_fn = array_function(args, A, cse=False)
             a_samples = []
             for _ in range(3):
-                z = rng.uniform(0.5, 1.5, n) * rng.choice([-1.0, 1.0], n)
+                z = rng.uniform(0.5, 1.5, n + len(time)) * rng.choice([-1.0, 1.0], n + len(time))
                 a_samples.append(np.array(a_fn(*z, *pvals), dtype=float).reshape(A.shape))
             col_pivots = independent_rows([m.T for m in a_samples], list(range(n)))
             kernel = (
-                polynomial_kernel(A, Numerics(space, parameter_values, seed=int(rng.integers(2**31))), rank, lagrangian.constraints)
+                polynomial_kernel(A, Numerics(space, parameter_values, seed=int(rng.integers(2**31)), time=(time or [None])[0]), rank, lagrangian.constraints)
                 if len(col_pivots) == rank == A.shape[0] else None
             )
             if kernel is not None:
