@@ -23,6 +23,8 @@ Hand derivations (momenta ``p = dL/dq_dot``, ``{q, p} = 1``, ``H_c = v.p - L``):
 
 from __future__ import annotations
 
+import signal
+
 import numpy as np
 import pytest
 import sympy
@@ -145,3 +147,26 @@ def test_elimination_over_its_time_budget_is_refused():
 def test_quadratic_lagrangians_keep_the_quadratic_path():
     a = dirac.analyze(dirac.load_system("pendulum"))
     assert "not quadratic" not in a.notes[0]
+
+
+@pytest.mark.skipif(not hasattr(signal, "setitimer"), reason="interval timers are POSIX only")
+def test_time_budget_restores_an_outer_timer():
+    """An alarm set by the caller (e.g. a test's watchdog) keeps running, with its remaining time."""
+    particle = Lagrangian.from_strings("rel", ["t", "x"], "-m*sqrt(t_dot**2 - x_dot**2)", parameters={"m": 1.0})
+    momenta = [sympy.Symbol("p_t", real=True), sympy.Symbol("p_x", real=True)]
+    fired: list[int] = []
+
+    def watchdog(signum, frame):
+        fired.append(signum)
+
+    previous = signal.signal(signal.SIGALRM, watchdog)
+    signal.setitimer(signal.ITIMER_REAL, 100.0)
+    try:
+        with pytest.raises(dirac.AnalysisError, match="took more than"):
+            eliminate_velocities(particle, momenta, np.random.default_rng(2), {particle.parameter_symbols["m"]: 1.1}, seconds=0.001)
+        remaining, _ = signal.getitimer(signal.ITIMER_REAL)
+        assert 90.0 < remaining <= 100.0 and not fired
+        assert signal.getsignal(signal.SIGALRM) is watchdog
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
