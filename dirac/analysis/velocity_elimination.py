@@ -20,8 +20,9 @@ mechanics", Lecture 1; Henneaux–Teitelboim, Sect. 1.1; Gitman–Tyutin, Sect. 
   function of ``(q, p)`` alone ((207)); for ``L`` homogeneous of degree one in the
   velocities ``E = 0`` by Euler's theorem (the reparametrisation-invariant relativistic
   particle ``L = -m sqrt(t_dot^2 - x_dot^2 - y_dot^2)``, primary constraint
-  ``p_t^2 - p_x^2 - p_y^2 - m^2 = 0``, ``H_c = 0``); otherwise ``h = E`` is eliminated
-  the same way and solved from the eliminant linear in ``h``.
+  ``p_t^2 - p_x^2 - p_y^2 - m^2 = 0``, ``H_c = 0``), and ``H_c = -L_0`` when only the
+  velocity-free terms ``L_0`` break the homogeneity; otherwise ``h = E`` is eliminated the
+  same way and ``H_c`` is the root of an eliminant that equals ``E`` at the physical points.
 
 Every step runs under a time budget; a step that fails or exceeds it is refused with an
 :class:`~dirac.errors.AnalysisError` naming the step and the form ``L`` must take. The
@@ -267,6 +268,14 @@ def _vanishes(values: np.ndarray, scale: np.ndarray) -> np.ndarray:
     return finite & np.all(np.abs(values) <= CHECK_TOLERANCE * (1 + scale), axis=0)
 
 
+def _split(lagrangian: Lagrangian) -> tuple[sympy.Expr, sympy.Expr]:
+    """``L = L_v + L_0``: the terms with velocities and the velocity-free terms (e.g. ``-V(q, t)``)."""
+    velocities = set(lagrangian.velocities)
+    terms = sympy.Add.make_args(lagrangian.expression)
+    rest = sympy.Add(*[term for term in terms if not (term.free_symbols & velocities)])
+    return lagrangian.expression - rest, rest
+
+
 # ---------------------------------------------------------------------- the transform
 def eliminate_velocities(
     lagrangian: Lagrangian,
@@ -376,8 +385,9 @@ def _regular(
             )
         chosen.append(good[0])
     solution = dict(zip(v, chosen))
-    energy_v = sum((pi * vi for pi, vi in zip(p, v)), sympy.S.Zero) - lagrangian.expression
-    energy = _positive(energy_v.xreplace(solution), lagrangian, seconds, "the simplification of H = p.v - L")
+    moving, rest = _split(lagrangian)
+    energy_v = sum((pi * vi for pi, vi in zip(p, v)), sympy.S.Zero) - moving
+    energy = _positive(energy_v.xreplace(solution), lagrangian, seconds, "the simplification of H = p.v - L") - rest
     # check: H(q, p(q, v)) equals the energy v.dL/dv - L at the physical points
     direct = sum((Pi * vi for Pi, vi in zip(P, v)), sympy.S.Zero) - lagrangian.expression
     h_values = _values(samples, [energy, direct], p, samples.momenta)
@@ -446,14 +456,24 @@ def _singular(
         )
     primary = [sympy.expand(physical[k]) for k in chosen]
     # the canonical Hamiltonian: the energy v.p - L on the primary surface
-    energy_v = sum((Pi * vi for Pi, vi in zip(P, v)), sympy.S.Zero) - lagrangian.expression
-    homogeneous = _step("the Euler test sum v dL/dv - L = 0", lagrangian, seconds, lambda: sympy.simplify(energy_v) == 0)
-    if homogeneous:
+    moving, rest = _split(lagrangian)
+    euler = sum((Pi * vi for Pi, vi in zip(P, v)), sympy.S.Zero) - moving
+    homogeneous = _step("the Euler test sum v dL/dv - L = 0", lagrangian, seconds, lambda: sympy.simplify(euler) == 0)
+    if homogeneous and rest == 0:
         energy: sympy.Expr = sympy.S.Zero
         how = "L is homogeneous of degree one in the velocities (Euler: v.dL/dv - L = 0), so H_c = 0"
+    elif homogeneous:
+        energy = -rest
+        how = (
+            "L is homogeneous of degree one in the velocities up to velocity-free terms L_0 "
+            "(Euler: v.dL/dv - (L - L_0) = 0), so H_c = -L_0"
+        )
     else:
-        energy = _energy(lagrangian, alg, energy_v, relations, gens, p, samples, seconds)
-        how = "H_c = v.p - L on the primary surface, from the eliminant linear in it"
+        energy = _energy(lagrangian, alg, euler, relations, gens, p, samples, seconds) - rest
+        how = (
+            "H_c = v.p - L on the primary surface, from an eliminant of h = v.p - L (the root equal to "
+            "it at the physical points)"
+        )
     method = (
         f"singular Hessian of rank {rank}, L not quadratic in the velocities: primary constraints by eliminating "
         f"the velocities and {len(roots)} root(s) from p = dL/dq_dot (lexicographic Gröbner basis), keeping the "
@@ -472,7 +492,11 @@ def _energy(
     samples: _Samples,
     seconds: float,
 ) -> sympy.Expr:
-    """``E = v.p - L`` as a function of ``(q, p)``: eliminate the velocities from ``h = E``."""
+    """``E = v.p - L`` as a function of ``(q, p)``: eliminate the velocities from ``h = E``.
+
+    The eliminants in ``h`` and ``p`` are tried lowest degree in ``h`` first; a root that
+    equals ``E`` at the physical points is the branch taken (linear: the quotient).
+    """
     h = sympy.Symbol("_h")
     num, den = _cleared(h - alg.convert(energy_v))
     w2 = sympy.Symbol("_w2")
@@ -480,16 +504,24 @@ def _energy(
     order = [w2, *gens[: len(gens) - len(p)], h, *p]
     basis = _step(
         "the Gröbner basis eliminating the velocities from H_c = v.p - L",
-        lagrangian, seconds, lambda: sympy.groebner(system, *order, order="lex"),
+        lagrangian, seconds, partial(sympy.groebner, system, *order, order="lex"),
     )
     assert isinstance(basis, sympy.GroebnerBasis)
     eliminated = set(order) - {h, *p}
-    for g in basis.exprs:
-        if g.free_symbols & eliminated or h not in g.free_symbols or sympy.degree(g, h) != 1:
-            continue
-        a, b = sympy.Poly(g, h).all_coeffs()
-        candidate = alg.back(sympy.cancel(-b / a))
-        values = _values(samples, [candidate, energy_v], p, samples.momenta)
-        if _vanishes((values[:, 0] - values[:, 1])[:, None], np.abs(values[:, 1:2]))[0]:
-            return candidate
+    eliminants = [g for g in basis.exprs if not (g.free_symbols & eliminated) and h in g.free_symbols]
+    for g in sorted(eliminants, key=lambda g: sympy.degree(g, h)):
+        if sympy.degree(g, h) == 1:
+            a, b = sympy.Poly(g, h).all_coeffs()
+            candidates = [sympy.cancel(-b / a)]
+        else:
+            found = _step("the roots of the eliminant of H_c", lagrangian, seconds, partial(sympy.roots, g, h))
+            assert isinstance(found, dict)
+            candidates = list(found)
+        for candidate in candidates:
+            candidate = alg.back(candidate)
+            values = _values(samples, [candidate, energy_v], p, samples.momenta)
+            if _vanishes((values[:, 0] - values[:, 1])[:, None], np.abs(values[:, 1:2]))[0]:
+                if sympy.degree(g, h) == 1:
+                    return candidate
+                return _positive(candidate, lagrangian, seconds, "the simplification of H_c")
     raise _refuse(lagrangian, "the energy v.p - L could not be written as a single function of q and p on the primary surface")

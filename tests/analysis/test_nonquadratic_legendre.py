@@ -19,6 +19,12 @@ Hand derivations (momenta ``p = dL/dq_dot``, ``{q, p} = 1``, ``H_c = v.p - L``):
   ``{chi, H_T} = -(x^2 + y^2) + u {chi, phi} = -(x^2 + y^2) + 2 u (p_x^2 + p_y^2)`` fixes
   ``u = (x^2 + y^2)/2`` on the surface; ``{phi, chi} = -2 != 0``: both second class,
   ``(4 - 2)/2 = 1`` degree of freedom.
+- ``L = -sqrt(1 - (x_dot - y_dot)^2) - x^2/2``, ``s = x_dot - y_dot``: ``p_x = s/sqrt(1 - s^2)
+  = -p_y``, primary ``p_x + p_y = 0``; the velocity part is not homogeneous:
+  ``v.p - L_v = s^2/sqrt(1 - s^2) + sqrt(1 - s^2) = 1/sqrt(1 - s^2) = sqrt(1 + p_x^2)``, so
+  ``H_c = sqrt(1 + p_x^2) + x^2/2`` on the surface. ``{p_x + p_y, H_c} = -x``: secondary
+  ``x = 0``; ``{x, H_T} = u`` fixes ``u = 0``; ``{p_x + p_y, x} = -1``: both second class,
+  ``(4 - 2)/2 = 1`` degree of freedom.
 """
 
 from __future__ import annotations
@@ -117,6 +123,20 @@ def test_singular_not_homogeneous_energy_on_the_primary_surface():
     (u,) = a.multipliers.values()
     on_surface = u.subs(p_y**2, 1 - p_x**2)
     assert sympy.simplify(on_surface - (x**2 + y**2) / 2) == 0
+    assert len(a.second_class) == 2 and a.physical_degrees_of_freedom == 1
+
+
+def test_singular_energy_from_a_root_of_its_eliminant():
+    L = Lagrangian.from_strings("boosted", ["x", "y"], "-sqrt(1 - (x_dot - y_dot)**2) - x**2/2")
+    a = dirac.analyze(L)
+    x, p_x, p_y = _symbols(a, "x", "p_x", "p_y")
+    assert a.hessian_rank == 1
+    assert sympy.simplify(a.stages[0][0] / (p_x + p_y)).is_number
+    kinetic = a.canonical_hamiltonian - x**2 / 2
+    assert sympy.simplify((kinetic**2 - 1 - p_x**2).subs(p_y, -p_x)) == 0
+    assert sympy.simplify(kinetic.subs({p_y: -sympy.Rational(3, 4), p_x: sympy.Rational(3, 4)}) - sympy.Rational(5, 4)) == 0
+    assert [len(stage) for stage in a.stages] == [1, 1] and a.stages[1][0] in (x, -x)
+    assert a.multipliers == {"u_1": 0}
     assert len(a.second_class) == 2 and a.physical_degrees_of_freedom == 1
 
 
