@@ -221,10 +221,20 @@ class ConstraintAnalysis:
         ------
         AnalysisError
             If a component's exact Dirac bracket is too large to solve symbolically
-            (bracket matrix block or time over its limit); the message names it.
+            (bracket matrix block or time over its limit); the message names it. Also
+            when second-class constraints depend explicitly on the time ``t`` (their
+            time derivative adds a term the engine does not build yet).
         InputError
             For a name that is not a phase-space variable.
         """
+        timed = [c for c in self.second_class if self.time is not None and self.time in c.free_symbols]
+        if timed:  # z_dot = {z, H}_D - {z, Phi_a} (C^-1)^ab d_t Phi_b (Gitman–Tyutin): the last term is not built
+            raise AnalysisError(
+                f"the equations of motion of {self.name!r} are not available: its second-class constraints depend "
+                f"explicitly on the time t (e.g. {timed[0]}), so z_dot has the term -{{z, Phi_a}} (C^-1)^ab d_t Phi_b "
+                "besides the Dirac bracket {z, H}_D, which the engine does not compute yet; the constraint chain, "
+                "the multipliers and dirac_bracket() are complete"
+            )
         free = set(self.undetermined_multipliers)
         H = self.canonical_hamiltonian + sum(
             (u * phi for u, phi in zip(self.primary_multipliers, self.primary_constraints) if u in free), sympy.S.Zero

@@ -144,3 +144,19 @@ def test_constraints_that_hold_at_one_instant_only_are_inconsistent():
 def test_numeric_points_carry_their_own_time(growing):
     times = [float(point[-1]) for point in growing._points]
     assert len(set(times)) == len(times) and np.all(np.isfinite(times))
+
+
+def test_equations_of_motion_with_time_dependent_second_class_constraints_are_refused(growing):
+    """z_dot = {z, H}_D - {z, Phi_a} (C^-1)^ab d_t Phi_b: the Dirac bracket alone would be wrong."""
+    with pytest.raises(dirac.AnalysisError, match="depend explicitly on the time t"):
+        growing.equations_of_motion(["x"])
+
+
+def test_equations_of_motion_with_time_only_in_the_hamiltonian():
+    """Driven oscillator L = x_dot^2/2 - x^2/2 + x cos(t): H_c = p^2/2 + x^2/2 - x cos(t), no
+    constraints, so x_dot = p and p_dot = -x + cos(t)."""
+    driven = dirac.analyze(Lagrangian.from_strings("driven", ["x"], "x_dot**2/2 - x**2/2 + x*cos(t)"))
+    x, p = driven.symbols["x"], driven.symbols["p_x"]
+    eom = driven.equations_of_motion()
+    assert eom[x] == p
+    assert sympy.simplify(eom[p] - (-x + sympy.cos(driven.time))) == 0
