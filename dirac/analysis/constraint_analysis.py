@@ -198,7 +198,10 @@ class ConstraintAnalysis:
 
         ``H = H_c + u_k phi_k`` over the primary constraints whose multipliers stay free
         (first class); those ``u_k`` stay as symbols. Second-class terms of ``H_T`` drop
-        out of Dirac brackets ((240); for the rigid body (250)-(251) follow).
+        out of Dirac brackets ((240); for the rigid body (250)-(251) follow). When
+        second-class constraints depend explicitly on the time ``t``,
+        ``z_dot = {z, H}_D - {z, Phi_a} (C^{-1})^{ab} d_t Phi_b`` (Gitman–Tyutin), so that
+        the motion stays on the moving surface; ``at`` then needs ``t`` too.
 
         Parameters
         ----------
@@ -221,20 +224,10 @@ class ConstraintAnalysis:
         ------
         AnalysisError
             If a component's exact Dirac bracket is too large to solve symbolically
-            (bracket matrix block or time over its limit); the message names it. Also
-            when second-class constraints depend explicitly on the time ``t`` (their
-            time derivative adds a term the engine does not build yet).
+            (bracket matrix block or time over its limit); the message names it.
         InputError
             For a name that is not a phase-space variable.
         """
-        timed = [c for c in self.second_class if self.time is not None and self.time in c.free_symbols]
-        if timed:  # z_dot = {z, H}_D - {z, Phi_a} (C^-1)^ab d_t Phi_b (Gitman–Tyutin): the last term is not built
-            raise AnalysisError(
-                f"the equations of motion of {self.name!r} are not available: its second-class constraints depend "
-                f"explicitly on the time t (e.g. {timed[0]}), so z_dot has the term -{{z, Phi_a}} (C^-1)^ab d_t Phi_b "
-                "besides the Dirac bracket {z, H}_D, which the engine does not compute yet; the constraint chain, "
-                "the multipliers and dirac_bracket() are complete"
-            )
         free = set(self.undetermined_multipliers)
         H = self.canonical_hamiltonian + sum(
             (u * phi for u, phi in zip(self.primary_multipliers, self.primary_constraints) if u in free), sympy.S.Zero
@@ -243,10 +236,12 @@ class ConstraintAnalysis:
         result: dict = {}
         for z in items:
             if at is not None:
-                result[z] = self._bracket.at(z, H, at)
+                result[z] = self._bracket.at(z, H, at) + self._bracket.explicit_time_term(z, at)
                 continue
             try:
                 result[z] = self._bracket.exact(z, H, time_limit=time_limit)
+                if self.time is not None:  # second-class constraints with explicit t
+                    result[z] = result[z] + self._bracket.explicit_time_term(z, time_limit=time_limit)
             except SolveTooLarge as exc:
                 raise AnalysisError(
                     f"the exact Dirac bracket {{{z}, H}}_D of {self.name!r} cannot be found symbolically: {exc}; "
