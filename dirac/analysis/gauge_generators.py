@@ -54,6 +54,7 @@ __all__ = [
     "first_class_hamiltonian",
     "gauge_structure",
     "parameter_name",
+    "transformation",
 ]
 
 #: relative size below which a residual counts as zero in the span tests
@@ -168,11 +169,15 @@ class GaugeGenerator:
         the parameter; ``G_N`` is a primary first-class constraint.
     multiplier
         Name of the free multiplier ``v`` that goes with it (``u_f``).
+    delta
+        ``delta z = {z, G}`` for each phase-space variable it moves, in the parameter
+        symbols of :meth:`parameter_symbols`.
     """
 
     parameter: str
     terms: tuple[sympy.Expr, ...]
     multiplier: str
+    delta: dict[sympy.Symbol, sympy.Expr] = field(default_factory=dict)
 
     @property
     def order(self) -> int:
@@ -188,15 +193,15 @@ class GaugeGenerator:
         """``G = sum_k eps^(k) G_k`` with the parameter derivatives as symbols."""
         return sum((e * g for e, g in zip(self.parameter_symbols(), self.terms)), sympy.S.Zero)
 
-    def transformation(self, space: PhaseSpace) -> dict[sympy.Symbol, sympy.Expr]:
-        """``delta z = {z, G}`` for every phase-space variable ``z`` (zero ones left out)."""
-        G = self.generator()
-        out = {}
-        for z in space.variables:
-            delta = sympy.expand(space.poisson_bracket(z, G))
-            if delta != 0:
-                out[z] = delta
-        return out
+
+def transformation(space: PhaseSpace, G: sympy.Expr) -> dict[sympy.Symbol, sympy.Expr]:
+    """``delta z = {z, G}`` for every phase-space variable ``z`` (zero ones left out)."""
+    out = {}
+    for z in space.variables:
+        d = sympy.expand(space.poisson_bracket(z, G))
+        if d != 0:
+            out[z] = d
+    return out
 
 
 @dataclass
@@ -209,14 +214,53 @@ class GaugeStructure:
         One :class:`GaugeGenerator` per independent gauge parameter (free multiplier).
     without_transformation
         First-class constraints outside the span of every generator's terms: they
-        generate no gauge transformation of the equations of motion.
-    notes
-        How the generators were found, and where Castellani's chain could not close.
+        generate no gauge transformation of the equations of motion (after a partial
+        gauge fixing: no transformation with a time-dependent parameter is left).
+    unclosed
+        Primary first-class combinations whose Castellani chain did not close.
+    gauge_fixed
+        Whether the analysis has gauge conditions (changes the account of
+        ``without_transformation``).
     """
 
     generators: list[GaugeGenerator] = field(default_factory=list)
     without_transformation: list[sympy.Expr] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
+    unclosed: list[sympy.Expr] = field(default_factory=list)
+    second_class_present: bool = False
+    gauge_fixed: bool = False
+
+    @property
+    def notes(self) -> list[str]:
+        """How the generators were found, and each first-class constraint without one."""
+        out = []
+        if self.generators:
+            out.append(
+                "gauge generators by Castellani's algorithm: G = sum_k eps^(k) G_k with G_N primary first class, "
+                "G_(k-1) = -{G_k, H'} and {G_0, H'} a primary first-class combination"
+                + (" modulo second-class constraints" if self.second_class_present else "")
+                + "; every term checked first class at the surface points"
+            )
+        for gamma in self.unclosed:
+            out.append(
+                f"Castellani's chain started at the primary first-class constraint {gamma} did not close with zero "
+                "PFC coefficients within the number of stages: no generator is reported for it"
+            )
+        for c in self.without_transformation:
+            out.append(self.account(c))
+        return out
+
+    def account(self, constraint: sympy.Expr) -> str:
+        """Why a first-class constraint has no generator."""
+        if self.gauge_fixed:
+            return (
+                f"the first-class constraint {constraint} remains after the gauge conditions, but no free multiplier "
+                "is left: it generates no gauge transformation with a time-dependent parameter (at most a residual "
+                "one with a constant parameter)"
+            )
+        return (
+            f"the first-class constraint {constraint} generates no gauge transformation: it is not in the span of "
+            "the generators' terms (Dirac's conjecture does not hold for it, as in Cawley's example)"
+        )
 
 
 def _gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
@@ -265,7 +309,7 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     closing_basis = _gradients(space, numerics, gammas + second, points)
     constraints = list(analysis.constraints)
     limit = len(analysis.stages) + 1
-    structure = GaugeStructure()
+    structure = GaugeStructure(second_class_present=bool(second), gauge_fixed=bool(analysis.gauge_conditions))
     multiplier_names = [u.name for u in analysis.primary_multipliers]
     for index, (gamma, f) in enumerate(zip(gammas, split.free), start=1):
         chain = [gamma]  # G_N, G_{N-1}, ...
@@ -277,30 +321,16 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
                 break
             chain.append(tidy(-R, space.variables))
         if not closed:
-            structure.notes.append(
-                f"Castellani's chain started at the primary first-class constraint {gamma} did not close "
-                f"within {limit} steps with zero PFC coefficients: no generator is reported for it"
-            )
+            structure.unclosed.append(gamma)
             continue
         _check_first_class(space, numerics, chain, constraints, points)
-        terms = tuple(reversed(chain))
-        structure.generators.append(GaugeGenerator(f"eps_{index}", terms, multiplier_names[f]))
+        generator = GaugeGenerator(f"eps_{index}", tuple(reversed(chain)), multiplier_names[f])
+        generator.delta = transformation(space, generator.generator())
+        structure.generators.append(generator)
     all_terms = [g for gen in structure.generators for g in gen.terms]
     first = list(analysis.first_class)
     spanned = _in_span(_gradients(space, numerics, first, points), _gradients(space, numerics, all_terms + second, points))
     structure.without_transformation = [c for c, ok in zip(first, spanned) if not ok]
-    if structure.generators:
-        structure.notes.append(
-            "gauge generators by Castellani's algorithm: G = sum_k eps^(k) G_k with G_N primary first class, "
-            "G_(k-1) = -{G_k, H'} and {G_0, H'} a primary first-class combination"
-            + (" modulo second-class constraints" if second else "")
-            + "; every term checked first class at the surface points"
-        )
-    for c in structure.without_transformation:
-        structure.notes.append(
-            f"the first-class constraint {c} generates no gauge transformation: it is not in the span of the "
-            "generators' terms (Dirac's conjecture does not hold for it, as in Cawley's example)"
-        )
     return structure
 
 
