@@ -17,7 +17,7 @@ import sympy
 from dirac.analysis.classification import bracket_matrix, classify
 from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
-from dirac.analysis.gauge_fixing import fix_gauge
+from dirac.analysis.gauge_fixing import fix_gauge, regular_gauge_point
 from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure, gauge_structure
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
@@ -288,7 +288,10 @@ class ConstraintAnalysis:
         index = {s.name: i for i, s in enumerate(self.phase_space)}
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:
-            point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
+            if self.gauge_conditions:
+                point = regular_gauge_point(self, numerics, fixed)
+            else:
+                point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
         except AnalysisError:
             if fixed:
                 raise InputError(

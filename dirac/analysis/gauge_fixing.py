@@ -42,13 +42,16 @@ from dirac.errors import AnalysisError, InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
 from dirac.validate import did_you_mean
 
-__all__ = ["fix_gauge", "parse_gauge_condition"]
+__all__ = ["fix_gauge", "parse_gauge_condition", "regular_gauge_point"]
 
 #: relative residual below which the preservation equations count as solved
 SOLVE_TOLERANCE = 1e-8
 
 #: rounds of surface points sampled to find regular points of the gauge surface
 REGULAR_ROUNDS = 5
+
+#: random starts allowed to find one regular point of a gauge-fixed surface
+REGULAR_ATTEMPTS = 20
 
 
 def parse_gauge_condition(text: str | sympy.Expr, analysis: Any) -> sympy.Expr:
@@ -191,6 +194,33 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
             "the gauge is not valid at such points"
         )
     return fixed
+
+
+def regular_gauge_point(analysis: Any, numerics: Numerics, fixed: dict[int, float]) -> np.ndarray:
+    """A point of the gauge-fixed surface of ``analysis`` where the gauge is valid.
+
+    The gauge surface can contain points where the conditions stop fixing the gauge (the
+    second-class matrix ``C`` of (240) is singular there, e.g. the origin for a rotation
+    gauge); random starts are repeated until ``C`` has full rank.
+
+    Raises
+    ------
+    InputError
+        If every point found (with the ``fixed`` values held) is singular for the gauge.
+    AnalysisError
+        If no point of the surface is found at all.
+    """
+    C = list(analysis._bracket.C)
+    size = len(analysis.second_class)
+    for _ in range(REGULAR_ATTEMPTS):
+        point = numerics.surface_points(analysis.constraints, 1, fixed=fixed)[0]
+        if not size or numeric_rank(numerics.evaluate(C, [point]).reshape(size, size)) == size:
+            return point
+    raise InputError(
+        f"every point found on the gauge surface of {analysis.name!r} with the given values is singular for the "
+        f"gauge conditions {', '.join(analysis.gauge_conditions)} (their brackets with the first-class "
+        "constraints lose rank there): the gauge is not valid at these values; give other values"
+    )
 
 
 def _regular_points(name, texts, exprs, first, constraints, numerics, pb) -> tuple[list[np.ndarray], int]:

@@ -1,0 +1,147 @@
+"""Gauge generators by Castellani's algorithm, against hand derivations.
+
+Castellani's chain: ``G_N = PFC``, ``G_(k-1) + {G_k, H'} = PFC``, ``{G_0, H'} = PFC``;
+``G = sum_k eps^(k) G_k`` and ``delta z = {z, G}``. Each test derives the chain by hand
+and checks, independently of the construction, that the transformation leaves the
+action invariant (``delta L`` is a total time derivative), which is what makes it a
+gauge symmetry of the equations of motion.
+"""
+
+from __future__ import annotations
+
+import pytest
+import sympy
+
+import dirac
+
+
+def _lagrangian_variation(analysis, generator):
+    """``delta L`` of the transformation ``delta q = {q, G}`` with ``eps = eps(t)`` a function
+    and the momenta replaced by ``dL/dq_dot`` (the Legendre map), on a curve ``q(t)``."""
+    lagrangian = analysis.lagrangian
+    t = sympy.Dummy("time", real=True)  # not "t": the einbein particle has a coordinate t
+    eps = sympy.Function("eps")(t)
+    q = lagrangian.coordinates
+    v = lagrangian.velocities
+    curve = {qi: sympy.Function(qi.name)(t) for qi in q}
+    curve_v = {vi: sympy.diff(curve[qi], t) for qi, vi in zip(q, v)}
+    momenta = {analysis.symbols[f"p_{qi.name}"]: sympy.diff(lagrangian.expression, vi) for qi, vi in zip(q, v)}
+    parameters = {e: sympy.diff(eps, t, k) for k, e in enumerate(generator.parameter_symbols())}
+    L = lagrangian.expression.xreplace(curve_v).xreplace(curve)
+    delta_q = {qi: generator.delta.get(qi, sympy.S.Zero).xreplace(parameters).xreplace(momenta) for qi in q}
+    delta_q = {qi: d.xreplace(curve_v).xreplace(curve) for qi, d in delta_q.items()}
+    variation = sum(
+        (sympy.diff(L, curve[qi]) * delta_q[qi] + sympy.diff(L, curve_v[vi]) * sympy.diff(delta_q[qi], t))
+        for qi, vi in zip(q, v)
+    )
+    return variation, L, eps, curve, t
+
+
+def test_christ_lee_generator_is_the_gauss_law_and_p_xi():
+    """gauge_system (the Christ-Lee model, xi called z), by hand:
+    H_c = (p_x^2 + p_y^2)/2 + k r^2/2 + z (y p_x - x p_y); G_1 = p_z (primary first class);
+    G_0 = -{p_z, H_c} = y p_x - x p_y; {G_0, H_c} = 0 (rotation invariance, {J, z J} = 0),
+    so the chain closes: G = eps (y p_x - x p_y) + eps_dot p_z, and
+    delta x = eps y, delta y = -eps x, delta z = eps_dot: a rotation by -eps with
+    z -> z + eps_dot, under which x_dot - z y and y_dot + z x rotate and L is invariant."""
+    analysis = dirac.analyze(dirac.load_system("gauge_system"))
+    s = analysis.symbols
+    [gen] = analysis.gauge_generators
+    G0, G1 = gen.terms
+    assert gen.order == 1 and gen.multiplier == "u_1"
+    c = sympy.cancel(G1 / s["p_z"])
+    assert c.is_number and c != 0  # G_1 proportional to p_z
+    gauss = s["y"] * s["p_x"] - s["x"] * s["p_y"]
+    rest = sympy.expand(G0 - c * gauss)  # G_0 = c * Gauss law + (multiple of p_z)
+    assert sympy.expand(rest - sympy.diff(rest, s["p_z"]) * s["p_z"]) == 0
+    eps, eps_dot = gen.parameter_symbols()
+    assert sympy.simplify(gen.delta[s["x"]] - c * eps * s["y"]) == 0
+    assert sympy.simplify(gen.delta[s["y"]] + c * eps * s["x"]) == 0
+    assert sympy.simplify(gen.delta[s["z"]] - c * eps_dot) == 0
+    variation, *_ = _lagrangian_variation(analysis, gen)
+    assert sympy.simplify(variation) == 0
+    assert analysis.gauge_structure.without_transformation == []
+
+
+def test_einbein_particle_generator_is_reparametrisation():
+    """relativistic_particle, by hand: H_c = e C, C = (m^2 - p_t^2 + p_x^2 + p_y^2 + p_z^2)/2;
+    G_1 = p_e, G_0 = -{p_e, H_c} = C, {C, e C} = 0: G = eps C + eps_dot p_e.
+    delta x^i = eps p_i = eps x_dot^i/e, delta t = -eps p_t = eps t_dot/e, delta e = eps_dot:
+    with xi = eps/e this is the reparametrisation delta q = xi q_dot, delta e = d(xi e)/dt,
+    under which delta L = d(xi L)/dt."""
+    analysis = dirac.analyze(dirac.load_system("relativistic_particle"))
+    s = analysis.symbols
+    m = sympy.Symbol("m", real=True)
+    [gen] = analysis.gauge_generators
+    G0, G1 = gen.terms
+    c = sympy.cancel(G1 / s["p_e"])
+    assert c.is_number and c != 0
+    shell = (m**2 - s["p_t"] ** 2 + s["p_x"] ** 2 + s["p_y"] ** 2 + s["p_z"] ** 2) / 2
+    rest = sympy.expand(G0 - c * shell)
+    assert sympy.expand(rest - sympy.diff(rest, s["p_e"]) * s["p_e"]) == 0
+    variation, L, eps, curve, t = _lagrangian_variation(analysis, gen)
+    e = curve[analysis.lagrangian.coordinates[-1]]
+    assert analysis.lagrangian.coordinates[-1].name == "e"
+    assert sympy.simplify(variation - sympy.diff(c * eps / e * L, t)) == 0
+
+
+def test_two_step_chain_gives_a_second_derivative_of_the_parameter():
+    """L = (x_dot - y)^2/2 + (y_dot - z)^2/2, by hand: p_x = x_dot - y, p_y = y_dot - z, p_z = 0;
+    H_c = p_x^2/2 + p_y^2/2 + y p_x + z p_y. {p_z, H_c} = -p_y, {p_y, H_c} = -p_x, {p_x, H_c} = 0:
+    first-class chain p_z -> p_y -> p_x (three stages), and Castellani's chain
+    G_2 = p_z, G_1 = p_y, G_0 = p_x: G = eps p_x + eps_dot p_y + eps_ddot p_z, i.e.
+    delta x = eps, delta y = eps_dot, delta z = eps_ddot, which leaves both x_dot - y and
+    y_dot - z unchanged."""
+    L = dirac.Lagrangian.from_strings("chain3", ["x", "y", "z"], "(x_dot - y)**2/2 + (y_dot - z)**2/2")
+    analysis = dirac.analyze(L)
+    s = analysis.symbols
+    assert [len(stage) for stage in analysis.stages] == [1, 1, 1]
+    [gen] = analysis.gauge_generators
+    assert gen.order == 2
+    assert list(gen.terms) == [s["p_x"], s["p_y"], s["p_z"]]
+    eps, eps_dot, eps_ddot = gen.parameter_symbols()
+    assert [e.name for e in (eps, eps_dot, eps_ddot)] == ["eps_1", "eps_1_dot", "eps_1_ddot"]
+    assert gen.delta == {s["x"]: eps, s["y"]: eps_dot, s["z"]: eps_ddot}
+    variation, *_ = _lagrangian_variation(analysis, gen)
+    assert sympy.simplify(variation) == 0
+
+
+def test_first_class_combination_beside_second_class_constraints():
+    """Circle twice, L = |x_dot|^2/2 - lambda_1 (r^2 - 1) - lambda_2 (2 r^2 - 2), by hand:
+    the multipliers enter only through lambda_1 + 2 lambda_2, so gamma = p_lambda_2 - 2 p_lambda_1
+    is primary first class, {gamma, H_c} = -2(r^2 - 1) + 2(r^2 - 1) = 0: G = eps gamma (no
+    derivative), delta lambda_1 = -2 eps, delta lambda_2 = eps (up to the normalisation of gamma)."""
+    L = dirac.Lagrangian.from_strings(
+        "twice", ["x", "y"], "(x_dot**2 + y_dot**2)/2", constraints=["x**2 + y**2 - 1", "2*x**2 + 2*y**2 - 2"]
+    )
+    analysis = dirac.analyze(L)
+    s = analysis.symbols
+    [gen] = analysis.gauge_generators
+    assert gen.order == 0
+    [G0] = gen.terms
+    ratio = sympy.cancel(G0 / (s["p_lambda_2"] - 2 * s["p_lambda_1"]))
+    assert ratio.is_number and ratio != 0
+    eps = gen.parameter_symbols()[0]
+    assert set(gen.delta) == {s["lambda_1"], s["lambda_2"]}
+    assert sympy.simplify(gen.delta[s["lambda_1"]] + 2 * gen.delta[s["lambda_2"]]) == 0
+    assert sympy.simplify(gen.delta[s["lambda_2"]] - ratio * eps) == 0
+
+
+def test_no_gauge_freedom_gives_no_generator():
+    """The pendulum's constraints are all second class: no gauge parameter."""
+    analysis = dirac.analyze(dirac.load_system("pendulum"))
+    assert analysis.gauge_generators == []
+    assert analysis.to_json()["gauge_generators"] == []
+
+
+@pytest.mark.parametrize("name", ["gauge_system", "relativistic_particle"])
+def test_json_terms_are_the_generator_terms(name):
+    analysis = dirac.analyze(dirac.load_system(name))
+    data = analysis.to_json()
+    assert data["gauge_generators"] == [{"terms": [str(g) for g in gen.terms]} for gen in analysis.gauge_generators]
+    assert len(data["gauge_generators"]) == len(analysis.undetermined_multipliers) == 1
+    assert data["first_class_without_gauge_transformation"] == []
+    assert data["gauge_conditions"] == []
+    text = analysis.to_text()
+    assert "gauge generators (Castellani): 1" in text
+    assert r"\varepsilon_{1}" in analysis.to_latex()
