@@ -15,9 +15,13 @@ where ``PFC`` is a combination of primary first-class constraints and ``H' = H_c
 the first-class Hamiltonian: ``H_T = H' + v_f gamma_f`` with ``U`` the particular solution
 of the multiplier equations ``{Phi_i, H_c} + {Phi_i, phi_a} u_a ~ 0`` whose free components
 vanish, and ``gamma_f = phi_f + V_fq phi_q`` spanning their homogeneous solutions
-(Henneaux–Teitelboim (1.32)-(1.35); Gitman–Tyutin, ch. 2). The chain is built with zero
-``PFC`` coefficients: ``G_{k-1} = -{G_k, H'}``, and it closes at the first ``G_0`` whose
-bracket with ``H'`` is ``PFC``. Second-class constraints vanish strongly in the Dirac
+(Henneaux–Teitelboim (1.32)-(1.35); Gitman–Tyutin, ch. 2). The chain is built downwards,
+``G_{k-1} = -{G_k, H'} + c_a gamma_a``, and closes at the first ``G_0`` whose bracket with
+``H'`` is ``PFC``. The free coefficients ``c_a`` (functions) are chosen so that
+``{G_{k-1}, H'} = -{R, H'} + c_a S_a + PFC`` (``R = {G_k, H'}``, ``S_a = {gamma_a, H'}``)
+has no ``S_a``-components: ``c_a`` are the ``S_a``-coefficients of ``{R, H'}`` expanded
+over the constraints (:func:`_expansion`). In abelian models ``c = 0``; in a
+Yang–Mills-type model they give the covariant derivative ``delta A = eps_dot + [eps, A]``. Second-class constraints vanish strongly in the Dirac
 bracket, so with second-class constraints "PFC" is read modulo them (their gradients are
 allowed in the closing test; Henneaux–Teitelboim ch. 3.3).
 
@@ -236,14 +240,14 @@ class GaugeStructure:
         if self.generators:
             out.append(
                 "gauge generators by Castellani's algorithm: G = sum_k eps^(k) G_k with G_N primary first class, "
-                "G_(k-1) = -{G_k, H'} and {G_0, H'} a primary first-class combination"
+                "G_(k-1) = -{G_k, H'} + PFC and {G_0, H'} a primary first-class combination"
                 + (" modulo second-class constraints" if self.second_class_present else "")
                 + "; every term checked first class at the surface points"
             )
         for gamma in self.unclosed:
             out.append(
-                f"Castellani's chain started at the primary first-class constraint {gamma} did not close with zero "
-                "PFC coefficients within the number of stages: no generator is reported for it"
+                f"Castellani's chain started at the primary first-class constraint {gamma} did not close within "
+                "the number of stages: no generator is reported for it"
             )
         for c in self.without_transformation:
             out.append(self.account(c))
@@ -251,6 +255,11 @@ class GaugeStructure:
 
     def account(self, constraint: sympy.Expr) -> str:
         """Why a first-class constraint has no generator."""
+        if self.unclosed:
+            return (
+                f"the first-class constraint {constraint} is not in the span of the generators found; since some "
+                "Castellani chains did not close, whether it generates a gauge transformation is not decided"
+            )
         if self.gauge_fixed:
             return (
                 f"the first-class constraint {constraint} remains after the gauge conditions, but no free multiplier "
@@ -311,6 +320,8 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     limit = len(analysis.stages) + 1
     structure = GaugeStructure(second_class_present=bool(second), gauge_fixed=bool(analysis.gauge_conditions))
     multiplier_names = [u.name for u in analysis.primary_multipliers]
+    secondary = [space.poisson_bracket(g, H1) for g in gammas]  # S_a = {gamma_a, H'}
+    expansion_basis = gammas + secondary + constraints
     for index, (gamma, f) in enumerate(zip(gammas, split.free), start=1):
         chain = [gamma]  # G_N, G_{N-1}, ...
         closed = False
@@ -319,7 +330,14 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
             if R == 0 or _closes(space, numerics, R, points, closing_basis):
                 closed = True
                 break
-            chain.append(tidy(-R, space.variables))
+            # G_(k-1) = -R + c_a gamma_a: c_a cancels the S_a-components of {R, H'}, so that
+            # {G_(k-1), H'} = -{R, H'} + c_a S_a + PFC loses them (Castellani's PFC freedom)
+            following = -R
+            coefficients = _expansion(space, numerics, space.poisson_bracket(R, H1), expansion_basis, points)
+            if coefficients is not None:
+                c = coefficients[len(gammas) : 2 * len(gammas)]
+                following += sum((ca * ga for ca, ga in zip(c, gammas)), sympy.S.Zero)
+            chain.append(tidy(following, space.variables))
         if not closed:
             structure.unclosed.append(gamma)
             continue
@@ -332,6 +350,38 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     spanned = _in_span(_gradients(space, numerics, first, points), _gradients(space, numerics, all_terms + second, points))
     structure.without_transformation = [c for c, ok in zip(first, spanned) if not ok]
     return structure
+
+
+def _expansion(space: PhaseSpace, numerics, W: sympy.Expr, basis: Sequence[sympy.Expr], points) -> list[sympy.Expr] | None:
+    """Coefficients ``l_b`` with ``grad W ~ sum_b l_b grad basis_b`` on the surface (exact, weakly).
+
+    ``W`` must vanish weakly; the basis elements are taken in the given order, dependent
+    ones get coefficient 0. Pivot variables ``P`` (columns of the gradients with an
+    invertible block) give ``(d basis_B / d z_P)^T l = d W / d z_P``, solved by
+    :func:`~dirac.analysis.linear_solve.weak_solve`. ``None`` when ``W`` is not weakly
+    zero or its gradient is not in the span.
+    """
+    if W == 0:
+        return [sympy.S.Zero] * len(basis)
+    if not numerics.weakly_zero([W], points)[0]:
+        return None
+    grads = _gradients(space, numerics, list(basis), points)
+    kept = independent(list(grads), list(range(len(basis))))
+    if not kept or not _in_span(_gradients(space, numerics, [W], points), grads[:, kept, :])[0]:
+        return None
+    columns = independent([g[kept].T for g in grads], list(range(len(space.variables))))
+    if len(columns) != len(kept):
+        return None
+    variables = space.variables
+    A = sympy.Matrix(len(columns), len(kept), lambda i, j: sympy.diff(basis[kept[j]], variables[columns[i]]))
+    b = sympy.Matrix([sympy.diff(W, variables[i]) for i in columns])
+    A_num = [g[np.ix_(kept, columns)].T for g in grads]
+    b_num = [w[0, columns].reshape(-1, 1) for w in _gradients(space, numerics, [W], points)]
+    x = weak_solve(A, b, A_num, b_num, variables=variables)
+    out = [sympy.S.Zero] * len(basis)
+    for j, k in enumerate(kept):
+        out[k] = x[j, 0]
+    return out
 
 
 def _closes(space: PhaseSpace, numerics, R: sympy.Expr, points, basis: np.ndarray) -> bool:

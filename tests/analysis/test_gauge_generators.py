@@ -145,3 +145,41 @@ def test_json_terms_are_the_generator_terms(name):
     text = analysis.to_text()
     assert "gauge generators (Castellani): 1" in text
     assert r"\varepsilon_{1}" in analysis.to_latex()
+
+
+SO3_TOY = (
+    "((x1_dot - (a2*x3 - a3*x2))**2 + (x2_dot - (a3*x1 - a1*x3))**2 + (x3_dot - (a1*x2 - a2*x1))**2"
+    " + (y1_dot - (a2*y3 - a3*y2))**2 + (y2_dot - (a3*y1 - a1*y3))**2 + (y3_dot - (a1*y2 - a2*y1))**2)/2"
+    " - k/2*(x1**2 + x2**2 + x3**2 + y1**2 + y2**2 + y3**2)"
+)
+
+
+def test_yang_mills_type_toy_needs_the_covariant_derivative():
+    """Two particles in R^3 with an so(3) gauge field a: L = sum |x_dot - a x x|^2/2 - k/2 (|x|^2 + |y|^2).
+    By hand: p_a = 0, H_c = |p|^2/2 + k/2 r^2 + a . J with J = x x p_x + y x p_y,
+    {J_i, J_j} = eps_ijk J_k (non-abelian). G_1 = p_a_i, R = {p_a_i, H_c} = -J_i and
+    {R, H_c} = -{J_i, a . J} = -eps_ijk a_j J_k, which is no primary combination: with
+    S_k = {p_a_k, H_c} = -J_k it is c_k S_k, c_k = eps_ijk a_j, so Castellani's free PFC term
+    gives G_0 = -R + c_k p_a_k = J_i + (a x p_a)_i, and {G_0, H_c} ~ 0 mod p_a.
+    Then delta x = eps x x, delta a = eps_dot + eps x a (the covariant derivative), under which
+    x_dot - a x x turns with the rotation and L is invariant. Three gauge parameters."""
+    names = ["x1", "x2", "x3", "y1", "y2", "y3", "a1", "a2", "a3"]
+    analysis = dirac.analyze(dirac.Lagrangian.from_strings("so3_toy", names, SO3_TOY, parameters={"k": 1.0}))
+    s = analysis.symbols
+    assert [len(st) for st in analysis.stages] == [3, 3] and analysis.physical_degrees_of_freedom == 3
+    generators = analysis.gauge_generators
+    assert len(generators) == 3
+    x = sympy.Matrix([s["x1"], s["x2"], s["x3"]])
+    a = sympy.Matrix([s["a1"], s["a2"], s["a3"]])
+    for i, gen in enumerate(generators):
+        eps, eps_dot = gen.parameter_symbols()
+        e = sympy.Matrix([eps if j == i else 0 for j in range(3)])
+        e_dot = sympy.Matrix([eps_dot if j == i else 0 for j in range(3)])
+        delta_x = e.cross(x)
+        delta_a = e_dot + e.cross(a)
+        for j in range(3):
+            assert sympy.expand(gen.delta.get(x[j], 0) - delta_x[j]) == 0
+            assert sympy.expand(gen.delta.get(a[j], 0) - delta_a[j]) == 0
+        variation, *_ = _lagrangian_variation(analysis, gen)
+        assert sympy.simplify(variation) == 0
+    assert analysis.gauge_structure.without_transformation == []
