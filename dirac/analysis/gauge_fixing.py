@@ -290,6 +290,8 @@ def _preserve(analysis, texts, exprs, split, points, numerics, pb) -> tuple[dict
     c, F = len(exprs), len(gammas)
     e_sym = [pb(chi, H1) for chi in exprs]
     B_sym = sympy.Matrix(c, F, lambda i, f: pb(exprs[i], gammas[f]))
+    zero = numerics.weakly_zero(list(B_sym), points) if F else []
+    B_sym = sympy.Matrix(c, F, lambda i, f: sympy.S.Zero if zero[i * F + f] else B_sym[i, f])
     e_num = numerics.evaluate(e_sym, points).reshape(len(points), c)
     B_num = numerics.evaluate(list(B_sym), points).reshape(len(points), c, F) if F else np.zeros((len(points), c, 0))
     bad = np.zeros(c, dtype=bool)

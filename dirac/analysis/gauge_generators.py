@@ -64,6 +64,11 @@ __all__ = [
 #: relative size below which a residual counts as zero in the span tests
 SPAN_TOLERANCE = 1e-8
 
+#: largest gradient of a generator term, at every surface point, that counts as vanishing:
+#: an irregular constraint such as p^2 = 0 is met by the Gauss-Newton points only to
+#: |p| ~ sqrt(residual), so its gradient there is ~1e-6, while a regular one's is O(1)
+IRREGULAR_GRADIENT = 1e-4
+
 
 def independent(matrices: Sequence[np.ndarray], order: Sequence[int]) -> list[int]:
     """:func:`~dirac.analysis.numeric.independent_rows`, and none of a matrix that is zero at every point."""
@@ -132,6 +137,8 @@ def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
         return FirstClassHamiltonian(H_c, [], [], [], {}, {})
     pb = space.poisson_bracket
     A = sympy.Matrix(m, K, lambda i, a: pb(constraints[i], primary[a]))
+    zero = numerics.weakly_zero(list(A), points)
+    A = sympy.Matrix(m, K, lambda i, a: sympy.S.Zero if zero[i * K + a] else A[i, a])
     b = sympy.Matrix([pb(c, H_c) for c in constraints])
     A_num = numerics.evaluate(list(A), points).reshape(len(points), m, K)
     b_num = numerics.evaluate(list(b), points).reshape(len(points), m)
@@ -230,6 +237,7 @@ class GaugeStructure:
     generators: list[GaugeGenerator] = field(default_factory=list)
     without_transformation: list[sympy.Expr] = field(default_factory=list)
     unclosed: list[sympy.Expr] = field(default_factory=list)
+    irregular_terms: list[sympy.Expr] = field(default_factory=list)
     second_class_present: bool = False
     gauge_fixed: bool = False
 
@@ -248,6 +256,11 @@ class GaugeStructure:
             out.append(
                 f"Castellani's chain started at the primary first-class constraint {gamma} did not close within "
                 "the number of stages: no generator is reported for it"
+            )
+        for term in self.irregular_terms:
+            out.append(
+                f"the generator term {term} has a vanishing gradient on the constraint surface (an irregular "
+                "constraint): the transformation it multiplies vanishes there, so it generates nothing"
             )
         for c in self.without_transformation:
             out.append(self.account(c))
@@ -346,6 +359,10 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
         generator.delta = transformation(space, generator.generator())
         structure.generators.append(generator)
     all_terms = [g for gen in structure.generators for g in gen.terms]
+    if all_terms:
+        flat = _gradients(space, numerics, all_terms, points)
+        size = np.max(np.abs(flat), axis=2)  # (points, terms)
+        structure.irregular_terms = [g for g, s in zip(all_terms, np.all(size <= IRREGULAR_GRADIENT, axis=0)) if s]
     first = list(analysis.first_class)
     spanned = _in_span(_gradients(space, numerics, first, points), _gradients(space, numerics, all_terms + second, points))
     structure.without_transformation = [c for c, ok in zip(first, spanned) if not ok]

@@ -183,3 +183,18 @@ def test_yang_mills_type_toy_needs_the_covariant_derivative():
         variation, *_ = _lagrangian_variation(analysis, gen)
         assert sympy.simplify(variation) == 0
     assert analysis.gauge_structure.without_transformation == []
+
+
+def test_a_term_with_vanishing_gradient_is_reported():
+    """L = exp(y) x_dot^2/2 (Henneaux-Teitelboim's irregular example), by hand: p_y = 0 primary,
+    H_c = exp(-y) p_x^2/2, {p_y, H_c} = exp(-y) p_x^2/2 = 0 (stage 2, irregular: its gradient
+    vanishes where it holds). G_1 = p_y, G_0 = -exp(-y) p_x^2/2: delta x = -eps exp(-y) p_x
+    vanishes on the surface, so that term generates nothing and the report says so."""
+    analysis = dirac.analyze(dirac.Lagrangian.from_strings("irregular", ["x", "y"], "exp(y)*x_dot**2/2"))
+    s = analysis.symbols
+    [gen] = analysis.gauge_generators
+    G0, G1 = gen.terms
+    assert G1 == s["p_y"]
+    assert sympy.simplify(G0 + sympy.exp(-s["y"]) * s["p_x"] ** 2 / 2) == 0
+    assert analysis.gauge_structure.irregular_terms == [G0]
+    assert any("vanishing gradient" in note for note in analysis.to_json()["notes"])
