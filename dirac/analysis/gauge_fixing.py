@@ -37,7 +37,7 @@ from dirac.analysis.constraint_chain import SAMPLE_POINTS
 from dirac.analysis.dirac_bracket import DiracBracket
 from dirac.analysis.gauge_generators import first_class_hamiltonian, independent
 from dirac.analysis.linear_solve import weak_solve
-from dirac.analysis.numeric import Numerics, numeric_rank
+from dirac.analysis.numeric import ZERO_TOLERANCE, Numerics, numeric_rank
 from dirac.errors import AnalysisError, InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
 from dirac.validate import did_you_mean
@@ -196,6 +196,15 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
     return fixed
 
 
+def _weak_values(numerics: Numerics, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
+    """Values of ``exprs`` at ``points`` (points, len(exprs)), with entries below ``1e-8`` times the
+    size of their terms set to zero: a bracket like ``x + y`` at ``x = y = 1e-13`` vanishes
+    there, which a rank relative to the largest entry alone would not see."""
+    values = numerics.evaluate(exprs, points)
+    scale = np.array([numerics.term_scale(exprs, [z])[0] for z in points]).reshape(values.shape)
+    return np.where(np.abs(values) <= ZERO_TOLERANCE * scale, 0.0, values)
+
+
 def regular_gauge_point(analysis: Any, numerics: Numerics, fixed: dict[int, float]) -> np.ndarray:
     """A point of the gauge-fixed surface of ``analysis`` where the gauge is valid.
 
@@ -214,7 +223,7 @@ def regular_gauge_point(analysis: Any, numerics: Numerics, fixed: dict[int, floa
     size = len(analysis.second_class)
     for _ in range(REGULAR_ATTEMPTS):
         point = numerics.surface_points(analysis.constraints, 1, fixed=fixed)[0]
-        if not size or numeric_rank(numerics.evaluate(C, [point]).reshape(size, size)) == size:
+        if not size or numeric_rank(_weak_values(numerics, C, [point]).reshape(size, size)) == size:
             return point
     raise InputError(
         f"every point found on the gauge surface of {analysis.name!r} with the given values is singular for the "
@@ -246,7 +255,7 @@ def _regular_points(name, texts, exprs, first, constraints, numerics, pb) -> tup
                 f"{name!r}: choose conditions that meet the constraint surface"
             ) from None
         sampled += batch
-        values = numerics.evaluate(flat, batch).reshape(len(batch), c, F)
+        values = _weak_values(numerics, flat, batch).reshape(len(batch), c, F)
         regular += [z for z, m in zip(batch, values) if numeric_rank(m) == c]
         if len(regular) >= SAMPLE_POINTS:
             break

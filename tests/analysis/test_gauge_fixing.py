@@ -152,3 +152,24 @@ def test_cli_gauge_json_and_refusal(run_cli):
     assert status == 0
     [entry] = json.loads(out)["gauge_generators"]
     assert entry == {"terms": ["p_x*y - p_y*x", "p_z"]}
+
+
+def test_fixing_in_two_steps_equals_fixing_at_once(christ_lee):
+    """z = 0, then y - x = 0 on that analysis: the Gauss law, left first class by the first
+    step, is fixed by the second; the brackets are those of gauge B ({x, p_x}_D = 1/2)."""
+    fixed = christ_lee.fix_gauge(["z"]).fix_gauge(["y - x"])
+    assert fixed.gauge_conditions == ("z", "y - x")
+    assert fixed.first_class == [] and fixed.physical_degrees_of_freedom == 1
+    point = fixed.surface_point({"x": 0.8, "p_x": 0.3})
+    assert fixed.dirac_bracket("x", "p_x", at=point) == pytest.approx(0.5, rel=1e-12)
+
+
+def test_singular_points_of_the_gauge_are_left_out_and_said(gauge_b):
+    """Rotations do not move the origin: there {y - x, J} = x + y = 0 and the gauge is singular.
+    Such sampled points are counted in a note; surface points avoid them."""
+    assert any("singular for the gauge" in note for note in gauge_b.notes)
+    for seed in range(4):
+        point = gauge_b.surface_point(seed=seed)
+        assert abs(point["x"] + point["y"]) > 1e-6
+    with pytest.raises(dirac.InputError, match="singular for the gauge"):
+        gauge_b.surface_point({"x": 0.0})
