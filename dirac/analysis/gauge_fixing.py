@@ -47,6 +47,9 @@ __all__ = ["fix_gauge", "parse_gauge_condition", "regular_gauge_point"]
 #: relative residual below which the preservation equations count as solved
 SOLVE_TOLERANCE = 1e-8
 
+#: largest second-class set whose bracket matrix is called small in the report (as for the analysis)
+SMALL_SECOND_CLASS = 8
+
 #: rounds of surface points sampled to find regular points of the gauge surface
 REGULAR_ROUNDS = 5
 
@@ -91,7 +94,9 @@ def parse_gauge_condition(text: str | sympy.Expr, analysis: Any) -> sympy.Expr:
         expr = parse_expression(text, names, what="gauge condition")
     else:
         expr = sympy.sympify(text)
-        unknown = sorted(s.name for s in expr.free_symbols if names.get(s.name) != s)
+        # symbols are matched by name (a plain sympy.Symbol("x") means the variable x)
+        expr = expr.xreplace({s: names[s.name] for s in expr.free_symbols if isinstance(s, sympy.Symbol) and s.name in names})
+        unknown = sorted(str(s) for s in expr.free_symbols if not (isinstance(s, sympy.Symbol) and names.get(s.name) == s))
         if unknown:
             raise InputError(
                 f"gauge condition {expr}: unknown symbol(s) {', '.join(unknown)}"
@@ -176,8 +181,10 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
     fixed._gauge = None
     s = len(cls.second_class)
     fixed.bracket_strategy = (
-        f"symbolic: C is {s}x{s} over the second-class constraints and the gauge conditions; exact brackets "
-        "solve C x = {Phi, B} after dropping weakly zero entries; numeric brackets (at=) solve C at the point"
+        f"{'symbolic' if s <= SMALL_SECOND_CLASS else 'block'}: C is {s}x{s} over the second-class constraints "
+        "and the gauge conditions; exact brackets solve C x = {Phi, B} after dropping weakly zero entries"
+        + ("" if s <= SMALL_SECOND_CLASS else ", by its block-triangular pieces")
+        + "; numeric brackets (at=) solve C at the point"
     )
     left = ", ".join(str(c) for c in cls.first_class)
     fixed.notes = list(analysis.notes) + [

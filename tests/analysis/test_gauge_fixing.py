@@ -173,3 +173,12 @@ def test_singular_points_of_the_gauge_are_left_out_and_said(gauge_b):
         assert abs(point["x"] + point["y"]) > 1e-6
     with pytest.raises(dirac.InputError, match="singular for the gauge"):
         gauge_b.surface_point({"x": 0.0})
+
+
+def test_sympy_conditions_are_matched_by_name(christ_lee):
+    """Plain sympy symbols (without the analysis' assumptions) name the same variables."""
+    x, y, z = sympy.symbols("x y z")
+    fixed = christ_lee.fix_gauge([z, y - x])
+    assert fixed.first_class == [] and fixed.gauge_conditions == ("z", "-x + y")
+    with pytest.raises(dirac.InputError, match="unknown symbol"):
+        christ_lee.fix_gauge([sympy.Symbol("w")])
