@@ -1,6 +1,6 @@
 """Gauge fixing: user gauge conditions ``chi_i = 0`` turn first-class constraints second class.
 
-Conditions ``chi_i`` are admissible (Dirac; Henneaux–Teitelboim ch. 1.4.2 and 3.3) when
+Conditions ``chi_i`` are admissible (Dirac; Henneaux–Teitelboim, chs. 1 and 3) when
 
 1. each fixes something: the matrix ``{chi_i, F_a}`` with the first-class constraints
    ``F_a`` has full row rank on the surface (a condition whose row vanishes commutes with

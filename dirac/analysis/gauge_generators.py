@@ -5,7 +5,7 @@ generator of the gauge transformations with parameter ``eps(t)`` is
 
     G = sum_{k=0}^{N} eps^(k) G_k,     delta z = {z, G},
 
-with the chain (L. Castellani, Ann. Phys. 143 (1982) 357; Henneaux–Teitelboim, ch. 3.2)
+with the chain (L. Castellani, Ann. Phys. 143 (1982) 357; Henneaux–Teitelboim, ch. 3)
 
     G_N = gamma                       (primary first class),
     G_{k-1} + {G_k, H'} = PFC         (k = N, ..., 1),
@@ -15,19 +15,20 @@ where ``PFC`` is a combination of primary first-class constraints and ``H' = H_c
 the first-class Hamiltonian: ``H_T = H' + v_f gamma_f`` with ``U`` the particular solution
 of the multiplier equations ``{Phi_i, H_c} + {Phi_i, phi_a} u_a ~ 0`` whose free components
 vanish, and ``gamma_f = phi_f + V_fq phi_q`` spanning their homogeneous solutions
-(Henneaux–Teitelboim (1.32)-(1.35); Gitman–Tyutin, ch. 2). The chain is built downwards,
+(Henneaux–Teitelboim, ch. 1; Gitman–Tyutin, ch. 2). The chain is built downwards,
 ``G_{k-1} = -{G_k, H'} + c_a gamma_a``, and closes at the first ``G_0`` whose bracket with
 ``H'`` is ``PFC``. The free coefficients ``c_a`` (functions) are chosen so that
 ``{G_{k-1}, H'} = -{R, H'} + c_a S_a + PFC`` (``R = {G_k, H'}``, ``S_a = {gamma_a, H'}``)
 has no ``S_a``-components: ``c_a`` are the ``S_a``-coefficients of ``{R, H'}`` expanded
 over the constraints (:func:`_expansion`). In abelian models ``c = 0``; in a
-Yang–Mills-type model they give the covariant derivative ``delta A = eps_dot + [eps, A]``. Second-class constraints vanish strongly in the Dirac
-bracket, so with second-class constraints "PFC" is read modulo them (their gradients are
-allowed in the closing test; Henneaux–Teitelboim ch. 3.3).
+Yang–Mills-type model they give the covariant derivative ``delta A = eps_dot + [eps, A]``.
+Second-class constraints vanish strongly in the Dirac bracket, so with second-class
+constraints "PFC" is read modulo them (their gradients are allowed in the closing test;
+Henneaux–Teitelboim, ch. 3).
 
 The conditions are exactly ``dG/dt = dG/dt|_eps + {G, H_T} = PFC`` for every ``eps(t)``:
 then ``delta z`` maps solutions of ``z_dot = {z, H_T}`` to solutions, with the free
-multipliers transformed as well (Henneaux–Teitelboim (3.25)-(3.29)). Each term is checked
+multipliers transformed as well (Castellani; Henneaux–Teitelboim, ch. 3). Each term is checked
 to be first class at points of the constraint surface.
 
 First-class constraints outside the span of all the ``G_k`` generate no gauge
@@ -123,7 +124,7 @@ def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
     Pivot rows ``P`` and columns ``Q`` of ``A`` (numeric rank at the surface points; the
     multipliers the analysis reports as determined come first among the columns) give
     ``U_Q = -A_PQ^{-1} b_P`` and, for each other column ``f``, ``V_fQ = -A_PQ^{-1} A_Pf``
-    (Henneaux–Teitelboim (1.32)-(1.35)). Solved exactly and weakly on the surface
+    (Henneaux–Teitelboim, ch. 1). Solved exactly and weakly on the surface
     (:func:`~dirac.analysis.linear_solve.weak_solve`).
     """
     space: PhaseSpace = analysis._space

@@ -96,7 +96,7 @@ class AnalysedSystem:
         multipliers : mapping, optional
             Values of free multipliers (names out of ``analysis.undetermined_multipliers``):
             numbers, or expressions in the phase-space variables; the flow is that of
-            ``H_c + v_f phi_f`` (Henneaux–Teitelboim (1.37)). Those not given are 0.
+            ``H_c + v_f phi_f`` (the total Hamiltonian; Henneaux–Teitelboim, ch. 1). Those not given are 0.
 
         Raises
         ------
