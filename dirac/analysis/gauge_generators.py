@@ -50,7 +50,6 @@ from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import independent_rows
 from dirac.analysis.phase_space import PhaseSpace
-from dirac.errors import AnalysisError
 
 __all__ = [
     "FirstClassHamiltonian",
@@ -238,6 +237,7 @@ class GaugeStructure:
     generators: list[GaugeGenerator] = field(default_factory=list)
     without_transformation: list[sympy.Expr] = field(default_factory=list)
     unclosed: list[sympy.Expr] = field(default_factory=list)
+    rejected: list[str] = field(default_factory=list)
     irregular_terms: list[sympy.Expr] = field(default_factory=list)
     second_class_present: bool = False
     gauge_fixed: bool = False
@@ -258,6 +258,7 @@ class GaugeStructure:
                 f"Castellani's chain started at the primary first-class constraint {gamma} did not close within "
                 "the number of stages: no generator is reported for it"
             )
+        out.extend(self.rejected)
         for term in self.irregular_terms:
             out.append(
                 f"the generator term {term} has a vanishing gradient on the constraint surface (an irregular "
@@ -269,10 +270,10 @@ class GaugeStructure:
 
     def account(self, constraint: sympy.Expr) -> str:
         """Why a first-class constraint has no generator."""
-        if self.unclosed:
+        if self.unclosed or self.rejected:
             return (
                 f"the first-class constraint {constraint} is not in the span of the generators found; since some "
-                "Castellani chains did not close, whether it generates a gauge transformation is not decided"
+                "Castellani chains did not give a generator, whether it generates a gauge transformation is not decided"
             )
         if self.gauge_fixed:
             return (
@@ -314,11 +315,8 @@ def _in_span(vectors: np.ndarray, basis: np.ndarray) -> np.ndarray:
 def gauge_structure(analysis: Any) -> GaugeStructure:
     """Castellani's generators of ``analysis`` (module docstring); empty without first-class constraints.
 
-    Raises
-    ------
-    AnalysisError
-        If a term of a chain is not first class at the surface points (the analysis
-        would then be inconsistent).
+    A chain whose terms are not first class, or that fails Castellani's conditions when
+    checked at the end, gives no generator; :attr:`GaugeStructure.rejected` says why.
     """
     if not analysis.first_class:
         return GaugeStructure()
@@ -355,7 +353,12 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
         if not closed:
             structure.unclosed.append(gamma)
             continue
-        _check_first_class(space, numerics, chain, constraints, points)
+        problem = _first_class_problem(space, numerics, chain, constraints, points) or _chain_problem(
+            space, numerics, list(reversed(chain)), H1, points, closing_basis
+        )
+        if problem:
+            structure.rejected.append(f"the chain started at {gamma} was built, but {problem}: no generator is reported for it")
+            continue
         generator = GaugeGenerator(f"eps_{index}", tuple(reversed(chain)), multiplier_names[f])
         generator.delta = transformation(space, generator.generator())
         structure.generators.append(generator)
@@ -410,14 +413,27 @@ def _closes(space: PhaseSpace, numerics, R: sympy.Expr, points, basis: np.ndarra
     return bool(_in_span(_gradients(space, numerics, [R], points), basis)[0])
 
 
-def _check_first_class(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], constraints, points) -> None:
-    """Every ``G_k`` is weakly zero and has weakly zero brackets with every constraint."""
+def _chain_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], H1: sympy.Expr, points, basis) -> str:
+    """Castellani's conditions, checked on the final terms ``(G_0, ..., G_N)``: ``G_N`` and every
+    ``G_(k-1) + {G_k, H'}`` and ``{G_0, H'}`` are primary first-class combinations (modulo
+    second class) at the surface points; together they say ``dG/dt ~ PFC`` for every
+    ``eps(t)``, i.e. that ``delta z = {z, G}`` maps solutions of the equations of motion to
+    solutions. Returns what fails, or ``""``."""
+    pb = space.poisson_bracket
+    conditions = [terms[-1], pb(terms[0], H1)] + [terms[k - 1] + pb(terms[k], H1) for k in range(1, len(terms))]
+    for c in conditions:
+        if not (sympy.expand(c) == 0 or _closes(space, numerics, c, points, basis)):
+            return f"Castellani's condition {c} = PFC fails on the constraint surface"
+    return ""
+
+
+def _first_class_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], constraints, points) -> str:
+    """Every ``G_k`` is weakly zero and has weakly zero brackets with every constraint;
+    returns what fails, or ``""``."""
     exprs = list(terms) + [space.poisson_bracket(g, c) for g in terms for c in constraints]
     zero = numerics.weakly_zero(exprs, points)
-    if not np.all(zero):
-        bad = next(i for i, z in enumerate(zero) if not z)
-        term = terms[bad if bad < len(terms) else (bad - len(terms)) // max(len(constraints), 1)]
-        raise AnalysisError(
-            f"a term {term} of a gauge generator is not a first-class constraint on the surface: the "
-            "first-class split of the analysis is inconsistent"
-        )
+    if np.all(zero):
+        return ""
+    bad = next(i for i, z in enumerate(zero) if not z)
+    term = terms[bad if bad < len(terms) else (bad - len(terms)) // max(len(constraints), 1)]
+    return f"its term {term} is not a first-class constraint on the surface"

@@ -206,6 +206,8 @@ def _gauge_lines(a: AnalysisResult) -> list[str]:
             lines.append(f"    delta {z} = {_short(d, 120)}")
     for gamma in gauge.unclosed:
         lines.append(f"  {_short(gamma, 120)}: Castellani's chain did not close; no generator")
+    for reason in gauge.rejected:
+        lines.append(f"  {reason}")
     for term in gauge.irregular_terms:
         lines.append(f"  {_short(term, 120)}: irregular (vanishing gradient on the surface), generates nothing")
     for c in gauge.without_transformation:

@@ -198,3 +198,20 @@ def test_a_term_with_vanishing_gradient_is_reported():
     assert sympy.simplify(G0 + sympy.exp(-s["y"]) * s["p_x"] ** 2 / 2) == 0
     assert analysis.gauge_structure.irregular_terms == [G0]
     assert any("vanishing gradient" in note for note in analysis.to_json()["notes"])
+
+
+def test_castellani_check_rejects_a_wrong_chain():
+    """The final check is not a formality: with the sign of G_0 flipped, G_0 + {G_1, H_c} =
+    -2 (y p_x - x p_y) is no primary first-class combination (hand: {p_z, H_c} = -(y p_x - x p_y));
+    with a non-first-class term the first-class check fails."""
+    from dirac.analysis.gauge_generators import _chain_problem, _first_class_problem, _gradients
+
+    analysis = dirac.analyze(dirac.load_system("gauge_system"))
+    s = analysis.symbols
+    space, numerics, points = analysis._space, analysis._numerics, analysis._points
+    basis = _gradients(space, numerics, [s["p_z"]], points)
+    H = analysis.canonical_hamiltonian
+    gauss = s["y"] * s["p_x"] - s["x"] * s["p_y"]
+    assert _chain_problem(space, numerics, [gauss, s["p_z"]], H, points, basis) == ""
+    assert "fails" in _chain_problem(space, numerics, [-gauss, s["p_z"]], H, points, basis)
+    assert "not a first-class" in _first_class_problem(space, numerics, [s["x"]], analysis.constraints, points)
