@@ -17,6 +17,8 @@ import sympy
 from dirac.analysis.classification import bracket_matrix, classify
 from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
+from dirac.analysis.gauge_fixing import fix_gauge, regular_gauge_point
+from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure, gauge_structure
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.numeric import Numerics
@@ -161,7 +163,34 @@ class ConstraintAnalysis:
                 "d_t Phi with the partial time derivative; t is sampled at random like a variable in the "
                 "numerical decisions, and the constraints may depend on t"
             )
+        self.gauge_conditions: tuple[str, ...] = ()
+        self._gauge: GaugeStructure | None = None
         self.seconds = time.perf_counter() - start
+
+    # ------------------------------------------------------------------ gauge
+    @property
+    def gauge_structure(self) -> GaugeStructure:
+        """Castellani's gauge generators and the first-class constraints without one
+        (:mod:`dirac.analysis.gauge_generators`); computed on first use."""
+        if self._gauge is None:
+            self._gauge = gauge_structure(self)
+        return self._gauge
+
+    @property
+    def gauge_generators(self) -> list[GaugeGenerator]:
+        """One generator ``G = sum_k eps^(k) G_k`` per independent gauge parameter (empty
+        without gauge freedom); see :mod:`dirac.analysis.gauge_generators`."""
+        return self.gauge_structure.generators
+
+    def fix_gauge(self, conditions: Sequence[sympy.Expr | str]) -> ConstraintAnalysis:
+        """The analysis with gauge conditions ``chi_i = 0`` added (:mod:`dirac.analysis.gauge_fixing`).
+
+        Raises
+        ------
+        InputError
+            For conditions that are not admissible; the message names the condition.
+        """
+        return fix_gauge(self, conditions)
 
     # ------------------------------------------------------------------ brackets
     def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:
@@ -282,7 +311,10 @@ class ConstraintAnalysis:
             values.setdefault(self.time.name, 0.0)
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:
-            point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
+            if self.gauge_conditions:
+                point = regular_gauge_point(self, numerics, fixed)
+            else:
+                point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
         except AnalysisError:
             if fixed:
                 raise InputError(

@@ -13,6 +13,7 @@ from typing import Any, Protocol
 
 import sympy
 
+from dirac.analysis.gauge_generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
 __all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
@@ -57,6 +58,10 @@ class AnalysisResult(Protocol):
     def bracket_strategy(self) -> str: ...
     @property
     def notes(self) -> Sequence[str]: ...
+    @property
+    def gauge_structure(self) -> GaugeStructure: ...
+    @property
+    def gauge_conditions(self) -> Sequence[str]: ...
 
 #: longest expression printed in full in the text report
 TEXT_LIMIT = 400
@@ -144,9 +149,13 @@ def to_json(analysis: AnalysisResult) -> dict:
     ``bracket_strategy``, ``notes``, ``time_dependent`` (``L`` or a constraint depends
     explicitly on the time ``t``); ``multiplier_subexpressions`` (name -> text) when a
     multiplier is too large to print as one tree: its text then uses those names
-    (see :func:`shared_form`).
+    (see :func:`shared_form`). Gauge keys: ``gauge_generators`` (one ``{"terms": [G_0,
+    G_1, ...]}`` per gauge parameter), ``gauge_transformations`` (for each, its
+    ``parameter``, free ``multiplier`` and ``delta``: variable -> ``{z, G}``),
+    ``first_class_without_gauge_transformation`` and ``gauge_conditions``.
     """
     multipliers, definitions = shared_form(dict(analysis.multipliers))
+    gauge = analysis.gauge_structure
     out = {
         "system": analysis.name,
         "coordinates": [s.name for s in analysis.coordinates],
@@ -165,12 +174,47 @@ def to_json(analysis: AnalysisResult) -> dict:
         "undetermined_multipliers": [u.name for u in analysis.undetermined_multipliers],
         "hessian_rank": analysis.hessian_rank,
         "bracket_strategy": analysis.bracket_strategy,
-        "notes": list(analysis.notes),
+        "notes": list(analysis.notes) + list(gauge.notes),
         "time_dependent": analysis.lagrangian.is_time_dependent,
+        "gauge_generators": [{"terms": [expression_text(g) for g in gen.terms]} for gen in gauge.generators],
+        "gauge_transformations": [
+            {
+                "parameter": gen.parameter,
+                "multiplier": gen.multiplier,
+                "delta": {z.name: expression_text(d) for z, d in gen.delta.items()},
+            }
+            for gen in gauge.generators
+        ],
+        "first_class_without_gauge_transformation": [expression_text(c) for c in gauge.without_transformation],
+        "gauge_conditions": list(analysis.gauge_conditions),
     }
     if definitions:
         out["multiplier_subexpressions"] = definitions
     return out
+
+
+def _gauge_lines(a: AnalysisResult) -> list[str]:
+    """Text lines on the gauge conditions, generators and first-class constraints without one."""
+    lines: list[str] = []
+    if a.gauge_conditions:
+        lines.append(f"gauge conditions: {', '.join(f'{c} = 0' for c in a.gauge_conditions)}")
+    if not a.first_class:
+        return lines
+    gauge = a.gauge_structure
+    lines.append(f"gauge generators (Castellani): {len(gauge.generators)}, G = sum_k eps^(k) G_k, delta z = {{z, G}}")
+    for gen in gauge.generators:
+        lines.append(f"  {gen.parameter} (free multiplier {gen.multiplier}): G = {_short(gen.generator())}")
+        for z, d in gen.delta.items():
+            lines.append(f"    delta {z} = {_short(d, 120)}")
+    for gamma in gauge.unclosed:
+        lines.append(f"  {_short(gamma, 120)}: Castellani's chain did not close; no generator")
+    for reason in gauge.rejected:
+        lines.append(f"  {reason}")
+    for term in gauge.irregular_terms:
+        lines.append(f"  {_short(term, 120)}: irregular (vanishing gradient on the surface), generates nothing")
+    for c in gauge.without_transformation:
+        lines.append(f"  {gauge.account(c)}")
+    return lines
 
 
 def to_text(analysis: AnalysisResult) -> str:
@@ -198,7 +242,7 @@ def to_text(analysis: AnalysisResult) -> str:
     else:
         lines.append("total Hamiltonian H_T = H_c")
     lines.append("")
-    lines.append(f"constraint chain: {len(a.stages)} stage(s), {len(a.constraints)} constraint(s)")
+    lines.append(f"constraint chain: {len(a.stages)} stage(s), {sum(len(stage) for stage in a.stages)} constraint(s)")
     for k, stage in enumerate(a.stages, start=1):
         label = " (primary)" if k == 1 else ""
         lines.append(f"  stage {k}{label}: {len(stage)} constraint(s)")
@@ -227,10 +271,29 @@ def to_text(analysis: AnalysisResult) -> str:
         f"physical degrees of freedom: ({2 * n} - 2*{len(a.first_class)} - {len(a.second_class)})/2 = "
         f"{a.physical_degrees_of_freedom}"
     )
+    lines.extend(_gauge_lines(a))
     lines.append(f"Dirac bracket: {a.bracket_strategy}")
     for note in a.notes:
         lines.append(f"note: {note}")
     return "\n".join(lines)
+
+
+def _gauge_latex_rows(a: AnalysisResult) -> list[str]:
+    """LaTeX rows: gauge conditions and ``G = sum_k eps^(k) G_k`` for each gauge parameter."""
+    conditions = list(a.constraints)[len(a.constraints) - len(a.gauge_conditions):] if a.gauge_conditions else []
+    rows = [rf"&{_latex(c)} = 0 \quad \text{{(gauge)}}" for c in conditions]
+    if not a.first_class or not a.gauge_structure.generators:
+        return rows
+    rows.append(r"&\text{gauge generators (Castellani)}")
+    for gen in a.gauge_structure.generators:
+        G = gen.generator()
+        names = latex_names(G)
+        index = gen.parameter.rsplit("_", 1)[1]
+        for k, eps in enumerate(gen.parameter_symbols()):
+            base = rf"\varepsilon_{{{index}}}"
+            names[eps] = base if k == 0 else (rf"\dot{{{base}}}" if k == 1 else (rf"\ddot{{{base}}}" if k == 2 else rf"{base}^{{({k})}}"))
+        rows.append(rf"G_{{{index}}} &= {sympy.latex(G, symbol_names=names)}")
+    return rows
 
 
 def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
@@ -256,6 +319,7 @@ def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
                 rows.append(rf"{lx(u)} &= {lx(a.multipliers[u.name])}")
             else:
                 rows.append(rf"{lx(u)} &\;\text{{undetermined (gauge)}}")
+    rows.extend(_gauge_latex_rows(a))
     rows.append(
         rf"&\text{{first class: {len(a.first_class)}, second class: {len(a.second_class)}, "
         rf"physical degrees of freedom: {a.physical_degrees_of_freedom}}}"

@@ -1,7 +1,8 @@
 """``dirac analyze SYSTEM``: run the Dirac–Bergmann algorithm and print the chain.
 
 Text by default (stage by stage, with counts), ``--json`` (docs/file_formats.md) or ``--latex``.
-``--param NAME=VALUE`` fixes parameters (the others stay symbolic); ``--compare SPEC``
+``--param NAME=VALUE`` fixes parameters (the others stay symbolic); ``--gauge EXPR``
+(repeatable) adds gauge conditions (:mod:`dirac.analysis.gauge_fixing`); ``--compare SPEC``
 compares two brackets of the result (see :mod:`dirac.commands.analyze_compare`).
 """
 
@@ -31,6 +32,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=[],
         metavar="NAME=VALUE",
         help="fix a parameter to a number (repeatable); the others stay symbolic",
+    )
+    parser.add_argument(
+        "--gauge",
+        action="append",
+        default=[],
+        metavar="EXPR",
+        help="add the gauge condition EXPR = 0 (repeatable; names as in the phase space, e.g. z, y, p_z) and "
+        "analyse the gauge-fixed system: Dirac bracket in that gauge, first-class constraints left",
     )
     output = parser.add_mutually_exclusive_group()
     output.add_argument("--json", action="store_true", help="print one JSON object (stages, classes, multipliers, degrees of freedom)")
@@ -83,6 +92,10 @@ def main(args: argparse.Namespace) -> int:
     lagrangian = load_system(args.system, **params)
     report = stage_printer(getattr(args, "verbosity", 0))
     analysis = analyze(lagrangian, progress=report)
+    if args.gauge:
+        analysis = analysis.fix_gauge(args.gauge)
+        if report is not None:
+            report(f"gauge fixed by {', '.join(args.gauge)}: {len(analysis.first_class)} first-class constraint(s) left")
     if args.compare is not None:
         from dirac.commands.analyze_compare import cli_compare
 

@@ -9,8 +9,11 @@ coordinates and multipliers, then their momenta), the numerical Hamiltonian vect
 over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
 ``grad Phi`` are generated from sympy (:mod:`dirac.codegen.numba_backend`), ``C`` is evaluated and
 solved numerically at each point (:func:`dirac.flows.constrained_kernels.analysed_field`).
-``H`` is the canonical Hamiltonian; with first-class constraints the gauge ``u = 0`` is
-taken (their multipliers stay arbitrary in ``H_T``). This path takes every Lagrangian the
+``H`` is the canonical Hamiltonian; with first-class constraints the free multipliers of
+``H_T`` take the values the user chooses (``multipliers=``, constants or phase-space
+functions; default ``u = 0``): ``H = H_c + v_f phi_f``. Gauge-invariant quantities do not
+depend on that choice; a gauge-fixed analysis (``analysis.fix_gauge``) has no free
+multiplier left. This path takes every Lagrangian the
 engine can analyse, also those that :class:`MechanicalSystem` refuses (terms linear in the
 velocities, singular Lagrangians such as the rigid body's (228)).
 """
@@ -52,6 +55,7 @@ class AnalysedSystem:
     functions: tuple
     analysis: ConstraintAnalysis = field(repr=False)
     momenta: Callable[..., np.ndarray] = field(repr=False)
+    gauge_multipliers: dict[str, str] = field(default_factory=dict)
 
     @classmethod
     def from_lagrangian(cls, lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> AnalysedSystem:
@@ -75,7 +79,9 @@ class AnalysedSystem:
         return cls.from_analysis(analyze(lagrangian.fix(**values)))
 
     @classmethod
-    def from_analysis(cls, analysis: ConstraintAnalysis) -> AnalysedSystem:
+    def from_analysis(
+        cls, analysis: ConstraintAnalysis, multipliers: Mapping[str, float | str] | None = None
+    ) -> AnalysedSystem:
         """Compile the Dirac vector field of an existing analysis (nothing is analysed again).
 
         ``grad H_c``, the second-class constraints ``Phi`` and ``grad Phi`` are generated
@@ -89,13 +95,18 @@ class AnalysedSystem:
         ----------
         analysis : ConstraintAnalysis
             The result of :func:`dirac.analyze`.
+        multipliers : mapping, optional
+            Values of free multipliers (names out of ``analysis.undetermined_multipliers``):
+            numbers, or expressions in the phase-space variables; the flow is that of
+            ``H_c + v_f phi_f`` (the total Hamiltonian; Henneaux–Teitelboim, ch. 1). Those not given are 0.
 
         Raises
         ------
         InputError
-            ``analysis`` is not an analysis, or a parameter still symbolic in it has no
-            default value; :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a
-            system that depends explicitly on the time ``t``.
+            ``analysis`` is not an analysis, a parameter still symbolic in it has no
+            default value, or a multiplier name is not a free multiplier;
+            :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a system that
+            depends explicitly on the time ``t``.
         """
         from dirac.codegen import GeneratedFunction, array_function, generate_module
         from dirac.flows.mechanics import refuse_time_dependent
@@ -114,10 +125,12 @@ class AnalysedSystem:
         z = tuple(analysis.phase_space)
         H = analysis.canonical_hamiltonian
         constraints = list(analysis.second_class)
-        gradient = [sympy.diff(H, s) for s in z]
+        chosen = _free_multipliers(analysis, multipliers or {})
+        H_flow = H + sum((v * phi for v, phi in chosen.values()), sympy.S.Zero)
+        gradient = [sympy.diff(H_flow, s) for s in z]
         jacobian = [sympy.diff(c, s) for c in constraints for s in z]
         generated = [
-            GeneratedFunction("hamiltonian_gradient", z, gradient, "grad H over the phase space"),
+            GeneratedFunction("hamiltonian_gradient", z, gradient, "grad (H_c + v_f phi_f) over the phase space"),
             GeneratedFunction("second_class", z, constraints, "second-class constraints Phi"),
             GeneratedFunction("second_class_jacobian", z, jacobian, "grad Phi, (k, N)"),
             GeneratedFunction("hamiltonian", z, [H], "canonical Hamiltonian H_c"),
@@ -140,6 +153,7 @@ class AnalysedSystem:
             functions=functions,
             analysis=analysis,
             momenta=momenta,
+            gauge_multipliers={name: str(v) for name, (v, _) in chosen.items()},
         )
 
     def _call(self, name: str, z: np.ndarray, size: int) -> np.ndarray:
@@ -190,6 +204,41 @@ class AnalysedSystem:
             values.update({f"p_{n}": float(v) for n, v in p.items()})
         point = self.analysis.surface_point(values)
         return np.array([point[n] for n in self.variable_names])
+
+
+def _free_multipliers(analysis: ConstraintAnalysis, values: Mapping[str, float | str]) -> dict[str, tuple]:
+    """Name -> ``(value, phi)`` of the chosen free multipliers (values parsed in the phase-space names).
+
+    Raises
+    ------
+    InputError
+        A name that is not a free multiplier of the analysis, or a value that is not a
+        number or an expression in the phase-space variables and parameters.
+    """
+    from dirac.model.expressions import parse_expression
+    from dirac.validate import unknown_name_error
+
+    free = {u.name: phi for u, phi in zip(analysis.primary_multipliers, analysis.primary_constraints)
+            if u in set(analysis.undetermined_multipliers)}
+    names = {**analysis.symbols, **{p.name: p for p in analysis.parameters}}
+    chosen: dict[str, tuple] = {}
+    for name, value in values.items():
+        if name not in free:
+            raise unknown_name_error(
+                "free multiplier", name, free,
+                hint="only the multipliers the analysis leaves undetermined can be chosen" if free
+                else f"{analysis.name!r} has no free multiplier (no gauge freedom, or the gauge is fixed)",
+            )
+        if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+            raise InputError(f"free multiplier {name}: give a number or an expression, not {value!r}")
+        if isinstance(value, str):
+            expr = parse_expression(value, names, what=f"free multiplier {name}")
+        elif not np.isfinite(value):
+            raise InputError(f"free multiplier {name}: the value must be a finite number, not {value}")
+        else:
+            expr = sympy.Rational(repr(float(value)))
+        chosen[name] = (expr, free[name])
+    return chosen
 
 
 @dataclass
