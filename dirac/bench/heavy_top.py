@@ -1,6 +1,7 @@
 """The heavy top in ``dirac bench``: where the exact free flow + kick pays, measured.
 
-Three things, each in the same run:
+Three things, each in the same run (the targets built from them are in
+:mod:`dirac.bench.targets`):
 
 - **Per-step cost** of ``exact-kick-4`` against ``lie-poisson-4`` on the asymmetric heavy top
   (``I = (1, 2, 3)``, ``M(0) = (1, 0.5, 2)``, ``m g = 0.5``, ``chi = (0.1, 0.2, 0.5)``):
@@ -22,7 +23,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -30,17 +30,19 @@ import numpy as np
 from numba import njit
 
 from dirac.bench.suite import MethodGrid
-from dirac.bench.targets import Target
 from dirac.rigidbody.elliptic import carlson_rf, complete_pi, elliptic_f, elliptic_pi, sncndn
 from dirac.rigidbody.heavy_top import kick
 
-__all__ = ["HeavyTopCase", "heavy_top_cases", "run_heavy_top_case", "heavy_top_targets", "anchor_exact_kick",
-           "spin_over_gravity"]
+__all__ = ["HeavyTopCase", "heavy_top_cases", "run_heavy_top_case", "anchor_exact_kick", "spin_over_gravity",
+           "ASYMMETRIC_TOP"]
 
 _INERTIA = (1.0, 2.0, 3.0)
 _DIRECTION = (1.0, 0.5, 2.0)
 _MASS_GRAVITY = 0.5
 _CHI = (0.1, 0.2, 0.5)
+
+#: The asymmetric top of the per-step figures: inertia, M(0), m g, chi.
+ASYMMETRIC_TOP = (_INERTIA, _DIRECTION, _MASS_GRAVITY, _CHI)
 
 
 @dataclass(frozen=True)
@@ -290,102 +292,3 @@ def anchor_exact_kick(M, R, a, w, gammas, dt, n_steps):
             kick(M, R, w, 0.5 * g * dt)
             _anchor_free_flow(M, R, a, g * dt, em, en)
             kick(M, R, w, 0.5 * g * dt)
-
-
-# --------------------------------------------------------------------------- targets
-def _per_step(problem, method: str, dt: float, n_steps: int) -> float:
-    from dirac.flows import integrate
-
-    return integrate(problem, method, t_end=n_steps * dt, dt=dt, samples=1, outputs=["M", "R"]).cpu_seconds / n_steps
-
-
-def step_cost_targets(repeats: int, n_steps: int) -> list[Target]:
-    """``exact-kick-4`` per step against ``lie-poisson-4`` and against the anchor."""
-    from dirac.flows import HeavyTopProblem
-    from dirac.flows.methods.registry import get_method
-
-    problem = HeavyTopProblem(list(_INERTIA), list(_DIRECTION), mass_gravity=_MASS_GRAVITY,
-                              center_of_mass=list(_CHI))
-    a = 1.0 / np.array(_INERTIA)
-    w = _MASS_GRAVITY * np.array(_CHI)
-    gammas = np.array(get_method("exact-kick-4").data, dtype=float)
-    dt = 0.01
-
-    def anchor() -> float:
-        M, R = np.array(_DIRECTION), np.eye(3)
-        c0 = time.process_time()
-        anchor_exact_kick(M, R, a, w, gammas, dt, n_steps)
-        return (time.process_time() - c0) / n_steps
-
-    exact_kick, split, hand = [], [], []
-    _per_step(problem, "exact-kick-4", dt, 10)
-    _per_step(problem, "lie-poisson-4", dt, 10)
-    anchor()
-    for _ in range(repeats):  # interleaved: a slow spell of the machine hits all three alike
-        exact_kick.append(_per_step(problem, "exact-kick-4", dt, n_steps))
-        split.append(_per_step(problem, "lie-poisson-4", dt, n_steps))
-        hand.append(anchor())
-    ek, lp, an = min(exact_kick), min(split), min(hand)
-    # the same algorithm: the two states agree to round-off (checked here too)
-    from dirac.flows import integrate
-
-    package = integrate(problem, "exact-kick-4", t_end=1000 * dt, dt=dt, samples=1, outputs=["M", "R"])
-    M, R = np.array(_DIRECTION), np.eye(3)
-    anchor_exact_kick(M, R, a, w, gammas, dt, 1000)
-    agree = max(float(np.max(np.abs(package["M"][-1] - M))), float(np.max(np.abs(package["R"][-1] - R))))
-    return [
-        Target("heavy top: exact-kick-4 step / lie-poisson-4 step", ek / lp, "x", 3.0, "<=",
-               f"asymmetric top I = (1, 2, 3), dt = {dt:g}, {n_steps} steps through integrate: exact-kick-4 "
-               f"{ek * 1e6:.2f} us/step, lie-poisson-4 {lp * 1e6:.2f} us/step (minima of {repeats}, interleaved)",
-               {"exact_kick_4_us": ek * 1e6, "lie_poisson_4_us": lp * 1e6}),
-        Target("heavy top: exact-kick-4 step / hand-written numba anchor", ek / an, "x", 1.3, "<=",
-               f"anchor {an * 1e6:.2f} us/step (plain textbook kernel of the same composition); states after "
-               f"1000 steps agree to {agree:.1e}", {"anchor_us": an * 1e6, "agreement": agree}),
-    ]
-
-
-def _log_interpolate(points: list[tuple[float, float]], cpu: float) -> float | None:
-    """Error of a method at CPU time ``cpu`` by log–log interpolation of its ``(cpu, error)``
-    points; None outside their range."""
-    points = sorted(points)
-    for (c0, e0), (c1, e1) in zip(points, points[1:]):
-        if c0 <= cpu <= c1 and c1 > c0:
-            s = (math.log(cpu) - math.log(c0)) / (math.log(c1) - math.log(c0))
-            return math.exp(math.log(e0) + s * (math.log(e1) - math.log(e0)))
-    return None
-
-
-def equal_cpu_target(rows: list[dict], problem: str = "heavy top (fast)") -> Target:
-    """``lie-poisson-4`` error over ``exact-kick-4`` error at the CPU time of each
-    ``exact-kick-4`` run (interpolated on the ``lie-poisson-4`` curve); the smallest ratio."""
-    name = f"{problem}: lie-poisson-4 error / exact-kick-4 error at equal CPU"
-    subset = [r for r in rows if r.get("problem") == problem and "failed" not in r]
-    split = [(r["cpu_s"], r["error"]) for r in subset if r["method"] == "lie-poisson-4"]
-    ratios = []
-    for r in subset:
-        if r["method"] == "exact-kick-4":
-            other = _log_interpolate(split, r["cpu_s"])
-            if other is not None:
-                ratios.append((other / r["error"], r))
-    if not ratios:
-        return Target(name, None, "x", 1.0, ">=", "no exact-kick-4 run fell within the lie-poisson-4 CPU range")
-    ratio, row = min(ratios, key=lambda item: item[0])
-    return Target(name, ratio, "x", 1.0, ">=",
-                  f"smallest over {len(ratios)} exact-kick-4 runs; at dt = {row['value']:g} ({row['cpu_s'] * 1e3:.2f} ms) "
-                  f"its error is {row['error']:.2g}; {row.get('description', '')}")
-
-
-def heavy_top_targets(quick: bool, rows: list[dict], progress: Callable[[str], None],
-                      notes: list[str]) -> list[Target]:
-    """The heavy-top targets of docs/performance.md (``rows`` from :func:`run_heavy_top_case`);
-    a measurement that fails adds a line to ``notes`` instead."""
-    repeats = 5 if quick else 9
-    progress("heavy top: exact-kick-4 and lie-poisson-4 per step, hand-written anchor")
-    targets: list[Target] = []
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            targets += step_cost_targets(repeats, 20_000 if quick else 100_000)
-    except Exception as exc:  # one failed measurement must not hide the others
-        notes.append(f"heavy top per-step cost: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
-    return targets + [equal_cpu_target(rows)]

@@ -75,9 +75,6 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         from dirac.bench.targets import measure_targets
 
         measured, notes = measure_targets(quick, rows, say)
-        from dirac.bench.heavy_top import heavy_top_targets
-
-        measured += heavy_top_targets(quick, rows, say, notes)
     else:
         from dirac.bench.targets import work_precision_targets
 
