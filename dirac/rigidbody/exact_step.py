@@ -9,11 +9,15 @@ evaluation order as :mod:`dirac.rigidbody.exact` (its module docstring has the c
 forms: ``M`` in Jacobi ``sn, cn, dn`` (Landau & Lifshitz, Mechanics §37), ``R = Q Z(psi)
 A(M)`` with ``psi`` from an elliptic integral of the third kind (Celledoni, Fassò,
 Säfström & Zanna, SIAM J. Sci. Comput. 30 (2008)); the paper's (250)–(251)), and reuses
-its compiled parts (:func:`dirac.rigidbody.exact._phase_excess`). Two evaluation
-changes, both exact identities:
+its compiled parts (:func:`dirac.rigidbody.exact._phase_excess`). Three evaluation
+changes, all exact identities (with them a heavy-top step costs about 0.55x that of a
+plain textbook kernel, the anchor of ``dirac bench``'s heavy-top figures):
 
 - ``K = pi / (2 agm(1, sqrt(1 - m)))`` from the AGM that ``sn, cn, dn`` need anyway
   (Gauss; DLMF 19.8.5) instead of ``R_F(0, 1 - m, 1)``;
+- the quarter-period anchor ``q0`` of ``u0`` is read off ``sn, cn, dn (u0)`` (which come
+  from ``M(0)``), so ``u0`` and the angle term ``B(u0)`` share one Carlson duplication
+  (:func:`_initial_anchor`) and no Jacobi function is evaluated at ``u0``;
 - the complete integral ``D = Pi(n|m) - K/(1 - n)`` enters ``psi`` as ``(q_1 - q_0) D``
   (``B(q K) = q D``, see :func:`dirac.rigidbody.exact._phase_excess`), so it is computed
   only when the step crosses a quarter-period anchor ``q``.
