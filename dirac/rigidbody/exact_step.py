@@ -10,7 +10,7 @@ forms: ``M`` in Jacobi ``sn, cn, dn`` (Landau & Lifshitz, Mechanics §37), ``R =
 A(M)`` with ``psi`` from an elliptic integral of the third kind (Celledoni, Fassò,
 Säfström & Zanna, SIAM J. Sci. Comput. 30 (2008)); the paper's (250)–(251)), and reuses
 its compiled parts (:func:`dirac.rigidbody.exact._phase_excess`). Three evaluation
-changes, all exact identities (with them a heavy-top step costs about 0.55x that of a
+changes, all exact identities (with them a heavy-top step costs about 0.6x that of a
 plain textbook kernel, the anchor of ``dirac bench``'s heavy-top figures):
 
 - ``K = pi / (2 agm(1, sqrt(1 - m)))`` from the AGM that ``sn, cn, dn`` need anyway

@@ -52,9 +52,9 @@ SUBSTEP_US = 0.11
 LOOP_SAMPLE_US = 15.0
 #: Heavy top, per stage of a composition (kick + free step), same machine: the 3-term
 #: Lie–Poisson Strang step, and the exact free flow set up and evaluated in the kernel
-#: (``dirac bench``'s heavy-top per-step figures, 0.57 and 1.40 us per 3-stage step).
-SPLIT_STAGE_US = 0.19
-EXACT_KICK_STAGE_US = 0.47
+#: (``dirac bench``'s heavy-top per-step figures, 0.59 and 1.45 us per 3-stage step).
+SPLIT_STAGE_US = 0.2
+EXACT_KICK_STAGE_US = 0.48
 HEAVY_TOP_CANDIDATES = ("lie-poisson-4", "lie-poisson-6", "lie-poisson-8", "exact-kick-4", "exact-kick-6", "exact-kick-8")
 
 
