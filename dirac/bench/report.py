@@ -140,6 +140,8 @@ _STYLE = {
     "lie-poisson-sym-8": ("tab:pink", "D"),
     "rattle-2": ("tab:blue", "o"),
     "rattle-4": ("tab:orange", "s"),
+    "exact-kick-4": ("tab:olive", "P"),
+    "exact-kick-8": ("tab:cyan", "X"),
 }
 
 

@@ -315,6 +315,93 @@ def double_pendulum_target(repeats: int, n_steps: int) -> Target:
                   if n_steps != 100_000 else "dt = 1e-3, CPU of the integrate loop")
 
 
+# --------------------------------------------------------------------------- heavy top
+def _heavy_top_per_step(problem, method: str, dt: float, n_steps: int) -> float:
+    from dirac.flows import integrate
+
+    return integrate(problem, method, t_end=n_steps * dt, dt=dt, samples=1, outputs=["M", "R"]).cpu_seconds / n_steps
+
+
+def heavy_top_step_targets(repeats: int, n_steps: int) -> list[Target]:
+    """``exact-kick-4`` per step against ``lie-poisson-4`` and against the hand-written anchor
+    :func:`dirac.bench.heavy_top.anchor_exact_kick` (asymmetric heavy top)."""
+    from dirac.bench.heavy_top import ASYMMETRIC_TOP, anchor_exact_kick
+    from dirac.flows import HeavyTopProblem, integrate
+    from dirac.flows.methods.registry import get_method
+
+    inertia, direction, mass_gravity, chi = ASYMMETRIC_TOP
+    problem = HeavyTopProblem(list(inertia), list(direction), mass_gravity=mass_gravity, center_of_mass=list(chi))
+    a = 1.0 / np.array(inertia)
+    w = mass_gravity * np.array(chi)
+    gammas = np.array(get_method("exact-kick-4").data, dtype=float)
+    dt = 0.01
+
+    def anchor() -> float:
+        M, R = np.array(direction), np.eye(3)
+        c0 = time.process_time()
+        anchor_exact_kick(M, R, a, w, gammas, dt, n_steps)
+        return (time.process_time() - c0) / n_steps
+
+    quiet = _quiet()
+    try:
+        exact_kick, split, hand = [], [], []
+        _heavy_top_per_step(problem, "exact-kick-4", dt, 10)
+        _heavy_top_per_step(problem, "lie-poisson-4", dt, 10)
+        anchor()
+        for _ in range(repeats):  # interleaved: a slow spell of the machine hits all three alike
+            exact_kick.append(_heavy_top_per_step(problem, "exact-kick-4", dt, n_steps))
+            split.append(_heavy_top_per_step(problem, "lie-poisson-4", dt, n_steps))
+            hand.append(anchor())
+        # the same algorithm: the two states agree to round-off (checked here too)
+        package = integrate(problem, "exact-kick-4", t_end=1000 * dt, dt=dt, samples=1, outputs=["M", "R"])
+    finally:
+        quiet.__exit__(None, None, None)
+    ek, lp, an = min(exact_kick), min(split), min(hand)
+    M, R = np.array(direction), np.eye(3)
+    anchor_exact_kick(M, R, a, w, gammas, dt, 1000)
+    agree = max(float(np.max(np.abs(package["M"][-1] - M))), float(np.max(np.abs(package["R"][-1] - R))))
+    return [
+        Target("heavy top: exact-kick-4 step / lie-poisson-4 step", ek / lp, "x", 3.0, "<=",
+               f"asymmetric top I = (1, 2, 3), dt = {dt:g}, {n_steps} steps through integrate: exact-kick-4 "
+               f"{ek * 1e6:.2f} us/step, lie-poisson-4 {lp * 1e6:.2f} us/step (minima of {repeats}, interleaved)",
+               {"exact_kick_4_us": ek * 1e6, "lie_poisson_4_us": lp * 1e6}),
+        Target("heavy top: exact-kick-4 step / hand-written numba anchor", ek / an, "x", 1.3, "<=",
+               f"anchor {an * 1e6:.2f} us/step (plain textbook kernel of the same composition); states after "
+               f"1000 steps agree to {agree:.1e}", {"anchor_us": an * 1e6, "agreement": agree}),
+    ]
+
+
+def _log_interpolate(points: list[tuple[float, float]], cpu: float) -> float | None:
+    """Error of a method at CPU time ``cpu`` by log–log interpolation of its ``(cpu, error)``
+    points; None outside their range."""
+    points = sorted(points)
+    for (c0, e0), (c1, e1) in zip(points, points[1:]):
+        if c0 <= cpu <= c1 and c1 > c0:
+            s = (math.log(cpu) - math.log(c0)) / (math.log(c1) - math.log(c0))
+            return math.exp(math.log(e0) + s * (math.log(e1) - math.log(e0)))
+    return None
+
+
+def heavy_top_equal_cpu_target(rows: list[dict], problem: str = "heavy top (fast)") -> Target:
+    """``lie-poisson-4`` error over ``exact-kick-4`` error at the CPU time of each
+    ``exact-kick-4`` run (interpolated on the ``lie-poisson-4`` curve); the smallest ratio."""
+    name = f"{problem}: lie-poisson-4 error / exact-kick-4 error at equal CPU"
+    subset = [r for r in rows if r.get("problem") == problem and "failed" not in r]
+    split = [(r["cpu_s"], r["error"]) for r in subset if r["method"] == "lie-poisson-4"]
+    ratios = []
+    for r in subset:
+        if r["method"] == "exact-kick-4":
+            other = _log_interpolate(split, r["cpu_s"])
+            if other is not None:
+                ratios.append((other / r["error"], r))
+    if not ratios:
+        return Target(name, None, "x", 1.0, ">=", "no exact-kick-4 run fell within the lie-poisson-4 CPU range")
+    ratio, row = min(ratios, key=lambda item: item[0])
+    return Target(name, ratio, "x", 1.0, ">=",
+                  f"smallest over {len(ratios)} exact-kick-4 runs; at dt = {row['value']:g} ({row['cpu_s'] * 1e3:.2f} ms) "
+                  f"its error is {row['error']:.2g}; {row.get('description', '')}")
+
+
 # --------------------------------------------------------------------------- start-up
 def _dirac_command() -> list[str]:
     return [sys.executable, "-m", "dirac"]
@@ -412,5 +499,8 @@ def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], Non
 
     attempt("batch through integrate", batch_through_integrate)
     attempt("double pendulum", lambda: double_pendulum_target(3 if quick else 5, 20_000 if quick else 100_000))
+    attempt("heavy top: exact-kick-4 and lie-poisson-4 per step, hand-written anchor",
+            lambda: heavy_top_step_targets(repeats, 20_000 if quick else 100_000))
+    targets.append(heavy_top_equal_cpu_target(rows))
     attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
     return targets, notes

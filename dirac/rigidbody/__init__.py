@@ -15,6 +15,8 @@ Modules, one job each:
   symmetric integrals, as numba kernels;
 - :mod:`dirac.rigidbody.exact` -- the exact flow in Jacobi elliptic functions and an
   elliptic integral of the third kind;
+- :mod:`dirac.rigidbody.exact_step` -- one step of that flow set up and evaluated in
+  compiled code, and the heavy top's exact-free-flow + kick compositions;
 - :mod:`dirac.rigidbody.closed_forms` -- the paper's elementary solutions (165), (183);
 - :mod:`dirac.rigidbody.batch` -- many bodies at once with the 3-term splitting.
 

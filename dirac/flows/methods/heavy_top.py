@@ -15,9 +15,11 @@ Two families of ``F``:
     ``F`` is the Strang step of the Lie–Poisson splitting of ``H_0`` (exact rotations
     about the body axes; for ``lie-poisson-sym-*`` the symmetric-top split, which is the
     *exact* free flow of a Lagrange top ``I_1 = I_2``).
-``exact-kick-*``
-    ``F`` is the exact free flow (:class:`dirac.rigidbody.exact.ExactRigidBodyFlow`,
-    elliptic functions), as in Celledoni et al. (2008); one Python call per stage.
+``exact-kick-*`` (numba, one kernel)
+    ``F`` is the exact free flow (Jacobi elliptic functions and an elliptic integral of
+    the third kind), as in Celledoni et al. (2008): :func:`dirac.rigidbody.exact_step.free_flow_step`
+    sets the flow up and evaluates it inside the compiled loop
+    :func:`dirac.rigidbody.exact_step.exact_kick_advance`.
 
 This module gives the ``lie-poisson-*`` methods their heavy-top factory
 (:data:`LIE_POISSON_FACTORIES`, joined to them by :mod:`dirac.flows.methods.registry`);
@@ -32,8 +34,9 @@ import numpy as np
 
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
 from dirac.flows.methods.base import Method, Stepper, StepperFactory
-from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper, exact_flow
-from dirac.rigidbody.heavy_top import heavy_top_advance, kick
+from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
+from dirac.rigidbody.exact_step import FreeFlowWork, exact_kick_advance
+from dirac.rigidbody.heavy_top import heavy_top_advance
 from dirac.rigidbody.splitting import CompositionScheme, build_sequence
 
 __all__ = ["HeavyTopSplittingStepper", "ExactKickStepper", "METHODS", "LIE_POISSON_FACTORIES"]
@@ -61,33 +64,22 @@ class HeavyTopSplittingStepper(RigidBodyStepper):
 
 
 class ExactKickStepper(RigidBodyStepper):
-    """Kick + exact free flow (Celledoni et al. 2008), composed; Python loop over stages."""
+    """Kick + exact free flow (Celledoni et al. 2008), composed; one compiled loop."""
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:
         super().__init__(problem, outputs)
         self.gammas = np.asarray(cast(tuple[float, ...], method.data), dtype=float)
         self.w = np.asarray(problem.weight_vector, dtype=float)
-
-    def _free(self, b: int, tau: float) -> None:
-        flow = exact_flow(self.inertia, self.M[b].copy(), self.R[b].copy())
-        M1, R1 = flow.state(np.array([tau]))
-        self.M[b] = M1[0]
-        self.R[b] = R1[0]
-
-    def _kick(self, b: int, tau: float) -> None:
-        kick(self.M[b], self.R[b], self.w, tau)  # compiled: np.cross costs ~100x more per call
+        self.work = FreeFlowWork()
 
     def warm_up(self) -> None:
-        exact_flow(self.inertia, self.M[0], self.R[0]).state(np.array([1e-3]))
-        kick(self.M[0].copy(), self.R[0], self.w, 0.0)
+        exact_kick_advance(self.M[0].copy(), self.R[0].copy(), self.inv_inertia, self.w, self.gammas, 1e-3, 1,
+                           *self.work.arrays())
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):
-            for _ in range(n_steps):
-                for gamma in self.gammas:
-                    self._kick(b, 0.5 * gamma * dt)
-                    self._free(b, gamma * dt)
-                    self._kick(b, 0.5 * gamma * dt)
+            exact_kick_advance(self.M[b], self.R[b], self.inv_inertia, self.w, self.gammas, dt, n_steps,
+                               *self.work.arrays())
         self.steps += n_steps
         self.evaluations += n_steps * 3 * len(self.gammas) * self.M.shape[0]
 
