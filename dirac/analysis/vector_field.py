@@ -77,7 +77,7 @@ class VectorField:
         """``dy/dt`` at ``y`` (a new array); ``t`` is not used."""
         try:
             return self._field(t, y, self._params)
-        except TypeError:  # not a C-contiguous float64 vector, or t not a float
+        except (TypeError, ValueError):  # not a C-contiguous float64 vector of N, or t not a float
             return self._field(float(t), self._state(y), self._params)
 
     def _state(self, y: object) -> np.ndarray:
