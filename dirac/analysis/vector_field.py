@@ -21,18 +21,32 @@ from __future__ import annotations
 import math
 import weakref
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 import sympy
 
 from dirac.codegen.field_source import compile_vector_field, vector_field_source
 from dirac.errors import InputError
-
-if TYPE_CHECKING:
-    from dirac.analysis.constraint_analysis import ConstraintAnalysis
+from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["VectorField", "vector_field"]
+
+
+class ConstraintAnalysis(Protocol):
+    """What the field needs of :class:`dirac.analysis.constraint_analysis.ConstraintAnalysis`
+    (named here without importing it: that module imports this one)."""
+
+    name: str
+    lagrangian: Lagrangian
+    phase_space: tuple[sympy.Symbol, ...]
+    parameters: tuple[sympy.Symbol, ...]
+    canonical_hamiltonian: sympy.Expr
+    primary_multipliers: tuple[sympy.Symbol, ...]
+    primary_constraints: list[sympy.Expr]
+    undetermined_multipliers: list[sympy.Symbol]
+    second_class: list[sympy.Expr]
+    constraints: list[sympy.Expr]
 
 
 class VectorField:
