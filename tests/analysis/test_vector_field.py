@@ -101,6 +101,10 @@ def test_inputs_that_are_not_contiguous_float_vectors_are_converted(pendulum):
     assert not strided.flags["C_CONTIGUOUS"]
     np.testing.assert_allclose(f(0, strided), expected, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(f(0.0, list(state)), expected, rtol=1e-12, atol=1e-12)
+    frozen = state.copy()
+    frozen.flags.writeable = False
+    np.testing.assert_allclose(f(0.0, frozen), expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(f.batch(frozen[None, :])[0], expected, rtol=1e-12, atol=1e-12)
 
 
 def test_bad_inputs_are_refused(pendulum):
