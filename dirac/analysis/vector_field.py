@@ -33,7 +33,7 @@ from dirac.model.lagrangian import Lagrangian
 __all__ = ["VectorField", "vector_field"]
 
 
-class ConstraintAnalysis(Protocol):
+class Analysis(Protocol):
     """What the field needs of :class:`dirac.analysis.constraint_analysis.ConstraintAnalysis`
     (named here without importing it: that module imports this one)."""
 
@@ -166,10 +166,10 @@ def _values(kind: str, given: Mapping[str, float] | None, allowed: dict[str, flo
 
 
 #: analysis -> its generated module (the parameters and multipliers are read at run time)
-_MODULES: weakref.WeakKeyDictionary[ConstraintAnalysis, Any] = weakref.WeakKeyDictionary()
+_MODULES: weakref.WeakKeyDictionary[Analysis, Any] = weakref.WeakKeyDictionary()
 
 
-def _module(analysis: ConstraintAnalysis, free: list[sympy.Symbol]) -> Any:
+def _module(analysis: Analysis, free: list[sympy.Symbol]) -> Any:
     """The generated module of the analysis (generated once per analysis)."""
     cached = _MODULES.get(analysis)
     if cached is not None:
@@ -185,7 +185,7 @@ def _module(analysis: ConstraintAnalysis, free: list[sympy.Symbol]) -> Any:
     return module
 
 
-def vector_field(analysis: ConstraintAnalysis, parameters: Mapping[str, float] | None = None,
+def vector_field(analysis: Analysis, parameters: Mapping[str, float] | None = None,
                  multipliers: Mapping[str, float] | None = None) -> VectorField:
     """The compiled Dirac vector field ``f`` of ``analysis`` (see :class:`VectorField`).
 
