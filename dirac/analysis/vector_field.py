@@ -57,9 +57,12 @@ class VectorField:
 
     At a point of the constraint surface ``f(t, y)`` is ``{z, H}_D`` (240) with the
     multipliers solved there. Off the surface it is the same formula evaluated at ``y``
-    (``C`` and its solve at ``y``): a continuation of the field that is not, in general,
-    tangent to any constraint surface; where ``C`` is singular its entries are ``inf``
-    or ``NaN``. :meth:`residual` gives the constraint values to check a state.
+    (``C`` and its solve at ``y``). Every second-class constraint is a Casimir of the
+    Dirac bracket wherever ``C`` is invertible (``{Phi_a, F}_D = 0`` by (240)), so this
+    continuation keeps each ``Phi_a`` at the value it has at ``y``: a state off the
+    surface stays off it by the same amount, and its motion is not that of the system.
+    Where ``C`` is singular the entries are ``inf`` or ``NaN``. :meth:`residual` gives
+    the constraint values to check a state.
 
     The generated function compiles once per system and machine (a second or two for a
     pendulum, about half a minute for the 24 second-class constraints of a rigid body)

@@ -48,6 +48,26 @@ def test_pendulum_field_equals_the_closed_form_at_surface_points(pendulum):
         assert np.max(np.abs(f.residual(state))) <= 1e-12 * (1 + omega * omega)
 
 
+def test_off_the_surface_the_field_keeps_every_second_class_constraint(pendulum):
+    """{Phi_a, F}_D = {Phi_a, F} - C_ab C^{-1}_bc {Phi_c, F} = 0 wherever C is invertible
+    (240), so grad Phi_a . f = {Phi_a, H}_D = 0 at any state, on the surface or not.
+    The gradients come from sympy here, independently of the generated code."""
+    import sympy
+
+    f = pendulum.vector_field()
+    z = pendulum.phase_space
+    values = {p: v for p, v in pendulum.lagrangian.parameters.items()}
+    gradients = sympy.lambdify([z], [[sympy.diff(phi.subs(values), s) for s in z] for phi in pendulum.second_class])
+    rng = np.random.default_rng(17)
+    for _ in range(20):
+        state = rng.normal(size=6)
+        state[0] += 1.5  # away from x = y = 0, where C is singular
+        D = np.array(gradients(state), dtype=float)
+        velocity = f(0.0, state)
+        assert np.max(np.abs(D @ velocity)) <= 1e-11 * (1 + np.abs(D).max() * np.abs(velocity).max())
+        assert np.max(np.abs(f.residual(state))) > 1e-3  # these states are off the surface
+
+
 def test_parameters_override_the_defaults(pendulum):
     f = pendulum.vector_field(parameters={"m": 2.0, "g": 3.7, "l": 1.5})
     assert f.parameters == {"m": 2.0, "g": 3.7, "l": 1.5}
