@@ -74,7 +74,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         measured, notes = measure_targets(quick, rows, say)
         say("Dirac vector field against a lean Python right-hand side")
         try:
-            field_rows, field_target = measure_vector_field(repeats, 20_000, 10_000)
+            field_rows, field_target = measure_vector_field(repeats, 20_000, 10_000, before=not quick)
             measured.append(field_target)
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"vector field: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")

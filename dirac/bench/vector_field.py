@@ -68,7 +68,7 @@ def _per_call(function: Callable[[], object], calls: int) -> float:
     return (time.process_time() - start) / calls
 
 
-def measure_vector_field(repeats: int, calls: int, batch: int) -> tuple[list[dict], Target]:
+def measure_vector_field(repeats: int, calls: int, batch: int, before: bool = True) -> tuple[list[dict], Target]:
     """The vector-field table (one row per candidate) and its target (``f`` / lean < 1).
 
     Parameters
@@ -79,6 +79,9 @@ def measure_vector_field(repeats: int, calls: int, batch: int) -> tuple[list[dic
         Calls per candidate and round.
     batch
         States of the batched evaluation.
+    before
+        Also time the fields the package had before (their first use compiles their
+        kernels: ``dirac bench --quick`` leaves them out).
     """
     from scipy.integrate import solve_ivp
 
@@ -92,17 +95,18 @@ def measure_vector_field(repeats: int, calls: int, batch: int) -> tuple[list[dic
     points = _surface_points(64)
     agreement = max(float(np.max(np.abs(f(0.0, z) - np.array(pendulum_lean_rhs(0.0, z))))) for z in points)
     z = points[0].copy()
-    mechanics = MechanicalSystem.from_lagrangian(lagrangian)
-    state = np.concatenate([z[:2], z[3:5]])
-    old = ConstrainedField(mechanics)
     many = np.repeat(points, batch // len(points) + 1, axis=0)[:batch].copy()
     candidates: dict[str, tuple[Callable[[], object], int]] = {
         "analysis.vector_field(): f(t, y)": (lambda: f(0.0, z), calls),
         "lean Python RHS (plain floats, list)": (lambda: pendulum_lean_rhs(0.0, z), calls),
-        "AnalysedSystem.field(z) (before)": (lambda: analysed.field(z), max(1, calls // 20)),
-        "ConstrainedField.scipy_rhs (before, q and p only)": (lambda: old.scipy_rhs(0.0, state), max(1, calls // 20)),
-        f"f.batch on {batch} states, per state": (lambda: f.batch(many), 1),
     }
+    if before:
+        old = ConstrainedField(MechanicalSystem.from_lagrangian(lagrangian))
+        state = np.concatenate([z[:2], z[3:5]])
+        candidates["AnalysedSystem.field(z) (before)"] = (lambda: analysed.field(z), max(1, calls // 20))
+        candidates["ConstrainedField.scipy_rhs (before, q and p only)"] = (lambda: old.scipy_rhs(0.0, state),
+                                                                            max(1, calls // 20))
+    candidates[f"f.batch on {batch} states, per state"] = (lambda: f.batch(many), 1)
     best = {name: math.inf for name in candidates}
     for function, _ in candidates.values():
         function()  # compilation and first-call costs outside the timed loops

@@ -28,3 +28,6 @@ def test_the_table_compares_the_compiled_field_with_the_lean_baseline():
     assert len(integrated) == 2 and integrated[0]["circle_drift"] <= 1e-8
     text = format_vector_field_table(rows)
     assert "analysis.vector_field(): f(t, y)" in text and "solve_ivp DOP853" in text
+    assert any("before" in name for name in names)
+    quick_rows, _ = measure_vector_field(repeats=1, calls=50, batch=100, before=False)
+    assert not any("before" in row["field"] for row in quick_rows)
