@@ -99,3 +99,14 @@ def test_a_state_of_the_wrong_length_is_refused(linear_module):
     *_, params = _values(np.random.default_rng(1))
     with pytest.raises(ValueError, match="8 entries"):
         linear_module.field(0.0, np.zeros(7), params)
+
+
+def test_the_module_is_cached_on_disk_by_the_hash_of_its_source(linear_module):
+    import hashlib
+
+    from dirac.codegen import cache_directory
+
+    path = cache_directory() / f"{linear_module.__name__}.py"
+    source = path.read_text(encoding="utf-8")
+    assert linear_module.__name__ == f"dirac_field_{hashlib.sha256(source.encode()).hexdigest()[:20]}"
+    assert compile_vector_field(source) is linear_module
