@@ -1,7 +1,7 @@
 """Source of one compiled Dirac vector field: grad H, grad Phi, C and its solve inlined.
 
 The Hamiltonian vector field over second-class constraints ``Phi_a`` (the Dirac
-bracket (240); Dirac, *Lectures on Quantum Mechanics*; Henneaux & Teitelboim, Sect. 1.3)
+bracket (240); Dirac, *Lectures on Quantum Mechanics*; Henneaux & Teitelboim, Ch. 1)
 
     z_dot = {z, H}_D = J g - J D^T x,    C x = D J g,
     g = grad H,   D = grad Phi  (k, N),   C_ab = {Phi_a, Phi_b} = D_a^T J D_b,
