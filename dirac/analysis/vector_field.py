@@ -221,6 +221,7 @@ def vector_field(analysis: Analysis, parameters: Mapping[str, float] | None = No
     multiplier_values = _values("multiplier", multipliers, {u.name: 0.0 for u in free},
                                 "the free multipliers (of first-class primary constraints) are")
     module = _module(analysis, free)
-    params = np.array([*parameter_values.values(), *multiplier_values.values()], dtype=float)
+    params = np.zeros(module.PARAMS)  # the values, then the scratch space of a looped solve
+    params[:len(parameter_values) + len(multiplier_values)] = [*parameter_values.values(), *multiplier_values.values()]
     return VectorField(tuple(s.name for s in analysis.phase_space), tuple(str(c) for c in analysis.constraints),
                        parameter_values, multiplier_values, params, module)

@@ -14,6 +14,14 @@ left out), then Gaussian elimination with partial pivoting on ``C``, unrolled on
 scalars: no array is allocated besides the output, no LAPACK is called. Row exchanges
 of the pivoting are conditional swaps of local names; a column whose diagonal entry is
 structurally zero takes its first structurally non-zero row before the comparisons.
+When the unrolled elimination would exceed ``UNROLL_LIMIT`` lines (a large ``C`` with
+much fill-in: the 24 second-class constraints of a rigid body), ``[C | D J g]`` is
+written into scratch space at the end of ``params`` instead and solved there by one
+looped elimination with partial pivoting (``solve_scratch``), which compiles in a
+fraction of the time; still nothing is allocated. ``params`` therefore holds
+``PARAMS`` entries: the parameter values, then the scratch space (none when unrolled).
+The generated functions hold the GIL, so callers on several threads never share the
+scratch space at the same time.
 
 :func:`compile_vector_field` writes the source into the cache directory under the hash
 of its text and imports it (as :func:`dirac.codegen.numba_backend.generate_module`), so
@@ -151,6 +159,62 @@ def _elimination(lines: _Lines, matrix: list[list[str | None]], rhs: list[str | 
     return x
 
 
+#: largest unrolled elimination (source lines) before the looped solve takes over
+UNROLL_LIMIT = 1200
+
+_SCRATCH_SOLVER = '''@numba.njit("void(float64[::1], int64, int64)", cache=True, error_model="numpy")
+def solve_scratch(w, start, k):
+    """Solve [C | b] (k x (k + 1), row-major in w[start:]) in place by Gaussian
+    elimination with partial pivoting; the solution ends up in column k."""
+    m = k + 1
+    for c in range(k):
+        pivot = c
+        best = abs(w[start + c * m + c])
+        for r in range(c + 1, k):
+            size = abs(w[start + r * m + c])
+            if size > best:
+                best = size
+                pivot = r
+        if pivot != c:
+            for j in range(c, m):
+                swap = w[start + c * m + j]
+                w[start + c * m + j] = w[start + pivot * m + j]
+                w[start + pivot * m + j] = swap
+        d = w[start + c * m + c]
+        for r in range(c + 1, k):
+            factor = w[start + r * m + c] / d
+            if factor != 0.0:
+                for j in range(c + 1, m):
+                    w[start + r * m + j] -= factor * w[start + c * m + j]
+    for c in range(k - 1, -1, -1):
+        acc = w[start + c * m + k]
+        for j in range(c + 1, k):
+            acc -= w[start + c * m + j] * w[start + j * m + k]
+        w[start + c * m + k] = acc / w[start + c * m + c]
+
+
+'''
+
+
+def _scratch_solve(lines: _Lines, matrix: list[list[str | None]], rhs: list[str | None], start: int) -> list[str | None]:
+    """``matrix x = rhs`` by the looped solve ``solve_scratch`` on ``params[start:]``.
+
+    The augmented matrix is written row by row into the scratch space (structurally
+    zero entries as 0.0), solved in place, and ``x`` read back into local names.
+    """
+    k = len(matrix)
+    m = k + 1
+    for r in range(k):
+        for j, value in enumerate([*matrix[r], rhs[r]]):
+            lines.add(f"params[{start + r * m + j}] = {value or '0.0'}")
+    lines.add(f"solve_scratch(params, {start}, {k})")
+    x: list[str | None] = []
+    for a in range(k):
+        lines.add(f"x{a}_ = params[{start + a * m + k}]")
+        x.append(f"x{a}_")
+    return x
+
+
 def vector_field_source(
     variables: Sequence[sympy.Symbol],
     parameters: Sequence[sympy.Symbol],
@@ -158,6 +222,7 @@ def vector_field_source(
     second_class: Sequence[sympy.Expr],
     residual_expressions: Sequence[sympy.Expr] = (),
     title: str = "Dirac vector field",
+    unroll_limit: int = UNROLL_LIMIT,
 ) -> str:
     """Python source of the compiled Dirac vector field (see the module docstring).
 
@@ -178,6 +243,10 @@ def vector_field_source(
         The expressions ``residual`` evaluates (typically every constraint).
     title
         First docstring line of the module.
+    unroll_limit
+        Largest number of source lines of the unrolled elimination; a larger one (large
+        ``C`` with much fill-in, e.g. the 24 second-class constraints of a rigid body)
+        is replaced by the looped solve, which compiles in a fraction of the time.
 
     Returns
     -------
@@ -186,6 +255,7 @@ def vector_field_source(
     """
     z = list(variables)
     N = len(z)
+    scratch = len(parameters)  # where the scratch space of the looped solve starts in params
     if N % 2:
         raise ValueError(f"a canonical phase space has an even dimension, not {N}")
     n = N // 2
@@ -209,6 +279,8 @@ def vector_field_source(
     lines = _Lines()
     lines.add(f"if z.shape[0] != {N} or out.shape[0] != {N}:")
     lines.add(f'    raise ValueError("the state must have {N} entries")')
+    lines.add("if params.shape[0] != PARAMS:")
+    lines.add('    raise ValueError("params must have PARAMS entries")')
     for i in range(N):
         lines.add(f"a{i}_ = z[{i}]")
     for i in range(len(parameters)):
@@ -225,6 +297,8 @@ def vector_field_source(
             d_name[a][i] = name
     # J g: (J g)_i = g_{n+i}, (J g)_{n+i} = -g_i
     correction: list[str | None] = [None] * N
+    scratch_size = [0]
+    solver_source: list[str] = []
     if k:
         # C_ab = sum_i D_a,i D_b,n+i - D_a,n+i D_b,i  (antisymmetric), b_a = (D J g)_a
         C: list[list[str | None]] = [[None] * k for _ in range(k)]
@@ -243,7 +317,14 @@ def vector_field_source(
             if entry is not None:
                 lines.add(f"b{a}_ = {entry}")
             rhs.append(f"b{a}_" if entry is not None else None)
-        x = _elimination(lines, C, rhs)
+        unrolled = _Lines()
+        x = _elimination(unrolled, C, rhs)
+        if len(unrolled.lines) <= unroll_limit:
+            lines.lines.extend(unrolled.lines)
+        else:
+            x = _scratch_solve(lines, C, rhs, scratch)
+            scratch_size[0] = k * (k + 1)
+            solver_source = _SCRATCH_SOLVER.splitlines()
         # w = D^T x
         for j in range(N):
             total = _sum([("+", _product(d_name[a][j], x[a])) for a in range(k)])
@@ -272,8 +353,11 @@ def vector_field_source(
         "",
         f"N = {N}",
         f"K = {len(residual_expressions)}",
+        f"#: entries of params: {len(parameters)} values, then {scratch_size[0]} of scratch space for the solve",
+        f"PARAMS = {len(parameters) + scratch_size[0]}",
         "",
         "",
+        *solver_source,
         decorated("field_into"),
         "def field_into(z, params, out):",
         '    """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H) at z, into out (240)."""',

@@ -20,18 +20,23 @@ PARAMETERS = sorted((A.free_symbols | S.free_symbols | c.free_symbols), key=lamb
 J = np.block([[np.zeros((n, n)), np.eye(n)], [-np.eye(n), np.zeros((n, n))]])
 
 
-@pytest.fixture(scope="module")
-def linear_module():
+@pytest.fixture(scope="module", params=["unrolled", "looped"])
+def linear_module(request):
     """Quadratic ``H = 1/2 z^T S z + c^T z`` and linear constraints ``Phi = A z``, all
     coefficients parameters: ``C = A J A^T`` is a dense antisymmetric matrix, so every
-    column's diagonal is structurally zero and the pivoting decides at run time."""
+    column's diagonal is structurally zero and the pivoting decides at run time. Both
+    solves: unrolled, and looped in the scratch space (``unroll_limit=0``)."""
     H = (Z.T * S * Z)[0, 0] / 2 + (c.T * Z)[0, 0]
     constraints = list(A * Z)
-    source = vector_field_source(z, PARAMETERS, H, constraints, constraints, title="linear test field")
-    return compile_vector_field(source)
+    limit = {"unrolled": 10_000, "looped": 0}[request.param]
+    source = vector_field_source(z, PARAMETERS, H, constraints, constraints, title="linear test field",
+                                 unroll_limit=limit)
+    module = compile_vector_field(source)
+    assert module.PARAMS == len(PARAMETERS) + (k * (k + 1) if request.param == "looped" else 0)
+    return module
 
 
-def _values(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _values(rng: np.random.Generator, module) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     a = rng.normal(size=(k, 2 * n))
     s = rng.normal(size=(2 * n, 2 * n))
     s = s + s.T
@@ -43,8 +48,9 @@ def _values(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarra
         for j in range(i, 2 * n):
             values[S[i, j]] = s[i, j]
         values[c[i, 0]] = cc[i]
-    params = np.array([values[symbol] for symbol in PARAMETERS])
-    return a, s, cc, params
+    params = np.zeros(len(PARAMETERS) + k * (k + 1))  # the values, then the scratch space if looped
+    params[:len(PARAMETERS)] = [values[symbol] for symbol in PARAMETERS]
+    return a, s, cc, params[:module.PARAMS].copy()
 
 
 def test_linear_field_against_the_dense_formula(linear_module):
@@ -53,7 +59,7 @@ def test_linear_field_against_the_dense_formula(linear_module):
     every pivot comparison occur."""
     rng = np.random.default_rng(7)
     for _ in range(200):
-        a, s, cc, params = _values(rng)
+        a, s, cc, params = _values(rng, linear_module)
         point = rng.normal(size=2 * n)
         g = s @ point + cc
         C = a @ J @ a.T
@@ -87,7 +93,7 @@ def test_a_small_first_pivot_is_exchanged():
 
 def test_batch_rows_equal_single_calls(linear_module):
     rng = np.random.default_rng(3)
-    *_, params = _values(rng)
+    *_, params = _values(rng, linear_module)
     states = rng.normal(size=(5, 2 * n))
     out = np.empty_like(states)
     linear_module.field_batch(states, params, out)
@@ -96,7 +102,7 @@ def test_batch_rows_equal_single_calls(linear_module):
 
 
 def test_a_state_of_the_wrong_length_is_refused(linear_module):
-    *_, params = _values(np.random.default_rng(1))
+    *_, params = _values(np.random.default_rng(1), linear_module)
     with pytest.raises(ValueError, match="8 entries"):
         linear_module.field(0.0, np.zeros(7), params)
 
