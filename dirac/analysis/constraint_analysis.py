@@ -23,6 +23,7 @@ from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.numeric import Numerics
 from dirac.analysis.report import to_json, to_latex, to_text
+from dirac.analysis.vector_field import VectorField, vector_field
 from dirac.errors import AnalysisError, InputError
 from dirac.model.lagrangian import Lagrangian
 
@@ -278,6 +279,30 @@ class ConstraintAnalysis:
                     "components you need with equations_of_motion(variables=[...])"
                 ) from None
         return result
+
+    def vector_field(self, parameters: Mapping[str, float] | None = None,
+                     multipliers: Mapping[str, float] | None = None) -> VectorField:
+        """The compiled Dirac vector field ``f(t, y)`` for ``scipy.integrate.solve_ivp``.
+
+        ``f(t, y)`` is ``z_dot = {z, H}_D`` (240) at the state ``y`` (the variables
+        ``f.names``, in the order of :attr:`symbols`), ``H`` as in
+        :meth:`equations_of_motion` with the free multipliers ``u_k`` given (default 0);
+        ``f.batch(Y)`` evaluates many states, ``f.residual(y)`` the constraints.
+        See :class:`dirac.analysis.vector_field.VectorField`.
+
+        Parameters
+        ----------
+        parameters
+            Values of the symbolic parameters (default: the Lagrangian's defaults).
+        multipliers
+            Values of the free multipliers of first-class primary constraints.
+
+        Raises
+        ------
+        InputError
+            Unknown names, parameters without a value, values that are not finite.
+        """
+        return vector_field(self, parameters, multipliers)
 
     # ------------------------------------------------------------------ points
     def surface_point(self, values: Mapping[str, float] | None = None, seed: int | None = None) -> dict[str, float]:

@@ -71,10 +71,18 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
                 rows += run_heavy_top_case(top, repeats, say)
     measured: list[Target] = []
     notes: list[str] = []
+    field_rows: list[dict] = []
     if targets:
         from dirac.bench.targets import measure_targets
+        from dirac.bench.vector_field import measure_vector_field
 
         measured, notes = measure_targets(quick, rows, say)
+        say("Dirac vector field against a lean Python right-hand side")
+        try:
+            field_rows, field_target = measure_vector_field(repeats, 20_000, 10_000, before=not quick)
+            measured.append(field_target)
+        except Exception as exc:  # one failed measurement must not hide the others
+            notes.append(f"vector field: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
     else:
         from dirac.bench.targets import work_precision_targets
 
@@ -86,6 +94,10 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
     print("CPU ms = median over repeats of the integration's CPU time (compiled kernels, warm-up excluded); "
           "errors at T against independent references")
     print(format_rows(rows))
+    if field_rows:
+        from dirac.bench.vector_field import format_vector_field_table
+
+        print(format_vector_field_table(field_rows))
     print(format_targets(measured))
     for note in notes:
         print(f"note: {note}")
@@ -97,6 +109,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         "elapsed_s": elapsed,
         "runs": rows,
         "targets": [t.as_dict() for t in measured],
+        "vector_field": field_rows,
         "notes": notes,
     }
     if json_path:
