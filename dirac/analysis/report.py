@@ -160,6 +160,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         "first_class": [expression_text(c) for c in analysis.first_class],
         "second_class": [expression_text(c) for c in analysis.second_class],
         "multipliers": multipliers,
+        "multiplier_solution": solution,
         "physical_degrees_of_freedom": analysis.physical_degrees_of_freedom,
         "phase_space": [s.name for s in analysis.phase_space],
         "parameters": [p.name for p in analysis.parameters],
@@ -170,7 +171,6 @@ def to_json(analysis: AnalysisResult) -> dict:
         "bracket_strategy": analysis.bracket_strategy,
         "notes": list(analysis.notes),
     }
-    out["multiplier_solution"] = solution
     if definitions:
         out["multiplier_subexpressions"] = definitions
     return out
