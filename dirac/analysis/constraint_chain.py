@@ -20,7 +20,8 @@ and the stages follow the paper's order for (228) — ``pi -> R^T R - 1`` first,
 ``d(R^T R)/dt = 0`` fixes ``v = 0`` and ``P_dot = 0`` fixes ``lambda`` (Sect. XI). New constraints
 that follow from the earlier ones (gradient dependent on the new surface) are dropped; a
 condition free of phase-space variables (``1 = 0``) is an inconsistency. The chain stops
-when a stage adds nothing; the last system then fixes the determined multipliers.
+when a stage adds nothing; the last system then fixes the determined multipliers, and its
+general solution ``u = U + v_a V_a`` is built by :mod:`dirac.analysis.multiplier_solution`.
 """
 
 from __future__ import annotations
