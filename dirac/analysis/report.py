@@ -9,12 +9,14 @@ call it).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
-from dirac.analysis.multiplier_solution import MultiplierSolution
 from dirac.model.lagrangian import Lagrangian, latex_names
+
+if TYPE_CHECKING:  # the report reads a solution; it needs no solver
+    from dirac.analysis.multiplier_solution import MultiplierSolution
 
 __all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
 
