@@ -21,6 +21,7 @@ from dirac.analysis.gauge_fixing import fix_gauge, regular_gauge_point
 from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure, gauge_structure
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
+from dirac.analysis.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.numeric import Numerics
 from dirac.analysis.report import to_json, to_latex, to_text
 from dirac.analysis.vector_field import VectorField, vector_field
@@ -59,7 +60,15 @@ class ConstraintAnalysis:
     primary_multipliers
         The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``.
     multipliers
-        ``u_k`` name -> solved expression, for those the algorithm determines.
+        ``u_k`` name -> solved expression, for those the algorithm fixes alone.
+    undetermined_multipliers
+        The ``u_k`` not fixed alone (free, or fixed only in combinations).
+    multiplier_solution
+        The general solution ``u = U + v_a V_a`` of the consistency conditions: a
+        :class:`~dirac.analysis.multiplier_solution.MultiplierSolution` with
+        ``.particular`` (name -> expression), ``.null_vectors`` (list of name ->
+        expression), the free ``.free`` (``v_1, ...``), the first-class combinations
+        ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``.
     stages, constraints
         The chain stage by stage (stage 1 = primary) and flat.
     first_class, second_class
@@ -123,6 +132,7 @@ class ConstraintAnalysis:
         self.constraints = chain.constraints
         self.multipliers = dict(chain.solved_multipliers)
         self.undetermined_multipliers = list(chain.undetermined)
+        self.multiplier_solution: MultiplierSolution = chain.multiplier_solution or unsolved_multipliers((), [], self.canonical_hamiltonian, [])
         self._points = chain.points
         C = bracket_matrix(space, self.constraints)
         cls = classify(space, self._numerics, self.constraints, self._points, C)

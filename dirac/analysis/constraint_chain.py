@@ -26,7 +26,8 @@ and the stages follow the paper's order for (228) — ``pi -> R^T R - 1`` first,
 ``d(R^T R)/dt = 0`` fixes ``v = 0`` and ``P_dot = 0`` fixes ``lambda`` (Sect. XI). New constraints
 that follow from the earlier ones (gradient dependent on the new surface) are dropped; a
 condition free of phase-space variables (``1 = 0``) is an inconsistency. The chain stops
-when a stage adds nothing; the last system then fixes the determined multipliers.
+when a stage adds nothing; the last system then fixes the determined multipliers, and its
+general solution ``u = U + v_a V_a`` is built by :mod:`dirac.analysis.multiplier_solution`.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ import sympy
 
 from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
+from dirac.analysis.multiplier_solution import MultiplierSolution, general_multiplier_solution, unsolved_multipliers
 from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.errors import AnalysisError, InconsistentSystemError
@@ -69,7 +71,7 @@ class ConstraintChain:
 
     After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
     expression, only those the chain determines), ``undetermined`` (multiplier symbols
-    left free), ``points`` (points of the final surface) and ``notes``.
+    not fixed alone), ``multiplier_solution`` (the general solution ``u = U + v_a V_a``), ``points`` (points of the final surface) and ``notes``.
     """
 
     phase_space: PhaseSpace
@@ -82,6 +84,7 @@ class ConstraintChain:
     undetermined: list[sympy.Symbol] = field(default_factory=list)
     points: list[np.ndarray] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    multiplier_solution: MultiplierSolution | None = None
     time: sympy.Symbol | None = None
 
     @property
@@ -237,9 +240,16 @@ class ConstraintChain:
         return b_row - sum((c[k, 0] * self._rows(constraints[P[k]])[0] for k in needed), sympy.S.Zero)
 
     def _solve_multipliers(self, points, P, Q) -> None:
-        """Solve ``b_P + A_PQ u_Q = 0`` for the determined multipliers ((214)-(215) ff.)."""
+        """Solve ``b_P + A_PQ u_Q = 0`` for the determined multipliers ((214)-(215) ff.).
+
+        Also the general solution ``u = U + v_a V_a`` (:attr:`multiplier_solution`, see
+        :mod:`dirac.analysis.multiplier_solution`); a multiplier counts as determined when
+        it is fixed alone.
+        """
         K = len(self.primary)
         constraints = self.constraints
+        taken = [s.name for s in (*self.phase_space.variables, *self.phase_space.parameters)]
+        self.multiplier_solution = unsolved_multipliers(self.multipliers, self.primary, self.canonical_hamiltonian, taken)
         if not K:
             return
         if not constraints or not P:
@@ -258,19 +268,19 @@ class ConstraintChain:
             if 2 * votes > len(A_num):
                 determined.append(k)
         self.undetermined = [self.multipliers[k] for k in range(K) if k not in determined]
-        if not determined:
-            return
         order = determined + [k for k in range(K) if k not in determined]
-        Q = independent_rows([A[P].T for A in A_num], order)
-        A_sym = sympy.Matrix([[self._rows(constraints[p])[1][k] for k in Q] for p in P])
-        b_sym = sympy.Matrix([-self._rows(constraints[p])[0] for p in P])
-        sol = weak_solve(
-            A_sym,
-            b_sym,
-            [A[np.ix_(P, Q)] for A in A_num],
-            [-b[P].reshape(-1, 1) for b in b_num],
-            variables=self.phase_space.variables,
+        self.multiplier_solution = general_multiplier_solution(
+            self.multipliers,
+            self.primary,
+            self.canonical_hamiltonian,
+            sympy.Matrix([self._rows(constraints[p])[1] for p in P]),
+            sympy.Matrix([self._rows(constraints[p])[0] for p in P]),
+            [A[P] for A in A_num],
+            [b[P] for b in b_num],
+            order,
+            self.phase_space.variables,
+            taken,
         )
-        for r, k in enumerate(Q):
-            if k in determined:
-                self.solved_multipliers[self.multipliers[k].name] = sol[r, 0]
+        for k in determined:
+            name = self.multipliers[k].name
+            self.solved_multipliers[name] = self.multiplier_solution.particular[name]

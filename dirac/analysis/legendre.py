@@ -28,6 +28,8 @@ and a polynomial ``B`` with ``A B = d 1`` (``G l = B^T (p - a) / d`` on the prim
 surface), which avoids denominators that vanish on the physical surface — used for the
 rigid-body Lagrangian (228), where the velocity combinations are the body angular
 velocities (227) and this gives ``sym(p R^T) = 0`` and the paper's (232).
+A Lagrangian linear in the velocities (``W = 0``, rank 0) is handled by
+:mod:`dirac.analysis.first_order`.
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.algebra import tidy
+from dirac.analysis.first_order import FIRST_ORDER_METHOD, first_order_primary
 from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.polynomial_kernel import polynomial_kernel
@@ -196,6 +199,11 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
         W_inv = _inverse(W)
         H_c = (shifted.T * W_inv * shifted)[0, 0] / 2 + potential
         velocity = W_inv * shifted
+    elif rank == 0:
+        primary.extend(first_order_primary(shifted, space.variables))
+        H_c = potential
+        velocity = None
+        method = FIRST_ORDER_METHOD
     else:
         forms = _velocity_forms(lagrangian)
         used_forms = False

@@ -67,7 +67,7 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
             if base is not None and len(base[k]):
                 stack.insert(0, base[k])
             current = np.vstack(stack) if stack else np.zeros((0, m.shape[1]))
-            scale = np.max(np.abs(m)) if m.size else 1.0
+            scale = (np.max(np.abs(m)) if m.size else 0.0) or 1.0  # an all-zero matrix has rank 0, not NaN
             before = numeric_rank(current / scale) if len(current) else 0
             after = numeric_rank(np.vstack([current, m[row : row + 1]]) / scale)
             votes += after > before

@@ -9,12 +9,15 @@ call it).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
 from dirac.analysis.gauge_generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
+
+if TYPE_CHECKING:  # the report reads a solution; it needs no solver
+    from dirac.analysis.multiplier_solution import MultiplierSolution
 
 __all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
 
@@ -48,6 +51,8 @@ class AnalysisResult(Protocol):
     def multipliers(self) -> Mapping[Any, sympy.Expr]: ...
     @property
     def undetermined_multipliers(self) -> Sequence[sympy.Symbol]: ...
+    @property
+    def multiplier_solution(self) -> MultiplierSolution: ...
     @property
     def first_class(self) -> Sequence[sympy.Expr]: ...
     @property
@@ -147,14 +152,16 @@ def to_json(analysis: AnalysisResult) -> dict:
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
     ``bracket_strategy``, ``notes``, ``time_dependent`` (``L`` or a constraint depends
-    explicitly on the time ``t``); ``multiplier_subexpressions`` (name -> text) when a
-    multiplier is too large to print as one tree: its text then uses those names
-    (see :func:`shared_form`). Gauge keys: ``gauge_generators`` (one ``{"terms": [G_0,
-    G_1, ...]}`` per gauge parameter), ``gauge_transformations`` (for each, its
-    ``parameter``, free ``multiplier`` and ``delta``: variable -> ``{z, G}``),
-    ``first_class_without_gauge_transformation`` and ``gauge_conditions``.
+    explicitly on the time ``t``); ``multiplier_solution`` (the general solution
+    ``u = U + v_a V_a``: ``particular``, ``null_vectors``, ``free``);
+    ``multiplier_subexpressions`` (name -> text) when a multiplier is too large to print
+    as one tree: its text then uses those names (see :func:`shared_form`). Gauge keys:
+    ``gauge_generators`` (one ``{"terms": [G_0, G_1, ...]}`` per gauge parameter),
+    ``gauge_transformations`` (for each, its ``parameter``, free ``multiplier`` and
+    ``delta``: variable -> ``{z, G}``), ``first_class_without_gauge_transformation`` and
+    ``gauge_conditions``.
     """
-    multipliers, definitions = shared_form(dict(analysis.multipliers))
+    multipliers, solution, definitions = _multiplier_texts(analysis)
     gauge = analysis.gauge_structure
     out = {
         "system": analysis.name,
@@ -166,6 +173,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         "first_class": [expression_text(c) for c in analysis.first_class],
         "second_class": [expression_text(c) for c in analysis.second_class],
         "multipliers": multipliers,
+        "multiplier_solution": solution,
         "physical_degrees_of_freedom": analysis.physical_degrees_of_freedom,
         "phase_space": [s.name for s in analysis.phase_space],
         "parameters": [p.name for p in analysis.parameters],
@@ -217,6 +225,40 @@ def _gauge_lines(a: AnalysisResult) -> list[str]:
     return lines
 
 
+#: the ``"multipliers"`` entry of a multiplier that is not fixed alone
+UNDETERMINED = "undetermined"
+
+
+def _multiplier_texts(analysis: AnalysisResult) -> tuple[dict, dict, dict]:
+    """Texts of ``"multipliers"`` and ``"multiplier_solution"``, sharing sub-expressions.
+
+    ``"multipliers"`` has one entry per multiplier (its expression where it is fixed
+    alone, ``"undetermined"`` where not); a particular-solution entry that is the same
+    expression as a fixed multiplier is printed once and its text reused.
+    """
+    solved = dict(analysis.multipliers)
+    sol = analysis.multiplier_solution
+    exprs: dict = {("fixed", name): e for name, e in solved.items()}
+    particular_keys: dict = {}
+    for name, e in sol.particular.items():
+        key = ("fixed", name) if name in solved and solved[name] is e else ("particular", name)
+        exprs.setdefault(key, e)
+        particular_keys[name] = key
+    for a, vec in enumerate(sol.null_vectors):
+        for name, e in vec.items():
+            exprs[("null", a, name)] = e
+    texts, definitions = shared_form(exprs)
+    multipliers = {
+        u.name: texts[("fixed", u.name)] if u.name in solved else UNDETERMINED for u in analysis.primary_multipliers
+    }
+    solution = {
+        "particular": {name: texts[key] for name, key in particular_keys.items()},
+        "null_vectors": [{name: texts[("null", a, name)] for name in vec} for a, vec in enumerate(sol.null_vectors)],
+        "free": [v.name for v in sol.free],
+    }
+    return multipliers, solution, definitions
+
+
 def to_text(analysis: AnalysisResult) -> str:
     """Readable report: the chain stage by stage with counts, classes, multipliers."""
     a = analysis
@@ -236,7 +278,10 @@ def to_text(analysis: AnalysisResult) -> str:
         lines.append(f"parameters (symbolic): {', '.join(p.name for p in a.parameters)}")
     lines.append(f"Hessian d2L/dq_dot2: rank {a.hessian_rank} of {len(a.lagrangian.coordinates)}")
     lines.append(f"canonical Hamiltonian H_c = {_short(a.canonical_hamiltonian)}")
-    if a.primary_multipliers:
+    general = not a.multiplier_solution.each_fixed_or_free
+    if general:
+        lines.append(_general_total_hamiltonian(a.multiplier_solution))
+    elif a.primary_multipliers:
         terms = " + ".join(f"{u}*({_short(phi, 80)})" for u, phi in zip(a.primary_multipliers, a.primary_constraints))
         lines.append(f"total Hamiltonian H_T = H_c + {terms}")
     else:
@@ -255,8 +300,12 @@ def to_text(analysis: AnalysisResult) -> str:
     for u in a.primary_multipliers:
         if u.name in a.multipliers:
             lines.append(f"  {u} = {_short(a.multipliers[u.name])}")
+        elif general:
+            lines.append(f"  {u}: not fixed alone (see the general solution)")
         else:
             lines.append(f"  {u}: undetermined (gauge freedom)")
+    if general:
+        lines.extend(_general_solution_lines(a.multiplier_solution))
     lines.append("")
     lines.append(f"first class: {len(a.first_class)}")
     for c in a.first_class:
@@ -312,7 +361,16 @@ def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
         title = "primary constraints" if k == 1 else f"stage {k}"
         rows.append(rf"&\text{{{title} ({len(stage)})}}")
         rows.extend(rf"&{lx(c)} = 0" for c in stage)
-    if a.primary_multipliers:
+    sol = a.multiplier_solution
+    if a.primary_multipliers and not sol.each_fixed_or_free:
+        free = ", ".join(lx(v) for v in sol.free)
+        rows.append(rf"&\text{{multipliers: general solution, }} {free} \text{{ free}}")
+        for u in a.primary_multipliers:
+            rows.append(rf"{lx(u)} &= {lx(sol.general[u.name])}")
+        for v, phi in zip(sol.free, sol.first_class_primary):
+            rows.append(rf"&\text{{first-class primary combination of }} {lx(v)}: {lx(phi)}")
+        rows.append(rf"H_T &= H_c + {lx(sol.total_hamiltonian - sol.canonical_hamiltonian)}")
+    elif a.primary_multipliers:
         rows.append(r"&\text{multipliers}")
         for u in a.primary_multipliers:
             if u.name in a.multipliers:
@@ -328,3 +386,29 @@ def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
     if display:
         return "$$\\begin{aligned}\n" + body + "\n\\end{aligned}$$"
     return "\\begin{align*}\n" + body + "\n\\end{align*}"
+
+
+def _general_total_hamiltonian(sol: MultiplierSolution) -> str:
+    """``H_T = H_c + U_k phi_k + v_a phi_a`` as one text line (the ``U_k = 0`` terms left out)."""
+    terms = [
+        f"({_short(sol.particular[u.name], 80)})*({_short(phi, 80)})"
+        for u, phi in zip(sol.multipliers, sol.primary)
+        if sol.particular[u.name] != 0
+    ]
+    terms += [f"{v}*({_short(phi, 80)})" for v, phi in zip(sol.free, sol.first_class_primary)]
+    free = ", ".join(v.name for v in sol.free)
+    return f"total Hamiltonian H_T = H_c + {' + '.join(terms) or '0'}   ({free} free: the general solution below)"
+
+
+def _general_solution_lines(sol: MultiplierSolution) -> list[str]:
+    """The general solution ``u = U + v_a V_a`` and the first-class primary combinations."""
+    names = [u.name for u in sol.multipliers]
+    free = " + ".join(f"{v}*V_{a}" for a, v in enumerate(sol.free, start=1))
+    lines = [f"general solution u = U + {free} ({', '.join(v.name for v in sol.free)} free):"]
+    lines.append("  particular solution U:")
+    lines.extend(f"    {name} = {_short(sol.particular[name])}" for name in names)
+    for a, (vec, phi) in enumerate(zip(sol.null_vectors, sol.first_class_primary), start=1):
+        components = ", ".join(_short(vec[name], 80) for name in names)
+        lines.append(f"  null vector V_{a} = ({components}) of ({', '.join(names)})")
+        lines.append(f"    first-class primary combination V_{a}.phi = {_short(phi)}")
+    return lines
