@@ -20,6 +20,7 @@ from dirac.analysis.dirac_bracket import DiracBracket
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.numeric import Numerics
+from dirac.analysis.regularity import regular_holonomic
 from dirac.analysis.report import to_json, to_latex, to_text
 from dirac.errors import AnalysisError, InputError
 from dirac.model.lagrangian import Lagrangian
@@ -58,7 +59,11 @@ class ConstraintAnalysis:
     multipliers
         ``u_k`` name -> solved expression, for those the algorithm determines.
     stages, constraints
-        The chain stage by stage (stage 1 = primary) and flat.
+        The chain stage by stage (stage 1 = primary) and flat: an independent set.
+    reducible_constraints
+        Constraints that hold on the surface but whose gradients depend on the kept ones
+        there (a reducible set such as ``J = x × p``, with ``x . J = 0``); empty for an
+        irreducible set.
     first_class, second_class
         The classes; ``physical_degrees_of_freedom = (2n - 2 #first - #second) / 2``.
     bracket_strategy
@@ -80,6 +85,7 @@ class ConstraintAnalysis:
                 progress(f"{message} ({now - clock[0]:.2f} s)")
                 clock[0] = now
 
+        lagrangian, regularised = regular_holonomic(lagrangian)
         self.lagrangian = lagrangian
         self.name = lagrangian.name
         rng = np.random.default_rng(seed)
@@ -111,6 +117,7 @@ class ConstraintAnalysis:
         self.total_hamiltonian = chain.total_hamiltonian
         self.stages = chain.stages
         self.constraints = chain.constraints
+        self.reducible_constraints = list(chain.reducible)
         self.multipliers = dict(chain.solved_multipliers)
         self.undetermined_multipliers = list(chain.undetermined)
         self._points = chain.points
@@ -147,6 +154,8 @@ class ConstraintAnalysis:
             "weak zeros, independence and ranks decided numerically at "
             f"{len(self._points)} random points of each constraint surface"
             + (" (symbolic parameters at generic random values)" if self.parameters else ""),
+            *regularised,
+            *chain.regularity_notes,
         ]
         self.seconds = time.perf_counter() - start
 
@@ -259,7 +268,7 @@ class ConstraintAnalysis:
         index = {s.name: i for i, s in enumerate(self.phase_space)}
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:
-            point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
+            point = numerics.surface_points(self.constraints + self.reducible_constraints, 1, fixed=fixed)[0]
         except AnalysisError:
             if fixed:
                 raise InputError(

@@ -34,6 +34,7 @@ from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.analysis.regularity import IRREGULAR_GRADIENT, ROUND_OFF, branches, normal_components, square_free_part
 from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]
@@ -60,7 +61,10 @@ class ConstraintChain:
 
     After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
     expression, only those the chain determines), ``undetermined`` (multiplier symbols
-    left free), ``points`` (points of the final surface) and ``notes``.
+    left free), ``points`` (regular points of the final surface), ``reducible`` (constraints
+    that hold but whose gradients depend on the kept ones on the regular part of the
+    surface, e.g. ``x . J = 0`` among ``J = x × p``; they still define the surface) and
+    ``notes`` (``regularity_notes``: regularised and reducible constraints, for the report).
     """
 
     phase_space: PhaseSpace
@@ -73,6 +77,8 @@ class ConstraintChain:
     undetermined: list[sympy.Symbol] = field(default_factory=list)
     points: list[np.ndarray] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    reducible: list[sympy.Expr] = field(default_factory=list)
+    regularity_notes: list[str] = field(default_factory=list)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -117,7 +123,7 @@ class ConstraintChain:
         self._row_cache: dict = {}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
         self.primary = primary
-        points = self.numerics.surface_points(primary, SAMPLE_POINTS) if primary else []
+        points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
         base_grads = self._independent(primary, [], points) if primary else []
         self.stages = [[primary[i] for i in base_grads]] if primary else []
         if primary and len(base_grads) < len(primary):
@@ -161,8 +167,10 @@ class ConstraintChain:
             if not chosen:
                 break
             self.stages.append([candidates[i] for i in chosen])
-            points = self.numerics.surface_points(self.constraints, SAMPLE_POINTS)
+            self._keep_reducible(candidates, chosen)
+            points = self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
         self.points = points
+        self.pivots = (pivots_rows, pivot_cols)
         self._solve_multipliers(points, pivots_rows, pivot_cols)
         return self
 
@@ -186,15 +194,99 @@ class ConstraintChain:
                 )
         if len(self.stages) >= limit:
             raise AnalysisError(f"the constraint chain did not terminate after {limit} stages")
+        candidates = [self._regularised(c) for c in candidates]
+        for c in candidates:
+            self._refuse_crossing(c, constraints)
         try:
-            new_points = self.numerics.surface_points(constraints + candidates, SAMPLE_POINTS)
+            new_points = self.numerics.surface_points(constraints + self.reducible + candidates, SAMPLE_POINTS, regular=len(constraints))
         except AnalysisError:
             shown = "; ".join(f"{c} = 0" for c in candidates[:4])
             raise InconsistentSystemError(
                 f"the stage-{len(self.stages) + 1} conditions {shown} have no real solution together with "
                 "the earlier constraints: the Lagrangian has no consistent motion"
             ) from None
-        return candidates, self._independent(candidates, constraints, new_points)
+        chosen = self._independent(candidates, constraints, new_points)
+        self._refuse_irregular(candidates, chosen, constraints, new_points)
+        return candidates, chosen
+
+    # ------------------------------------------------------------------ regularity
+    def _regularised(self, constraint: sympy.Expr) -> sympy.Expr:
+        """``f`` for a constraint ``f^k`` (``k > 1``): the same surface, with a gradient that does not vanish on it.
+
+        Henneaux–Teitelboim, Sect. 1.1.2 (regularity conditions) and Sect. 1.2.2 (Cawley's
+        ``z^2 = 0``, regular as ``z = 0``). The replacement is recorded in :attr:`notes`.
+        """
+        part = square_free_part(constraint, self.phase_space.variables)
+        if part is None:
+            return constraint
+        regular = tidy(part, self.phase_space.variables, sign=True)
+        self.regularity_notes.append(
+            f"stage {len(self.stages) + 1}: the constraint {constraint} = 0 is irregular (its gradient vanishes where it "
+            f"holds); it was replaced by its square-free part {regular} = 0, the same surface described regularly; "
+            "the classes and counts below refer to this regular form (with the irregular form, first-class "
+            "constraints need not all generate gauge transformations, as in Cawley's example)"
+        )
+        return regular
+
+    def _refuse_crossing(self, constraint: sympy.Expr, constraints: list[sympy.Expr]) -> None:
+        """Refuse a product ``f g = 0`` whose branches meet on the surface (no single regular surface there)."""
+        parts = branches(constraint, self.phase_space.variables)
+        if len(parts) < 2:
+            return
+        for i in range(len(parts)):
+            for j in range(i + 1, len(parts)):
+                try:
+                    self.numerics.surface_points(constraints + self.reducible + [parts[i], parts[j]], 1, attempts=8)
+                except AnalysisError:
+                    continue  # these branches do not meet: the product is regular where it holds
+                shown = " and ".join(f"{f} = 0" for f in parts)
+                raise AnalysisError(
+                    f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: it is the union of the "
+                    f"branches {shown}, which meet (where {parts[i]} = {parts[j]} = 0 its gradient vanishes), so there "
+                    f"is no single regular constraint surface; analyse the branches {shown} separately "
+                    "(one system each)"
+                )
+
+    def _refuse_irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> None:
+        """Refuse a new constraint whose gradient is numerically zero (normal to the old ones) on its surface.
+
+        Such a constraint restricts the surface (it is not weakly zero on the old one) but
+        its gradient vanishes where it holds, e.g. ``x^2 + y^2 = 0``: no regular form was
+        found for it (not a power of a polynomial), so the analysis cannot go on.
+        """
+        if not chosen:
+            return
+        n = len(self.phase_space.variables)
+        og = [g for c in old + self.reducible for g in self.phase_space.gradient(c)]
+        base = self.numerics.evaluate(og, points).reshape(len(points), -1, n) if og else np.zeros((len(points), 0, n))
+        for i in chosen:
+            grad = self.phase_space.gradient(candidates[i])
+            rows = self.numerics.evaluate(grad, points)
+            rough = [normal_components(rows[p : p + 1], base[p], np.ones(1) + np.max(np.abs(base[p]), initial=0.0))[0] for p in range(len(points))]
+            if max(rough) > 1e-2:  # clearly regular: skip the finer test
+                continue
+            scales = self.numerics.term_scale(grad, points).sum(axis=1) - (n - 1)  # 1 + sum of |terms| of the gradient
+            sizes = np.array([normal_components(rows[p : p + 1], base[p], scales[p : p + 1])[0] for p in range(len(points))])
+            if np.all(sizes < IRREGULAR_GRADIENT) and np.any(sizes > ROUND_OFF):
+                raise AnalysisError(
+                    f"the stage-{len(self.stages) + 1} constraint {candidates[i]} = 0 is irregular: its gradient vanishes "
+                    "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
+                    "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
+                    "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)"
+                )
+
+    def _keep_reducible(self, candidates: list[sympy.Expr], chosen: list[int]) -> None:
+        """Keep the new constraints left out as dependent: they still define the surface (reducible set)."""
+        dropped = [c for i, c in enumerate(candidates) if i not in chosen]
+        if not dropped:
+            return
+        self.reducible.extend(dropped)
+        self.regularity_notes.append(
+            f"stage {len(self.stages)}: the constraints {', '.join(str(c) for c in candidates)} are reducible: on the "
+            f"regular part of their surface {', '.join(str(c) for c in dropped)} depend(s) on the others "
+            f"(independent set kept: {', '.join(str(candidates[i]) for i in chosen)}); the dependent ones still "
+            "define the surface and every sample point satisfies them"
+        )
 
     def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> list[int]:
         """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by."""
