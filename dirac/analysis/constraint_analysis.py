@@ -19,9 +19,10 @@ from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
-from dirac.analysis.numeric import Numerics
+from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.regularity import regular_holonomic
 from dirac.analysis.report import to_json, to_latex, to_text
+from dirac.analysis.special_values import RankUse, SpecialValue, special_parameter_values
 from dirac.errors import AnalysisError, InputError
 from dirac.model.lagrangian import Lagrangian
 
@@ -157,7 +158,32 @@ class ConstraintAnalysis:
             *regularised,
             *chain.regularity_notes,
         ]
+        self.special_parameter_values: list[SpecialValue] = []
+        if self.parameters:
+            self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
+            self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
+
+    def _special_values(self, chain: ConstraintChain, C: sympy.Matrix, second: list[int], seed: int) -> tuple[list[SpecialValue], list[str]]:
+        """Parameter values where the rank of the Hessian, of ``A_PQ`` or of ``C`` drops (:mod:`dirac.analysis.special_values`)."""
+        space = self._space
+        uses = []
+        W = self.hessian
+        if self.hessian_rank and W.free_symbols & set(self.parameters):
+            points = [self._numerics.random_point() for _ in range(3)]
+            values = self._numerics.evaluate(list(W), points).reshape(len(points), *W.shape)
+            S = independent_rows(list(values), list(range(W.shape[0])))
+            uses.append(RankUse("Hessian", W[S, S], W, len(S), on_surface=False))
+        P, Q = chain.pivots
+        if P:
+            A = sympy.Matrix([[chain._rows(c)[1][k] for k in range(len(chain.primary))] for c in self.constraints])
+            uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True))
+        if second:
+            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True))
+        everything = self.constraints + self.reducible_constraints
+        return special_parameter_values(
+            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed
+        )
 
     # ------------------------------------------------------------------ brackets
     def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:

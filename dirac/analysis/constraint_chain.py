@@ -32,7 +32,7 @@ import sympy
 
 from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
-from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
+from dirac.analysis.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.regularity import IRREGULAR_GRADIENT, ROUND_OFF, branches, normal_components, square_free_part
 from dirac.errors import AnalysisError, InconsistentSystemError
@@ -179,6 +179,9 @@ class ConstraintChain:
         if not candidates:
             return []
         keep = ~self.numerics.weakly_zero(candidates, points)
+        for c, k in zip(candidates, keep):
+            if k:  # a product as written: its branches must not meet (read before expanding)
+                self._refuse_crossing(c, self.constraints)
         return [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
 
     def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
@@ -194,31 +197,51 @@ class ConstraintChain:
                 )
         if len(self.stages) >= limit:
             raise AnalysisError(f"the constraint chain did not terminate after {limit} stages")
-        candidates = [self._regularised(c) for c in candidates]
-        for c in candidates:
-            self._refuse_crossing(c, constraints)
+        for _ in range(2):
+            new_points = self._new_points(constraints, candidates)
+            chosen = self._independent(candidates, constraints, new_points)
+            irregular = self._irregular(candidates, chosen, constraints, new_points)
+            if not irregular:
+                return candidates, chosen
+            candidates = [self._regularised(c) if i in irregular else c for i, c in enumerate(candidates)]
+        raise AnalysisError("the constraint chain could not regularise its new constraints")  # pragma: no cover
+
+    def _new_points(self, constraints: list[sympy.Expr], candidates: list[sympy.Expr]) -> list[np.ndarray]:
+        """Regular points of the old surface on which the candidates vanish too."""
         try:
-            new_points = self.numerics.surface_points(constraints + self.reducible + candidates, SAMPLE_POINTS, regular=len(constraints))
+            return self.numerics.surface_points(constraints + self.reducible + candidates, SAMPLE_POINTS, regular=len(constraints))
+        except SingularSurface:
+            raise
         except AnalysisError:
             shown = "; ".join(f"{c} = 0" for c in candidates[:4])
             raise InconsistentSystemError(
                 f"the stage-{len(self.stages) + 1} conditions {shown} have no real solution together with "
                 "the earlier constraints: the Lagrangian has no consistent motion"
             ) from None
-        chosen = self._independent(candidates, constraints, new_points)
-        self._refuse_irregular(candidates, chosen, constraints, new_points)
-        return candidates, chosen
 
     # ------------------------------------------------------------------ regularity
     def _regularised(self, constraint: sympy.Expr) -> sympy.Expr:
         """``f`` for a constraint ``f^k`` (``k > 1``): the same surface, with a gradient that does not vanish on it.
 
         Henneaux–Teitelboim, Sect. 1.1.2 (regularity conditions) and Sect. 1.2.2 (Cawley's
-        ``z^2 = 0``, regular as ``z = 0``). The replacement is recorded in :attr:`notes`.
+        ``z^2 = 0``, regular as ``z = 0``). The replacement is recorded in
+        :attr:`regularity_notes`. Called for a constraint found irregular at surface points.
+
+        Raises
+        ------
+        AnalysisError
+            When the constraint has no repeated factor (e.g. ``x^2 + y^2 = 0``): no
+            regular form is known, the analysis is refused.
         """
         part = square_free_part(constraint, self.phase_space.variables)
         if part is None:
-            return constraint
+            raise AnalysisError(
+                f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: its gradient vanishes "
+                "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
+                "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
+                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)"
+            )
+        self._refuse_crossing(part, self.constraints)
         regular = tidy(part, self.phase_space.variables, sign=True)
         self.regularity_notes.append(
             f"stage {len(self.stages) + 1}: the constraint {constraint} = 0 is irregular (its gradient vanishes where it "
@@ -247,33 +270,32 @@ class ConstraintChain:
                     "(one system each)"
                 )
 
-    def _refuse_irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> None:
-        """Refuse a new constraint whose gradient is numerically zero (normal to the old ones) on its surface.
+    def _irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
+        """New constraints whose gradient is numerically zero where they hold (normal to the others' gradients).
 
-        Such a constraint restricts the surface (it is not weakly zero on the old one) but
-        its gradient vanishes where it holds, e.g. ``x^2 + y^2 = 0``: no regular form was
-        found for it (not a power of a polynomial), so the analysis cannot go on.
+        A kept constraint is compared with the old ones, a dropped one with the old and the
+        kept ones. A component below ``IRREGULAR_GRADIENT`` (relative to the size of the
+        gradient's terms) at every point, yet above round-off, marks a gradient that
+        vanishes on the surface: ``f^2 = 0`` or ``x^2 + y^2 = 0``.
         """
-        if not chosen:
-            return
         n = len(self.phase_space.variables)
-        og = [g for c in old + self.reducible for g in self.phase_space.gradient(c)]
-        base = self.numerics.evaluate(og, points).reshape(len(points), -1, n) if og else np.zeros((len(points), 0, n))
-        for i in chosen:
-            grad = self.phase_space.gradient(candidates[i])
+        everything = old + self.reducible + [candidates[i] for i in chosen]
+        grads = [g for c in everything for g in self.phase_space.gradient(c)]
+        stacked = self.numerics.evaluate(grads, points).reshape(len(points), len(everything), n)
+        n_old = len(old) + len(self.reducible)
+        found = []
+        for i, c in enumerate(candidates):
+            grad = self.phase_space.gradient(c)
             rows = self.numerics.evaluate(grad, points)
+            base = stacked[:, :n_old] if i in chosen else stacked
             rough = [normal_components(rows[p : p + 1], base[p], np.ones(1) + np.max(np.abs(base[p]), initial=0.0))[0] for p in range(len(points))]
             if max(rough) > 1e-2:  # clearly regular: skip the finer test
                 continue
             scales = self.numerics.term_scale(grad, points).sum(axis=1) - (n - 1)  # 1 + sum of |terms| of the gradient
             sizes = np.array([normal_components(rows[p : p + 1], base[p], scales[p : p + 1])[0] for p in range(len(points))])
             if np.all(sizes < IRREGULAR_GRADIENT) and np.any(sizes > ROUND_OFF):
-                raise AnalysisError(
-                    f"the stage-{len(self.stages) + 1} constraint {candidates[i]} = 0 is irregular: its gradient vanishes "
-                    "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
-                    "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
-                    "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)"
-                )
+                found.append(i)
+        return found
 
     def _keep_reducible(self, candidates: list[sympy.Expr], chosen: list[int]) -> None:
         """Keep the new constraints left out as dependent: they still define the surface (reducible set)."""

@@ -23,7 +23,7 @@ from dirac.analysis.phase_space import PhaseSpace
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
-__all__ = ["Numerics", "numeric_rank", "independent_rows"]
+__all__ = ["Numerics", "SingularSurface", "numeric_rank", "independent_rows"]
 
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
@@ -31,6 +31,10 @@ ZERO_TOLERANCE = 1e-8
 SURFACE_TOLERANCE = 1e-11
 #: smallest singular value of the row-normalised constraint Jacobian at a regular point
 REGULAR_TOLERANCE = 1e-6
+
+
+class SingularSurface(AnalysisError):
+    """Points of a constraint surface were found, but none is regular (irregular constraints)."""
 
 
 def numeric_rank(matrix: np.ndarray, tol: float = 1e-8) -> int:
@@ -278,7 +282,7 @@ class Numerics:
         if len(points) < count:
             names = "; ".join(str(c) for c in constraints[:6])
             if singular:
-                raise AnalysisError(
+                raise SingularSurface(
                     f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
                     f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
                     "(irregular constraints); write the surface with constraints whose gradients are independent on it"

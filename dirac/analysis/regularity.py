@@ -13,6 +13,10 @@ The Dirac–Bergmann algorithm assumes *regular* constraints: on the surface
   at the crossing the gradient ``f dg + g df`` vanishes, and no single regular surface
   contains both branches (:func:`branches`); each branch is a system of its own.
 
+Square-free parts are computed only for constraints found irregular at surface points
+(and for the holonomic constraints of the Lagrangian), since multivariate gcds cost more
+than the analysis on large constraints.
+
 Whether branches meet, and whether a gradient is numerically zero on a surface, is
 decided at surface points (:mod:`dirac.analysis.numeric`).
 """
@@ -32,6 +36,8 @@ __all__ = ["square_free_part", "branches", "regular_holonomic", "normal_componen
 #: polynomials with more terms than this are not factored (the cost grows fast); their
 #: regularity is still checked numerically at surface points
 MAX_FACTOR_TERMS = 60
+
+
 
 #: a new constraint whose gradient, relative to the size of the gradient's terms, has a
 #: component normal to the earlier constraints' gradients below this at every surface
@@ -77,25 +83,25 @@ def square_free_part(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sym
         return None
     if all(k == 1 for _, k in factors):
         return None
-    out = sympy.Mul(*[f.as_expr() for f, _ in factors if f.total_degree() > 0])
-    return sympy.expand(out)
+    return sympy.Mul(*[f.as_expr() for f, _ in factors if f.total_degree() > 0])
 
 
 def branches(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
-    """Distinct factors of a polynomial constraint that depend on the phase-space ``variables``.
+    """Distinct factors of a constraint written as a product, that depend on the phase-space ``variables``.
 
-    One element (the constraint itself) for an irreducible or non-polynomial constraint;
-    more for a product ``f g ...``, whose zero set is the union of the branches ``f = 0``,
-    ``g = 0``, ...
+    One element (the constraint itself) unless ``expr`` is a product ``f g ...`` (powers
+    counted once) of at least two factors in the variables; its zero set is then the union
+    of the branches ``f = 0``, ``g = 0``, ... Only the written product structure is read
+    (multivariate factorisation of every constraint would cost more than the analysis);
+    a product hidden by expansion is caught by the regular-point and rank checks instead.
     """
-    poly = _polynomial(expr, variables)
-    if poly is None:
+    if not isinstance(expr, sympy.Mul):
         return [expr]
-    try:
-        _, factors = sympy.factor_list(poly.as_expr(), *poly.gens)
-    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
-        return [expr]
-    found = [f for f, _ in factors if f.free_symbols & set(variables)]
+    found: list[sympy.Expr] = []
+    for arg in expr.args:
+        base = arg.base if isinstance(arg, sympy.Pow) and arg.exp.is_Integer and arg.exp > 0 else arg
+        if base.free_symbols & set(variables) and base not in found:
+            found.append(base)
     return found if len(found) > 1 else [expr]
 
 
@@ -126,19 +132,27 @@ def normal_components(rows: np.ndarray, base: np.ndarray, scales: np.ndarray) ->
     return np.linalg.norm(normal, axis=1) / scales
 
 
+def _written_power(expr: sympy.Expr) -> bool:
+    """Whether ``expr`` is written as a power ``f**k`` (``k > 1``) or a product containing one."""
+    parts = expr.args if isinstance(expr, sympy.Mul) else (expr,)
+    return any(isinstance(a, sympy.Pow) and a.exp.is_Integer and a.exp > 1 and a.base.free_symbols for a in parts)
+
+
 def regular_holonomic(lagrangian: Lagrangian) -> tuple[Lagrangian, list[str]]:
     """The Lagrangian with each holonomic constraint ``chi = f^k`` (``k > 1``) replaced by ``f``.
 
     In ``L_ext = L - lambda chi`` (the paper's (1)) the constraint force is ``lambda dchi``;
     for ``chi = f^2`` it vanishes on the surface, so the multiplier cannot hold the motion
-    there (the chain ends in a contradiction). The user means the surface ``f = 0``: the
+    there (the chain ends in a contradiction). Constraints written as such a power are
+    read (an expanded square is found irregular by the chain and refused there). The user
+    means the surface ``f = 0``: the
     square-free part describes it regularly (Henneaux–Teitelboim, Sect. 1.1.2). Returns the
     new Lagrangian (the same one if nothing changed) and one note per replacement.
     """
     notes: list[str] = []
     new: list[sympy.Expr] = []
     for k, chi in enumerate(lagrangian.constraints, start=1):
-        part = square_free_part(chi, lagrangian.coordinates)
+        part = square_free_part(chi, lagrangian.coordinates) if _written_power(chi) else None
         if part is None:
             new.append(chi)
             continue
