@@ -23,7 +23,7 @@ from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.regularity import regular_holonomic
 from dirac.analysis.report import to_json, to_latex, to_text
 from dirac.analysis.special_values import RankUse, SpecialValue, special_parameter_values
-from dirac.errors import AnalysisError, InputError
+from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["ConstraintAnalysis", "analyze"]
@@ -350,8 +350,15 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     InconsistentSystemError
         If the consistency conditions demand something like ``1 = 0``.
     AnalysisError
-        If the Lagrangian is not quadratic in the velocities, or the chain cannot be
-        carried out.
+        If the Lagrangian is not quadratic in the velocities, the chain cannot be
+        carried out, or a constraint is irregular with no regular form (branches that
+        cross, a gradient that vanishes where the constraint holds).
+
+    Warns
+    -----
+    DiracWarning
+        When a parameter's value in the system lies on a special parameter value: the
+        analysis is then at that value (see :func:`at_given_values`).
 
     Examples
     --------
@@ -362,4 +369,42 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     """
     if not isinstance(lagrangian, Lagrangian):
         raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
-    return ConstraintAnalysis(lagrangian, progress=progress)
+    return at_given_values(ConstraintAnalysis(lagrangian, progress=progress), progress)
+
+
+def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
+    """The analysis at the parameter values written in the system, when they are special.
+
+    The analysis is symbolic in its parameters (generic structure). When the value a
+    parameter has in the system (its default: the system file, or ``--param``) lies on a
+    special parameter value (:mod:`dirac.analysis.special_values`), the structure there
+    differs from the generic one: the analysis is done again with those parameters fixed
+    to their values (what the user wrote), with a note and a :class:`~dirac.errors.DiracWarning`
+    saying that generic values give another structure.
+    """
+    values = {p.name: v for p, v in analysis.lagrangian.parameters.items()}
+    hits = [s for s in analysis.special_parameter_values if s.holds_at(values)]
+    if not hits:
+        return analysis
+    names = {h.parameter for h in hits} | {sym.name for h in hits for sym in h.value.free_symbols}
+    given = {n: v for n in sorted(names) if (v := values.get(n)) is not None}
+    fixed = analysis.lagrangian.fix(**given)
+    at = ConstraintAnalysis(fixed, progress=progress)
+    shown = ", ".join(f"{h.parameter} = {h.value}" for h in hits)
+    generic = (
+        f"{len(analysis.first_class)} first class, {len(analysis.second_class)} second class, "
+        f"physical degrees of freedom {analysis.physical_degrees_of_freedom}"
+    )
+    here = (
+        f"{len(at.first_class)} first class, {len(at.second_class)} second class, "
+        f"physical degrees of freedom {at.physical_degrees_of_freedom}"
+    )
+    message = (
+        f"{shown}, the value given for {analysis.name!r}, is a special parameter value "
+        f"({'; '.join(h.where for h in hits)}): the analysis is at that value ({here}); for generic values "
+        f"the structure differs ({generic})"
+    )
+    at.notes.append(message)
+    at.special_parameter_values = analysis.special_parameter_values
+    warn(message)
+    return at

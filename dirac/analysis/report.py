@@ -57,6 +57,10 @@ class AnalysisResult(Protocol):
     def bracket_strategy(self) -> str: ...
     @property
     def notes(self) -> Sequence[str]: ...
+    @property
+    def reducible_constraints(self) -> Sequence[sympy.Expr]: ...
+    @property
+    def special_parameter_values(self) -> Sequence[Any]: ...
 
 #: longest expression printed in full in the text report
 TEXT_LIMIT = 400
@@ -141,7 +145,9 @@ def to_json(analysis: AnalysisResult) -> dict:
 
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
-    ``bracket_strategy``, ``notes``; ``multiplier_subexpressions`` (name -> text) when a
+    ``bracket_strategy``, ``notes``, ``reducible_constraints`` (constraints that hold but
+    depend on the kept independent set), ``special_parameter_values`` (list of
+    ``{"parameter", "value", "where"}``); ``multiplier_subexpressions`` (name -> text) when a
     multiplier is too large to print as one tree: its text then uses those names
     (see :func:`shared_form`).
     """
@@ -165,6 +171,8 @@ def to_json(analysis: AnalysisResult) -> dict:
         "hessian_rank": analysis.hessian_rank,
         "bracket_strategy": analysis.bracket_strategy,
         "notes": list(analysis.notes),
+        "reducible_constraints": [expression_text(c) for c in analysis.reducible_constraints],
+        "special_parameter_values": [s.to_json() for s in analysis.special_parameter_values],
     }
     if definitions:
         out["multiplier_subexpressions"] = definitions
@@ -223,7 +231,14 @@ def to_text(analysis: AnalysisResult) -> str:
         f"physical degrees of freedom: ({2 * n} - 2*{len(a.first_class)} - {len(a.second_class)})/2 = "
         f"{a.physical_degrees_of_freedom}"
     )
+    if a.reducible_constraints:
+        lines.append(
+            f"reducible: {len(a.reducible_constraints)} more constraint(s) hold but depend on the independent set above: "
+            + ", ".join(_short(c, 80) for c in a.reducible_constraints)
+        )
     lines.append(f"Dirac bracket: {a.bracket_strategy}")
+    for s in a.special_parameter_values:
+        lines.append(f"special parameter value: {s.parameter} = {s.value} ({s.where})")
     for note in a.notes:
         lines.append(f"note: {note}")
     return "\n".join(lines)
