@@ -41,6 +41,11 @@ def numeric_rank(matrix: np.ndarray, tol: float = 1e-8) -> int:
     """Rank of ``matrix`` by SVD, with a singular-value cut relative to the largest one."""
     if matrix.size == 0:
         return 0
+    if not np.all(np.isfinite(matrix)):
+        raise AnalysisError(
+            "a rank was needed where the expressions are not finite (a denominator vanishes at a sample "
+            "point of the constraint surface): the analysis cannot decide it there"
+        )
     s = np.linalg.svd(matrix, compute_uv=False)
     if s[0] == 0 or not np.isfinite(s[0]):
         return 0
@@ -73,7 +78,7 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
             if base is not None and len(base[k]):
                 stack.insert(0, base[k])
             current = np.vstack(stack) if stack else np.zeros((0, m.shape[1]))
-            scale = np.max(np.abs(m)) if m.size else 1.0
+            scale = (np.max(np.abs(m)) if m.size else 0.0) or 1.0  # an all-zero matrix: no row raises the rank
             before = numeric_rank(current / scale) if len(current) else 0
             after = numeric_rank(np.vstack([current, m[row : row + 1]]) / scale)
             votes += after > before
