@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy
+from sympy.polys.matrices import DomainMatrix
 
 from dirac.analysis.numeric import Numerics, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
@@ -87,6 +88,19 @@ class RankUse:
     on_surface: bool
 
 
+def _numerator_of_determinant(block: sympy.Matrix) -> sympy.Expr:
+    """Numerator of ``det block`` for a block whose entries are rational functions of the parameters.
+
+    Computed over the field of rational functions (sympy's ``DomainMatrix``), much faster
+    than a sympy determinant followed by ``together``.
+    """
+    try:
+        matrix = DomainMatrix.from_Matrix(block).to_field()
+        return sympy.fraction(matrix.domain.to_sympy(matrix.det()))[0]  # reduced in the field already
+    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, ValueError, TypeError):
+        return sympy.fraction(sympy.together(block.det(method="berkowitz")))[0]
+
+
 def _candidates(block: sympy.Matrix, variables: Sequence[sympy.Symbol], parameters: Sequence[sympy.Symbol], rng: np.random.Generator) -> list[tuple[sympy.Symbol, sympy.Expr]]:
     """Zeros of the parameter-only factors of ``det block`` (the content of its numerator in ``variables``).
 
@@ -98,8 +112,7 @@ def _candidates(block: sympy.Matrix, variables: Sequence[sympy.Symbol], paramete
     numerators = []
     for _ in range(2 if present else 1):
         point = {v: sympy.Rational(int(rng.integers(1, 89)), int(rng.integers(1, 11))) for v in present}
-        det = sympy.together(block.xreplace(point).det(method="berkowitz"))
-        numerators.append(sympy.fraction(det)[0])
+        numerators.append(_numerator_of_determinant(block.xreplace(point)))
     content = numerators[0] if len(numerators) == 1 else sympy.gcd(numerators[0], numerators[1])
     params = set(parameters)
     found: list[tuple[sympy.Symbol, sympy.Expr]] = []

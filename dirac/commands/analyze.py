@@ -13,7 +13,7 @@ import math
 import sys
 from collections.abc import Callable
 
-from dirac.errors import InputError
+from dirac.errors import DiracError, InputError
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -92,7 +92,10 @@ def _at_special(system: str, params: dict[str, float], report: Callable[[str], N
     if not set(params) <= set(free.parameter_values):
         return None
     generic = dataclasses.replace(free, parameters={p: params.get(p.name, v) for p, v in free.parameters.items()})
-    analysis = analyze(generic, progress=report)
+    try:
+        analysis = analyze(generic, progress=report)
+    except DiracError:  # no generic analysis: the analysis at the given values decides alone
+        return None
     return analysis if analysis.lagrangian.fixed_values else None
 
 
