@@ -69,8 +69,12 @@ class ConstraintAnalysis:
         The classes; ``physical_degrees_of_freedom = (2n - 2 #first - #second) / 2``.
     bracket_strategy
         How Dirac brackets are computed ("symbolic", "block" or "numeric", and why).
+    special_parameter_values
+        :class:`~dirac.analysis.special_values.SpecialValue` list: parameter values at
+        which a rank the analysis used drops (:mod:`dirac.analysis.special_values`).
     notes
-        How the decisions were made (for the report).
+        How the decisions were made (for the report), including regularised and
+        reducible constraints.
     """
 
     def __init__(
