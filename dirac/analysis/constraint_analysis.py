@@ -22,7 +22,7 @@ from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.regularity import regular_holonomic
 from dirac.analysis.report import to_json, to_latex, to_text
-from dirac.analysis.special_values import RankUse, SpecialValue, special_parameter_values
+from dirac.analysis.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
 from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
 
@@ -172,22 +172,40 @@ class ConstraintAnalysis:
         """Parameter values where the rank of the Hessian, of ``A_PQ`` or of ``C`` drops (:mod:`dirac.analysis.special_values`)."""
         space = self._space
         uses = []
+        large: list[str] = []
+        params = set(self.parameters)
         W = self.hessian
-        if self.hessian_rank and W.free_symbols & set(self.parameters):
-            points = [self._numerics.random_point() for _ in range(3)]
-            values = self._numerics.evaluate(list(W), points).reshape(len(points), *W.shape)
-            S = independent_rows(list(values), list(range(W.shape[0])))
-            uses.append(RankUse("Hessian", W[S, S], W, len(S), on_surface=False))
         P, Q = chain.pivots
-        if P:
-            A = sympy.Matrix([[chain._rows(c)[1][k] for k in range(len(chain.primary))] for c in self.constraints])
-            uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True))
-        if second:
-            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True))
+        small = 0 < len(P) <= MAX_BLOCK
+        A = sympy.Matrix([[chain._rows(c)[1][k] for k in range(len(chain.primary))] for c in self.constraints]) if small else None
+        for label, size, block in (
+            ("Hessian", self.hessian_rank, W),
+            ("consistency matrix {Phi_a, phi_k}", len(P), A[P, Q] if A is not None else None),
+            ("bracket matrix C", len(second), C[second, second] if 0 < len(second) <= MAX_BLOCK else None),
+        ):
+            if not size:
+                continue
+            if size > MAX_BLOCK:
+                large.append(f"{label} ({size}x{size})")
+                continue
+            if block is None or not block.free_symbols & params:
+                continue
+            if label == "Hessian":
+                points = [self._numerics.random_point() for _ in range(3)]
+                values = self._numerics.evaluate(list(W), points).reshape(len(points), *W.shape)
+                S = independent_rows(list(values), list(range(W.shape[0])))
+                uses.append(RankUse(label, W[S, S], W, len(S), on_surface=False))
+            elif A is not None and label.startswith("consistency"):
+                uses.append(RankUse(label, A[P, Q], A, len(P), on_surface=True))
+            else:
+                uses.append(RankUse(label, C[second, second], C, len(second), on_surface=True))
+        notes = [
+            f"special parameter values: not searched in the {', '.join(large)}: blocks larger than "
+            f"{MAX_BLOCK}x{MAX_BLOCK} are too large for a symbolic determinant"
+        ] if large else []
         everything = self.constraints + self.reducible_constraints
-        return special_parameter_values(
-            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed
-        )
+        found, _ = special_parameter_values(space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed)
+        return found, notes
 
     # ------------------------------------------------------------------ brackets
     def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:
