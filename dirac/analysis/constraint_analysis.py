@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 import sympy
 
+from dirac.analysis.algebra import tidy
 from dirac.analysis.classification import bracket_matrix, classify
 from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
@@ -112,6 +113,9 @@ class ConstraintAnalysis:
         self.primary_multipliers = tuple(sympy.Symbol(f"u_{k + 1}", real=True) for k in range(K))
         self._numerics = Numerics(space, self._generic, seed=seed)
         chain = ConstraintChain(space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers)
+        chain.written = {
+            tidy(chi, space.variables, sign=True): chi for chi in lagrangian.constraints if isinstance(chi, sympy.Mul)
+        }
         chain.run()
         self._chain = chain
         done(

@@ -65,6 +65,8 @@ class ConstraintChain:
     that hold but whose gradients depend on the kept ones on the regular part of the
     surface, e.g. ``x . J = 0`` among ``J = x × p``; they still define the surface) and
     ``notes`` (``regularity_notes``: regularised and reducible constraints, for the report).
+    ``written`` maps the expanded form (as :func:`tidy` gives it) of a constraint the
+    user wrote as a product to that product, so that its branches are checked.
     """
 
     phase_space: PhaseSpace
@@ -79,6 +81,7 @@ class ConstraintChain:
     notes: list[str] = field(default_factory=list)
     reducible: list[sympy.Expr] = field(default_factory=list)
     regularity_notes: list[str] = field(default_factory=list)
+    written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -182,7 +185,11 @@ class ConstraintChain:
         for c, k in zip(candidates, keep):
             if k:  # a product as written: its branches must not meet (read before expanding)
                 self._refuse_crossing(c, self.constraints)
-        return [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+        kept = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+        for c in kept:  # a holonomic constraint written as a product, met in expanded form
+            if c in self.written:
+                self._refuse_crossing(self.written[c], self.constraints)
+        return kept
 
     def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
         """Check new conditions for inconsistency and keep the independent ones (indices into ``candidates``)."""

@@ -135,3 +135,12 @@ def test_sample_points_are_regular():
     for z in a._points:
         J = a._numerics.evaluate(grads, [z]).reshape(len(a.constraints), n)
         assert np.linalg.matrix_rank(J) == len(a.constraints)
+
+
+def test_squared_factor_of_a_crossing_product_is_refused():
+    """``(x - 1)^2 (y - 2) = 0``: the square-free part ``(x - 1)(y - 2)`` is the union of the lines
+    ``x = 1`` and ``y = 2``, which cross at ``(1, 2)`` where its gradient ``(y - 2, x - 1)``
+    vanishes: after regularisation it is still refused, naming both branches."""
+    L = dirac.Lagrangian.from_strings("corner", ["x", "y"], "(x_dot**2 + y_dot**2)/2 - y", ["(x - 1)**2*(y - 2)"])
+    with pytest.raises(AnalysisError, match=r"branches x - 1 = 0 and y - 2 = 0"):
+        dirac.analyze(L)
