@@ -21,6 +21,15 @@ and the stages follow the paper's order for (228) — ``pi -> R^T R - 1`` first,
 that follow from the earlier ones (gradient dependent on the new surface) are dropped; a
 condition free of phase-space variables (``1 = 0``) is an inconsistency. The chain stops
 when a stage adds nothing; the last system then fixes the determined multipliers.
+
+Regularity (Henneaux–Teitelboim, Sect. 1.1.2): every sample point is a regular point of
+the surface found so far (independent gradients of the kept constraints, checked). A
+new constraint whose gradient vanishes where it holds is replaced by its square-free
+part (Cawley's ``z^2 = 0`` -> ``z = 0``, with a note) or refused; a product whose
+branches cross is refused. New constraints whose gradients depend on the others on the
+regular part of the surface (a reducible set, ``x . J = 0`` for ``J = x × p``) are kept
+in :attr:`ConstraintChain.reducible`: they do not enter the classification but still
+define the surface on which points are sampled.
 """
 
 from __future__ import annotations

@@ -7,8 +7,11 @@ numerically at several random points of that surface (probabilistic identity tes
 an expression that vanishes at independent random points of an irreducible surface
 vanishes on it, up to an event of probability zero. Points are found by Gauss–Newton
 projection (minimum-norm steps) of random points, with compiled residuals and
-Jacobians. Parameters that are still symbolic take generic random values for these
-decisions, so the answers hold for generic parameters.
+Jacobians; with ``regular=k`` only regular points are kept (the first ``k``
+constraints' gradients independent there), so that no rank is read at a crossing or
+another singular point. Parameters that are still symbolic take generic random values
+for these decisions, so the answers hold for generic parameters (the values where
+they do not are found by :mod:`dirac.analysis.special_values`).
 """
 
 from __future__ import annotations
