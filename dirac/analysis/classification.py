@@ -2,7 +2,8 @@
 
 A constraint is first class when its bracket with every constraint vanishes weakly;
 the rank of ``C`` on the surface counts the second-class constraints (docs/conventions.md,
-the matrix Δ of (240)-(245)). When ``C`` is singular but no single constraint is first
+the matrix Δ of (240)-(245)). The rank is decided at regular surface points, which must
+all agree: a disagreement is refused, never resolved by taking the largest. When ``C`` is singular but no single constraint is first
 class, first-class *combinations* ``F_a = Phi_a + k_s Phi_s`` are built, with ``k``
 solving ``C_SS^T k = -C_aS^T`` for a set ``S`` of constraints whose principal block
 ``C_SS`` is invertible (for an antisymmetric matrix the rows of a row basis give such a
@@ -19,6 +20,7 @@ import sympy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.errors import AnalysisError
 
 __all__ = ["Classification", "classify", "bracket_matrix"]
 
@@ -72,11 +74,23 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
     tiny = np.all(np.abs(values) <= 1e-9 * scale, axis=0)
     alone_first = [a for a in range(m) if np.all(tiny[a])]
     rest = [a for a in range(m) if a not in alone_first]
-    rank = max(numeric_rank(v) for v in values)
+    ranks = [numeric_rank(v) for v in values]
+    if len(set(ranks)) > 1:
+        raise AnalysisError(
+            f"the rank of the bracket matrix C_ab = {{Phi_a, Phi_b}} differs between regular points of the constraint "
+            f"surface ({', '.join(map(str, ranks))}): the first/second-class split is not the same everywhere on it "
+            "(parts of different structure); analyse each part as a system of its own"
+        )
+    rank = ranks[0] if ranks else 0
     if not rest:
         return Classification(list(constraints), [], [], 0, 0)
     S = independent_rows([v[np.ix_(rest, rest)] for v in values], list(range(len(rest))))
     S = [rest[i] for i in S]
+    if len(S) != rank:
+        raise AnalysisError(
+            f"the second-class block found ({len(S)} constraints) does not match the rank {rank} of C_ab = "
+            "{Phi_a, Phi_b} on the surface: the classification cannot be decided consistently"
+        )
     first = [constraints[a] for a in alone_first]
     combos = 0
     for a in rest:

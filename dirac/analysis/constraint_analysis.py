@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 import sympy
 
+from dirac.analysis.algebra import tidy
 from dirac.analysis.classification import bracket_matrix, classify
 from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
@@ -22,10 +23,12 @@ from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure, gaug
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.multiplier_solution import MultiplierSolution, unsolved_multipliers
-from dirac.analysis.numeric import Numerics
+from dirac.analysis.numeric import Numerics, independent_rows
+from dirac.analysis.regularity import regular_holonomic
 from dirac.analysis.report import to_json, to_latex, to_text
+from dirac.analysis.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
 from dirac.analysis.vector_field import VectorField, vector_field
-from dirac.errors import AnalysisError, InputError
+from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["ConstraintAnalysis", "analyze"]
@@ -70,7 +73,11 @@ class ConstraintAnalysis:
         expression), the free ``.free`` (``v_1, ...``), the first-class combinations
         ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``.
     stages, constraints
-        The chain stage by stage (stage 1 = primary) and flat.
+        The chain stage by stage (stage 1 = primary) and flat: an independent set.
+    reducible_constraints
+        Constraints that hold on the surface but whose gradients depend on the kept ones
+        there (a reducible set such as ``J = x × p``, with ``x . J = 0``); empty for an
+        irreducible set.
     first_class, second_class
         The classes; ``physical_degrees_of_freedom = (2n - 2 #first - #second) / 2``.
     time
@@ -79,8 +86,12 @@ class ConstraintAnalysis:
         ``t``), else ``None``.
     bracket_strategy
         How Dirac brackets are computed ("symbolic", "block" or "numeric", and why).
+    special_parameter_values
+        :class:`~dirac.analysis.special_values.SpecialValue` list: parameter values at
+        which a rank the analysis used drops (:mod:`dirac.analysis.special_values`).
     notes
-        How the decisions were made (for the report).
+        How the decisions were made (for the report), including regularised and
+        reducible constraints.
     """
 
     def __init__(
@@ -96,6 +107,7 @@ class ConstraintAnalysis:
                 progress(f"{message} ({now - clock[0]:.2f} s)")
                 clock[0] = now
 
+        lagrangian, regularised = regular_holonomic(lagrangian)
         self.lagrangian = lagrangian
         self.name = lagrangian.name
         rng = np.random.default_rng(seed)
@@ -120,6 +132,9 @@ class ConstraintAnalysis:
         chain = ConstraintChain(
             space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
         )
+        chain.written = {
+            tidy(chi, space.variables, sign=True): chi for chi in lagrangian.constraints if isinstance(chi, sympy.Mul)
+        }
         chain.run()
         self._chain = chain
         done(
@@ -130,6 +145,7 @@ class ConstraintAnalysis:
         self.total_hamiltonian = chain.total_hamiltonian
         self.stages = chain.stages
         self.constraints = chain.constraints
+        self.reducible_constraints = list(chain.reducible)
         self.multipliers = dict(chain.solved_multipliers)
         self.undetermined_multipliers = list(chain.undetermined)
         self.multiplier_solution: MultiplierSolution = chain.multiplier_solution or unsolved_multipliers((), [], self.canonical_hamiltonian, [])
@@ -167,6 +183,8 @@ class ConstraintAnalysis:
             "weak zeros, independence and ranks decided numerically at "
             f"{len(self._points)} random points of each constraint surface"
             + (" (symbolic parameters at generic random values)" if self.parameters else ""),
+            *regularised,
+            *chain.regularity_notes,
         ]
         if self.time is not None:
             self.notes.append(
@@ -176,6 +194,10 @@ class ConstraintAnalysis:
             )
         self.gauge_conditions: tuple[str, ...] = ()
         self._gauge: GaugeStructure | None = None
+        self.special_parameter_values: list[SpecialValue] = []
+        if self.parameters:
+            self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
+            self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
 
     # ------------------------------------------------------------------ gauge
@@ -202,6 +224,45 @@ class ConstraintAnalysis:
             For conditions that are not admissible; the message names the condition.
         """
         return fix_gauge(self, conditions)
+
+    def _special_values(self, chain: ConstraintChain, C: sympy.Matrix, second: list[int], seed: int) -> tuple[list[SpecialValue], list[str]]:
+        """Parameter values where the rank of the Hessian, of ``A_PQ`` or of ``C`` drops (:mod:`dirac.analysis.special_values`)."""
+        space = self._space
+        uses = []
+        large: list[str] = []
+        params = set(self.parameters)
+        W = self.hessian
+        P, Q = chain.pivots
+        small = 0 < len(P) <= MAX_BLOCK
+        A = sympy.Matrix([[chain._rows(c)[1][k] for k in range(len(chain.primary))] for c in self.constraints]) if small else None
+        for label, size, block in (
+            ("Hessian", self.hessian_rank, W),
+            ("consistency matrix {Phi_a, phi_k}", len(P), A[P, Q] if A is not None else None),
+            ("bracket matrix C", len(second), C[second, second] if 0 < len(second) <= MAX_BLOCK else None),
+        ):
+            if not size:
+                continue
+            if size > MAX_BLOCK:
+                large.append(f"{label} ({size}x{size})")
+                continue
+            if block is None or not block.free_symbols & params:
+                continue
+            if label == "Hessian":
+                points = [self._numerics.random_point() for _ in range(3)]
+                values = self._numerics.evaluate(list(W), points).reshape(len(points), *W.shape)
+                S = independent_rows(list(values), list(range(W.shape[0])))
+                uses.append(RankUse(label, W[S, S], W, len(S), on_surface=False))
+            elif A is not None and label.startswith("consistency"):
+                uses.append(RankUse(label, A[P, Q], A, len(P), on_surface=True))
+            else:
+                uses.append(RankUse(label, C[second, second], C, len(second), on_surface=True))
+        notes = [
+            f"special parameter values: not searched in the {', '.join(large)}: blocks larger than "
+            f"{MAX_BLOCK}x{MAX_BLOCK} are too large for a symbolic determinant"
+        ] if large else []
+        everything = self.constraints + self.reducible_constraints
+        found, _ = special_parameter_values(space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed)
+        return found, notes
 
     # ------------------------------------------------------------------ brackets
     def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:
@@ -349,7 +410,7 @@ class ConstraintAnalysis:
             if self.gauge_conditions:
                 point = regular_gauge_point(self, numerics, fixed)
             else:
-                point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
+                point = numerics.surface_points(self.constraints + self.reducible_constraints, 1, fixed=fixed)[0]
         except AnalysisError:
             if fixed:
                 raise InputError(
@@ -406,8 +467,15 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     InconsistentSystemError
         If the consistency conditions demand something like ``1 = 0``.
     AnalysisError
-        If the Lagrangian is not quadratic in the velocities, or the chain cannot be
-        carried out.
+        If the Lagrangian is not quadratic in the velocities, the chain cannot be
+        carried out, or a constraint is irregular with no regular form (branches that
+        cross, a gradient that vanishes where the constraint holds).
+
+    Warns
+    -----
+    DiracWarning
+        When a parameter's value in the system lies on a special parameter value: the
+        analysis is then at that value (see :func:`at_given_values`).
 
     Examples
     --------
@@ -418,4 +486,42 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     """
     if not isinstance(lagrangian, Lagrangian):
         raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
-    return ConstraintAnalysis(lagrangian, progress=progress)
+    return at_given_values(ConstraintAnalysis(lagrangian, progress=progress), progress)
+
+
+def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
+    """The analysis at the parameter values written in the system, when they are special.
+
+    The analysis is symbolic in its parameters (generic structure). When the value a
+    parameter has in the system (its default: the system file, or ``--param``) lies on a
+    special parameter value (:mod:`dirac.analysis.special_values`), the structure there
+    differs from the generic one: the analysis is done again with those parameters fixed
+    to their values (what the user wrote), with a note and a :class:`~dirac.errors.DiracWarning`
+    saying that generic values give another structure.
+    """
+    values = {p.name: v for p, v in analysis.lagrangian.parameters.items()}
+    hits = [s for s in analysis.special_parameter_values if s.holds_at(values)]
+    if not hits:
+        return analysis
+    names = {h.parameter for h in hits} | {sym.name for h in hits for sym in h.value.free_symbols}
+    given = {n: v for n in sorted(names) if (v := values.get(n)) is not None}
+    fixed = analysis.lagrangian.fix(**given)
+    at = ConstraintAnalysis(fixed, progress=progress)
+    shown = ", ".join(f"{h.parameter} = {h.value}" for h in hits)
+    generic = (
+        f"{len(analysis.first_class)} first class, {len(analysis.second_class)} second class, "
+        f"physical degrees of freedom {analysis.physical_degrees_of_freedom}"
+    )
+    here = (
+        f"{len(at.first_class)} first class, {len(at.second_class)} second class, "
+        f"physical degrees of freedom {at.physical_degrees_of_freedom}"
+    )
+    message = (
+        f"{shown}, the value given for {analysis.name!r}, is a special parameter value "
+        f"({'; '.join(h.where for h in hits)}): the analysis is at that value ({here}); for generic values "
+        f"the structure differs ({generic})"
+    )
+    at.notes.append(message)
+    at.special_parameter_values = analysis.special_parameter_values
+    warn(message)
+    return at

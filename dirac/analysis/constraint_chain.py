@@ -28,6 +28,15 @@ that follow from the earlier ones (gradient dependent on the new surface) are dr
 condition free of phase-space variables (``1 = 0``) is an inconsistency. The chain stops
 when a stage adds nothing; the last system then fixes the determined multipliers, and its
 general solution ``u = U + v_a V_a`` is built by :mod:`dirac.analysis.multiplier_solution`.
+
+Regularity (Henneaux–Teitelboim, Sect. 1.1.2): every sample point is a regular point of
+the surface found so far (independent gradients of the kept constraints, checked). A
+new constraint whose gradient vanishes where it holds is replaced by its square-free
+part (Cawley's ``z^2 = 0`` -> ``z = 0``, with a note) or refused; a product whose
+branches cross is refused. New constraints whose gradients depend on the others on the
+regular part of the surface (a reducible set, ``x . J = 0`` for ``J = x × p``) are kept
+in :attr:`ConstraintChain.reducible`: they do not enter the classification but still
+define the surface on which points are sampled.
 """
 
 from __future__ import annotations
@@ -40,8 +49,9 @@ import sympy
 from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.multiplier_solution import MultiplierSolution, general_multiplier_solution, unsolved_multipliers
-from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
+from dirac.analysis.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.analysis.regularity import IRREGULAR_GRADIENT, ROUND_OFF, branches, normal_components, square_free_part
 from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]
@@ -71,7 +81,13 @@ class ConstraintChain:
 
     After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
     expression, only those the chain determines), ``undetermined`` (multiplier symbols
-    not fixed alone), ``multiplier_solution`` (the general solution ``u = U + v_a V_a``), ``points`` (points of the final surface) and ``notes``.
+    not fixed alone), ``multiplier_solution`` (the general solution ``u = U + v_a V_a``),
+    ``points`` (regular points of the final surface), ``reducible`` (constraints
+    that hold but whose gradients depend on the kept ones on the regular part of the
+    surface, e.g. ``x . J = 0`` among ``J = x × p``; they still define the surface) and
+    ``notes`` (``regularity_notes``: regularised and reducible constraints, for the report).
+    ``written`` maps the expanded form (as :func:`tidy` gives it) of a constraint the
+    user wrote as a product to that product, so that its branches are checked.
     """
 
     phase_space: PhaseSpace
@@ -86,6 +102,9 @@ class ConstraintChain:
     notes: list[str] = field(default_factory=list)
     multiplier_solution: MultiplierSolution | None = None
     time: sympy.Symbol | None = None
+    reducible: list[sympy.Expr] = field(default_factory=list)
+    regularity_notes: list[str] = field(default_factory=list)
+    written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -133,7 +152,7 @@ class ConstraintChain:
         self._row_cache: dict = {}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
         self.primary = primary
-        points = self.numerics.surface_points(primary, SAMPLE_POINTS) if primary else []
+        points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
         base_grads = self._independent(primary, [], points) if primary else []
         self.stages = [[primary[i] for i in base_grads]] if primary else []
         if primary and len(base_grads) < len(primary):
@@ -177,8 +196,10 @@ class ConstraintChain:
             if not chosen:
                 break
             self.stages.append([candidates[i] for i in chosen])
-            points = self.numerics.surface_points(self.constraints, SAMPLE_POINTS)
+            self._keep_reducible(candidates, chosen)
+            points = self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
         self.points = points
+        self.pivots = (pivots_rows, pivot_cols)
         self._solve_multipliers(points, pivots_rows, pivot_cols)
         return self
 
@@ -187,7 +208,14 @@ class ConstraintChain:
         if not candidates:
             return []
         keep = ~self.numerics.weakly_zero(candidates, points)
-        return [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+        for c, k in zip(candidates, keep):
+            if k:  # a product as written: its branches must not meet (read before expanding)
+                self._refuse_crossing(c, self.constraints)
+        kept = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+        for c in kept:  # a holonomic constraint written as a product, met in expanded form
+            if c in self.written:
+                self._refuse_crossing(self.written[c], self.constraints)
+        return kept
 
     def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
         """Check new conditions for inconsistency and keep the independent ones (indices into ``candidates``)."""
@@ -202,15 +230,118 @@ class ConstraintChain:
                 )
         if len(self.stages) >= limit:
             raise AnalysisError(f"the constraint chain did not terminate after {limit} stages")
+        for _ in range(2):
+            new_points = self._new_points(constraints, candidates)
+            chosen = self._independent(candidates, constraints, new_points)
+            irregular = self._irregular(candidates, chosen, constraints, new_points)
+            if not irregular:
+                return candidates, chosen
+            candidates = [self._regularised(c) if i in irregular else c for i, c in enumerate(candidates)]
+        raise AnalysisError("the constraint chain could not regularise its new constraints")  # pragma: no cover
+
+    def _new_points(self, constraints: list[sympy.Expr], candidates: list[sympy.Expr]) -> list[np.ndarray]:
+        """Regular points of the old surface on which the candidates vanish too."""
         try:
-            new_points = self.numerics.surface_points(constraints + candidates, SAMPLE_POINTS)
+            return self.numerics.surface_points(constraints + self.reducible + candidates, SAMPLE_POINTS, regular=len(constraints))
+        except SingularSurface:
+            raise
         except AnalysisError:
             shown = "; ".join(f"{c} = 0" for c in candidates[:4])
             raise InconsistentSystemError(
                 f"the stage-{len(self.stages) + 1} conditions {shown} have no real solution together with "
                 "the earlier constraints: the Lagrangian has no consistent motion"
             ) from None
-        return candidates, self._independent(candidates, constraints, new_points)
+
+    # ------------------------------------------------------------------ regularity
+    def _regularised(self, constraint: sympy.Expr) -> sympy.Expr:
+        """``f`` for a constraint ``f^k`` (``k > 1``): the same surface, with a gradient that does not vanish on it.
+
+        Henneaux–Teitelboim, Sect. 1.1.2 (regularity conditions) and Sect. 1.2.2 (Cawley's
+        ``z^2 = 0``, regular as ``z = 0``). The replacement is recorded in
+        :attr:`regularity_notes`. Called for a constraint found irregular at surface points.
+
+        Raises
+        ------
+        AnalysisError
+            When the constraint has no repeated factor (e.g. ``x^2 + y^2 = 0``): no
+            regular form is known, the analysis is refused.
+        """
+        part = square_free_part(constraint, self.phase_space.variables)
+        if part is None:
+            raise AnalysisError(
+                f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: its gradient vanishes "
+                "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
+                "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
+                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)"
+            )
+        self._refuse_crossing(part, self.constraints)
+        regular = tidy(part, self.phase_space.variables, sign=True)
+        self.regularity_notes.append(
+            f"stage {len(self.stages) + 1}: the constraint {constraint} = 0 is irregular (its gradient vanishes where it "
+            f"holds); it was replaced by its square-free part {regular} = 0, the same surface described regularly; "
+            "the classes and counts below refer to this regular form (with the irregular form, first-class "
+            "constraints need not all generate gauge transformations, as in Cawley's example)"
+        )
+        return regular
+
+    def _refuse_crossing(self, constraint: sympy.Expr, constraints: list[sympy.Expr]) -> None:
+        """Refuse a product ``f g = 0`` whose branches meet on the surface (no single regular surface there)."""
+        parts = branches(constraint, self.phase_space.variables)
+        if len(parts) < 2:
+            return
+        for i in range(len(parts)):
+            for j in range(i + 1, len(parts)):
+                try:
+                    self.numerics.surface_points(constraints + self.reducible + [parts[i], parts[j]], 1, attempts=8)
+                except AnalysisError:
+                    continue  # these branches do not meet: the product is regular where it holds
+                shown = " and ".join(f"{f} = 0" for f in parts)
+                raise AnalysisError(
+                    f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: it is the union of the "
+                    f"branches {shown}, which meet (where {parts[i]} = {parts[j]} = 0 its gradient vanishes), so there "
+                    f"is no single regular constraint surface; analyse the branches {shown} separately "
+                    "(one system each)"
+                )
+
+    def _irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
+        """New constraints whose gradient is numerically zero where they hold (normal to the others' gradients).
+
+        A kept constraint is compared with the old ones, a dropped one with the old and the
+        kept ones. A component below ``IRREGULAR_GRADIENT`` (relative to the size of the
+        gradient's terms) at every point, yet above round-off, marks a gradient that
+        vanishes on the surface: ``f^2 = 0`` or ``x^2 + y^2 = 0``.
+        """
+        n = len(self.phase_space.variables)
+        everything = old + self.reducible + [candidates[i] for i in chosen]
+        grads = [g for c in everything for g in self.phase_space.gradient(c)]
+        stacked = self.numerics.evaluate(grads, points).reshape(len(points), len(everything), n)
+        n_old = len(old) + len(self.reducible)
+        found = []
+        for i, c in enumerate(candidates):
+            grad = self.phase_space.gradient(c)
+            rows = self.numerics.evaluate(grad, points)
+            base = stacked[:, :n_old] if i in chosen else stacked
+            rough = [normal_components(rows[p : p + 1], base[p], np.ones(1) + np.max(np.abs(base[p]), initial=0.0))[0] for p in range(len(points))]
+            if max(rough) > 1e-2:  # clearly regular: skip the finer test
+                continue
+            scales = self.numerics.term_scale(grad, points).sum(axis=1) - (n - 1)  # 1 + sum of |terms| of the gradient
+            sizes = np.array([normal_components(rows[p : p + 1], base[p], scales[p : p + 1])[0] for p in range(len(points))])
+            if np.all(sizes < IRREGULAR_GRADIENT) and np.any(sizes > ROUND_OFF):
+                found.append(i)
+        return found
+
+    def _keep_reducible(self, candidates: list[sympy.Expr], chosen: list[int]) -> None:
+        """Keep the new constraints left out as dependent: they still define the surface (reducible set)."""
+        dropped = [c for i, c in enumerate(candidates) if i not in chosen]
+        if not dropped:
+            return
+        self.reducible.extend(dropped)
+        self.regularity_notes.append(
+            f"stage {len(self.stages)}: the constraints {', '.join(str(c) for c in candidates)} are reducible: on the "
+            f"regular part of their surface {', '.join(str(c) for c in dropped)} depend(s) on the others "
+            f"(independent set kept: {', '.join(str(candidates[i]) for i in chosen)}); the dependent ones still "
+            "define the surface and every sample point satisfies them"
+        )
 
     def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> list[int]:
         """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by."""

@@ -7,8 +7,11 @@ numerically at several random points of that surface (probabilistic identity tes
 an expression that vanishes at independent random points of an irreducible surface
 vanishes on it, up to an event of probability zero. Points are found by Gauss–Newton
 projection (minimum-norm steps) of random points, with compiled residuals and
-Jacobians. Parameters that are still symbolic take generic random values for these
-decisions, so the answers hold for generic parameters.
+Jacobians; with ``regular=k`` only regular points are kept (the first ``k``
+constraints' gradients independent there), so that no rank is read at a crossing or
+another singular point. Parameters that are still symbolic take generic random values
+for these decisions, so the answers hold for generic parameters (the values where
+they do not are found by :mod:`dirac.analysis.special_values`).
 """
 
 from __future__ import annotations
@@ -23,18 +26,29 @@ from dirac.analysis.phase_space import PhaseSpace
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
-__all__ = ["Numerics", "numeric_rank", "independent_rows"]
+__all__ = ["Numerics", "SingularSurface", "numeric_rank", "independent_rows"]
 
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
 #: residual (relative to the constraint's own term sizes) of a converged surface point
 SURFACE_TOLERANCE = 1e-11
+#: smallest singular value of the row-normalised constraint Jacobian at a regular point
+REGULAR_TOLERANCE = 1e-6
+
+
+class SingularSurface(AnalysisError):
+    """Points of a constraint surface were found, but none is regular (irregular constraints)."""
 
 
 def numeric_rank(matrix: np.ndarray, tol: float = 1e-8) -> int:
     """Rank of ``matrix`` by SVD, with a singular-value cut relative to the largest one."""
     if matrix.size == 0:
         return 0
+    if not np.all(np.isfinite(matrix)):
+        raise AnalysisError(
+            "a rank was needed where the expressions are not finite (a denominator vanishes at a sample "
+            "point of the constraint surface): the analysis cannot decide it there"
+        )
     s = np.linalg.svd(matrix, compute_uv=False)
     if s[0] == 0 or not np.isfinite(s[0]):
         return 0
@@ -187,6 +201,21 @@ class Numerics:
         return mask
 
     # ------------------------------------------------------------------ surface points
+    @staticmethod
+    def _regular_point(jacobian: np.ndarray) -> bool:
+        """Whether the rows of ``jacobian`` (constraint gradients at a point) are independent.
+
+        Each row is scaled to unit length (constraints may be multiplied by any non-zero
+        function), then the smallest singular value must exceed ``REGULAR_TOLERANCE``.
+        """
+        if not np.all(np.isfinite(jacobian)):
+            return False
+        norms = np.linalg.norm(jacobian, axis=1)
+        if np.any(norms == 0):
+            return False
+        s = np.linalg.svd(jacobian / norms[:, None], compute_uv=False)
+        return bool(s[-1] > REGULAR_TOLERANCE) if len(s) == jacobian.shape[0] else False
+
     def random_point(self) -> np.ndarray:
         """A random phase-space point with components of size 0.5-1.5 and random signs (and a time ``t``)."""
         n = len(self.phase_space.variables) + (self.time is not None)
@@ -199,6 +228,7 @@ class Numerics:
         fixed: Mapping[int, float] | None = None,
         attempts: int = 40,
         start: np.ndarray | None = None,
+        regular: int = 0,
     ) -> list[np.ndarray]:
         """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
 
@@ -214,11 +244,17 @@ class Numerics:
             Random restarts allowed in total before giving up.
         start
             First starting point (random ones follow).
+        regular
+            The first ``regular`` constraints must have independent gradients at each point
+            returned (a full-rank Jacobian, the regularity condition of Henneaux–Teitelboim,
+            Sect. 1.1.2): points where they do not (crossings, singular points) are dropped
+            and others sampled, so that no decision is taken at a singular point.
 
         Raises
         ------
         AnalysisError
-            If no point is found: the surface may be empty (no real solution).
+            If no point is found: the surface may be empty (no real solution), or it has
+            no regular point (its constraints are irregular).
         """
         constraints = [sympy.sympify(c) for c in constraints]
         residual = self.function(constraints)
@@ -231,6 +267,7 @@ class Numerics:
         free = np.array([i for i in range(n) if i not in fixed], dtype=int)
         points: list[np.ndarray] = []
         tries = 0
+        singular = 0
         while len(points) < count and tries < attempts:
             tries += 1
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
@@ -257,10 +294,19 @@ class Numerics:
                     step *= 10.0 / norm
                 z = z.copy()
                 z[free] += step
+            if ok and regular and not self._regular_point(jac_fn(z).reshape(m, n)[:regular]):
+                singular += 1
+                continue
             if ok:
                 points.append(z)
         if len(points) < count:
             names = "; ".join(str(c) for c in constraints[:6])
+            if singular:
+                raise SingularSurface(
+                    f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
+                    f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
+                    "(irregular constraints); write the surface with constraints whose gradients are independent on it"
+                )
             raise AnalysisError(
                 f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
                 "after many random starts: the constraints may have no real solution for these parameters"

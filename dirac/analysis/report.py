@@ -67,6 +67,9 @@ class AnalysisResult(Protocol):
     def gauge_structure(self) -> GaugeStructure: ...
     @property
     def gauge_conditions(self) -> Sequence[str]: ...
+    def reducible_constraints(self) -> Sequence[sympy.Expr]: ...
+    @property
+    def special_parameter_values(self) -> Sequence[Any]: ...
 
 #: longest expression printed in full in the text report
 TEXT_LIMIT = 400
@@ -151,7 +154,9 @@ def to_json(analysis: AnalysisResult) -> dict:
 
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
-    ``bracket_strategy``, ``notes``, ``time_dependent`` (``L`` or a constraint depends
+    ``bracket_strategy``, ``notes``, ``reducible_constraints`` (constraints that hold but
+    depend on the kept independent set), ``special_parameter_values`` (list of
+    ``{"parameter", "value", "where"}``), ``time_dependent`` (``L`` or a constraint depends
     explicitly on the time ``t``); ``multiplier_solution`` (the general solution
     ``u = U + v_a V_a``: ``particular``, ``null_vectors``, ``free``);
     ``multiplier_subexpressions`` (name -> text) when a multiplier is too large to print
@@ -183,6 +188,8 @@ def to_json(analysis: AnalysisResult) -> dict:
         "hessian_rank": analysis.hessian_rank,
         "bracket_strategy": analysis.bracket_strategy,
         "notes": list(analysis.notes) + list(gauge.notes),
+        "reducible_constraints": [expression_text(c) for c in analysis.reducible_constraints],
+        "special_parameter_values": [s.to_json() for s in analysis.special_parameter_values],
         "time_dependent": analysis.lagrangian.is_time_dependent,
         "gauge_generators": [{"terms": [expression_text(g) for g in gen.terms]} for gen in gauge.generators],
         "gauge_transformations": [
@@ -320,8 +327,15 @@ def to_text(analysis: AnalysisResult) -> str:
         f"physical degrees of freedom: ({2 * n} - 2*{len(a.first_class)} - {len(a.second_class)})/2 = "
         f"{a.physical_degrees_of_freedom}"
     )
+    if a.reducible_constraints:
+        lines.append(
+            f"reducible: {len(a.reducible_constraints)} more constraint(s) hold but depend on the independent set above: "
+            + ", ".join(_short(c, 80) for c in a.reducible_constraints)
+        )
     lines.extend(_gauge_lines(a))
     lines.append(f"Dirac bracket: {a.bracket_strategy}")
+    for s in a.special_parameter_values:
+        lines.append(f"special parameter value: {s.parameter} = {s.value} ({s.where})")
     for note in a.notes:
         lines.append(f"note: {note}")
     return "\n".join(lines)

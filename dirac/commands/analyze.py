@@ -14,7 +14,7 @@ import math
 import sys
 from collections.abc import Callable
 
-from dirac.errors import InputError
+from dirac.errors import DiracError, InputError
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -84,6 +84,30 @@ def stage_printer(level: int) -> Callable[[str], None] | None:
     return report
 
 
+def _at_special(system: str, params: dict[str, float], report: Callable[[str], None] | None):
+    """The analysis at ``--param`` values that lie on a special parameter value, else None.
+
+    The parameters are first kept symbolic, with the given values as their defaults, to
+    find the special values (:func:`dirac.analysis.constraint_analysis.at_given_values`
+    then analyses at the given values and warns); when none is hit the caller analyses
+    with the parameters fixed, as ``--param`` promises.
+    """
+    import dataclasses
+
+    from dirac.analysis.constraint_analysis import analyze
+    from dirac.model.systems import load_system
+
+    free = load_system(system)
+    if not set(params) <= set(free.parameter_values):
+        return None
+    generic = dataclasses.replace(free, parameters={p: params.get(p.name, v) for p, v in free.parameters.items()})
+    try:
+        analysis = analyze(generic, progress=report)
+    except DiracError:  # no generic analysis: the analysis at the given values decides alone
+        return None
+    return analysis if analysis.lagrangian.fixed_values else None
+
+
 def main(args: argparse.Namespace) -> int:
     from dirac.analysis.constraint_analysis import analyze
     from dirac.model.systems import load_system
@@ -91,7 +115,9 @@ def main(args: argparse.Namespace) -> int:
     params = parse_params(args.param)
     lagrangian = load_system(args.system, **params)
     report = stage_printer(getattr(args, "verbosity", 0))
-    analysis = analyze(lagrangian, progress=report)
+    analysis = _at_special(args.system, params, report) if params else None
+    if analysis is None:
+        analysis = analyze(lagrangian, progress=report)
     if args.gauge:
         analysis = analysis.fix_gauge(args.gauge)
         if report is not None:
