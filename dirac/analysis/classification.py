@@ -74,7 +74,8 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
     tiny = np.all(np.abs(values) <= 1e-9 * scale, axis=0)
     alone_first = [a for a in range(m) if np.all(tiny[a])]
     rest = [a for a in range(m) if a not in alone_first]
-    ranks = [numeric_rank(v) for v in values]
+    # entries at round-off of the matrix's scale are weak zeros, as in ``tiny``: not rank
+    ranks = [numeric_rank(np.where(np.abs(v) <= 1e-9 * sc, 0.0, v)) for v, sc in zip(values, scale)]
     if len(set(ranks)) > 1:
         raise AnalysisError(
             f"the rank of the bracket matrix C_ab = {{Phi_a, Phi_b}} differs between regular points of the constraint "

@@ -230,6 +230,7 @@ class ConstraintAnalysis:
         space = self._space
         uses = []
         large: list[str] = []
+        unsearched: list[str] = []
         params = set(self.parameters)
         W = self.hessian
         P, Q = chain.pivots
@@ -247,6 +248,12 @@ class ConstraintAnalysis:
                 continue
             if block is None or not block.free_symbols & params:
                 continue
+            if label == "Hessian" and block.free_symbols & set(self.lagrangian.velocities):
+                unsearched.append(
+                    "special parameter values: not searched in the Hessian, which depends on the velocities "
+                    "(L is not quadratic in them)"
+                )
+                continue
             if label == "Hessian":
                 points = [self._numerics.random_point() for _ in range(3)]
                 values = self._numerics.evaluate(list(W), points).reshape(len(points), *W.shape)
@@ -261,8 +268,10 @@ class ConstraintAnalysis:
             f"{MAX_BLOCK}x{MAX_BLOCK} are too large for a symbolic determinant"
         ] if large else []
         everything = self.constraints + self.reducible_constraints
-        found, _ = special_parameter_values(space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed)
-        return found, notes
+        found, skipped = special_parameter_values(
+            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time
+        )
+        return found, notes + unsearched + skipped
 
     # ------------------------------------------------------------------ brackets
     def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:

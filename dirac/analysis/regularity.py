@@ -69,14 +69,21 @@ def _polynomial(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sympy.Po
         return None
 
 
+def _never_zero(factor: sympy.Expr) -> bool:
+    """``factor`` has no real zero (``exp(-y)``, ``y**2 + 1``; all symbols are real): it is no branch."""
+    return bool(factor.is_positive or factor.is_negative)
+
+
 def square_free_part(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sympy.Expr | None:
     """The square-free part of a constraint with a repeated factor, else ``None``.
 
     For ``Phi = c f_1^k_1 ... f_r^k_r`` (``f_i`` distinct, non-constant in the phase-space
-    ``variables``, ``c`` free of them) with some ``k_i > 1`` returns ``f_1 ... f_r``: the
+    ``variables``, ``c`` free of them or without a real zero, like ``exp(-y)``) with some ``k_i > 1`` returns ``f_1 ... f_r``: the
     same zero set, with a gradient that does not vanish on it identically (square-free
     decomposition, Yun's algorithm, via :meth:`sympy.Poly.sqf_list`).
     """
+    if isinstance(expr, sympy.Mul):  # factors that never vanish (exp(-y), y**2 + 1) do not shape the surface
+        expr = sympy.Mul(*[f for f in expr.args if not _never_zero(f)])
     poly = _polynomial(expr, variables)
     if poly is None:
         return None
@@ -103,7 +110,7 @@ def branches(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.
     found: list[sympy.Expr] = []
     for arg in expr.args:
         base = arg.base if isinstance(arg, sympy.Pow) and arg.exp.is_Integer and arg.exp > 0 else arg
-        if base.free_symbols & set(variables) and base not in found:
+        if base.free_symbols & set(variables) and base not in found and not _never_zero(base):
             found.append(base)
     return found if len(found) > 1 else [expr]
 

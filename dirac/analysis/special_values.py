@@ -101,6 +101,10 @@ def _numerator_of_determinant(block: sympy.Matrix) -> sympy.Expr:
         return sympy.fraction(sympy.together(block.det(method="berkowitz")))[0]
 
 
+class NotPolynomial(ValueError):
+    """The determinant of a block is not a polynomial in the parameters: no search there."""
+
+
 def _candidates(block: sympy.Matrix, variables: Sequence[sympy.Symbol], parameters: Sequence[sympy.Symbol], rng: np.random.Generator) -> list[tuple[sympy.Symbol, sympy.Expr]]:
     """Zeros of the parameter-only factors of ``det block`` (the content of its numerator in ``variables``).
 
@@ -108,17 +112,23 @@ def _candidates(block: sympy.Matrix, variables: Sequence[sympy.Symbol], paramete
     points of phase space (a factor common to both by accident is removed by the check
     that follows in :func:`special_parameter_values`).
     """
-    present = sorted(block.free_symbols & set(variables), key=lambda s: s.name)
+    params = set(parameters)
+    # every symbol that is not a parameter (phase-space variables, and the time t of a
+    # time-dependent system) is set to random rationals
+    present = sorted(block.free_symbols - params, key=lambda s: s.name)
     numerators = []
     for _ in range(2 if present else 1):
         point = {v: sympy.Rational(int(rng.integers(1, 89)), int(rng.integers(1, 11))) for v in present}
         numerators.append(_numerator_of_determinant(block.xreplace(point)))
-    content = numerators[0] if len(numerators) == 1 else sympy.gcd(numerators[0], numerators[1])
-    params = set(parameters)
     found: list[tuple[sympy.Symbol, sympy.Expr]] = []
-    if content == 0:
-        return found
-    for factor, _ in sympy.factor_list(content)[1]:
+    try:
+        content = numerators[0] if len(numerators) == 1 else sympy.gcd(numerators[0], numerators[1])
+        if content == 0:
+            return found
+        factors = sympy.factor_list(content)[1]
+    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+        raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block is not polynomial in the parameters") from None
+    for factor, _ in factors:
         if not factor.free_symbols or not factor.free_symbols <= params:
             continue
         for p in sorted(factor.free_symbols, key=lambda s: s.name):
@@ -134,6 +144,7 @@ def special_parameter_values(
     uses: Sequence[RankUse],
     constraints_at: Callable[[dict], list[sympy.Expr]],
     seed: int = 20240607,
+    time: sympy.Symbol | None = None,
 ) -> tuple[list[SpecialValue], list[str]]:
     """The special parameter values of the rank decisions ``uses``, checked numerically.
 
@@ -148,6 +159,8 @@ def special_parameter_values(
     constraints_at
         ``substitution -> constraints`` (the constraints, reducible ones included, with
         the parameter substituted): where the ranks on the surface are evaluated again.
+    time
+        The time ``t`` of a time-dependent system (sampled like a variable), else ``None``.
 
     Returns
     -------
@@ -170,8 +183,13 @@ def special_parameter_values(
                 f"{use.block.shape[0]} block is too large for a symbolic determinant)"
             )
             continue
-        for p, value in _candidates(use.block, space.variables, parameters, rng):
-            at = _rank_at(space, generic, use, {p: value}, constraints_at, seed)
+        try:
+            candidates = _candidates(use.block, space.variables, parameters, rng)
+        except NotPolynomial as exc:
+            notes.append(f"special parameter values: not searched in the {use.label}: {exc}")
+            continue
+        for p, value in candidates:
+            at = _rank_at(space, generic, use, {p: value}, constraints_at, seed, time)
             if at == UNDEFINED or (at is not None and at >= use.rank):
                 continue
             change = f"rank of the {use.label} drops from {use.rank} to {at}" if at is not None else (
@@ -192,12 +210,13 @@ def _rank_at(
     substitution: dict[sympy.Symbol, sympy.Expr],
     constraints_at: Callable[[dict], list[sympy.Expr]],
     seed: int,
+    time: sympy.Symbol | None = None,
 ) -> int | None:
     """Rank of ``use.matrix`` with ``substitution``, at points of the surface there (None: no point found)."""
     numbers = dict(generic)
     for p, value in substitution.items():
         numbers[p] = float(sympy.re(value.subs(generic)))
-    numerics = Numerics(space, numbers, seed=seed)
+    numerics = Numerics(space, numbers, seed=seed, time=time)
     matrix = use.matrix.subs(substitution)
     constraints = constraints_at(substitution) if use.on_surface else []
     if any(e.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo) for e in [*matrix, *constraints]):

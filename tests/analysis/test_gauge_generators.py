@@ -185,19 +185,25 @@ def test_yang_mills_type_toy_needs_the_covariant_derivative():
     assert analysis.gauge_structure.without_transformation == []
 
 
-def test_a_term_with_vanishing_gradient_is_reported():
+def test_an_irregular_constraint_is_regularised_and_dirac_s_conjecture_fails_for_it():
     """L = exp(y) x_dot^2/2 (Henneaux-Teitelboim's irregular example), by hand: p_y = 0 primary,
-    H_c = exp(-y) p_x^2/2, {p_y, H_c} = exp(-y) p_x^2/2 = 0 (stage 2, irregular: its gradient
-    vanishes where it holds). G_1 = p_y, G_0 = -exp(-y) p_x^2/2: delta x = -eps exp(-y) p_x
-    vanishes on the surface, so that term generates nothing and the report says so."""
+    H_c = exp(-y) p_x^2/2, {p_y, H_c} = exp(-y) p_x^2/2 = 0 at stage 2 is irregular (its gradient
+    vanishes where it holds); its regular form is p_x = 0 (exp(-y) never vanishes). Both are
+    first class. Castellani: G_1 = p_y and G_0 = -{p_y, H_c} = -exp(-y) p_x^2/2, weakly zero
+    with a vanishing gradient, so G = eps p_y: delta y = eps, delta x = 0. The motion
+    (d/dt(exp(y) x_dot) = 0 with exp(y) x_dot^2 = 0, so x_dot = 0) leaves x fixed but
+    arbitrary: x is not a gauge variable, and the first-class p_x generates no gauge
+    transformation (Dirac's conjecture fails); the report says so."""
     analysis = dirac.analyze(dirac.Lagrangian.from_strings("irregular", ["x", "y"], "exp(y)*x_dot**2/2"))
     s = analysis.symbols
+    assert analysis.stages == [[s["p_y"]], [s["p_x"]]]
+    assert any("square-free part p_x = 0" in note for note in analysis.notes)
     [gen] = analysis.gauge_generators
-    G0, G1 = gen.terms
-    assert G1 == s["p_y"]
-    assert sympy.simplify(G0 + sympy.exp(-s["y"]) * s["p_x"] ** 2 / 2) == 0
-    assert analysis.gauge_structure.irregular_terms == [G0]
-    assert any("vanishing gradient" in note for note in analysis.to_json()["notes"])
+    assert gen.terms[-1] == s["p_y"]
+    assert all(sympy.simplify(term) == 0 for term in gen.terms[:-1])
+    assert gen.delta == {s["y"]: gen.parameter_symbols()[0]}
+    assert analysis.gauge_structure.without_transformation == [s["p_x"]]
+    assert "generates no gauge transformation" in analysis.to_text()
 
 
 def test_castellani_check_rejects_a_wrong_chain():
