@@ -120,6 +120,8 @@ def _candidates(block: sympy.Matrix, variables: Sequence[sympy.Symbol], paramete
     for _ in range(2 if present else 1):
         point = {v: sympy.Rational(int(rng.integers(1, 89)), int(rng.integers(1, 11))) for v in present}
         numerators.append(_numerator_of_determinant(block.xreplace(point)))
+        if not numerators[-1].free_symbols & params:
+            return []  # free of parameters at one point: no parameter-only factor anywhere
     found: list[tuple[sympy.Symbol, sympy.Expr]] = []
     try:
         content = numerators[0] if len(numerators) == 1 else sympy.gcd(numerators[0], numerators[1])
