@@ -118,7 +118,10 @@ class FirstClassHamiltonian:
 
 
 def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
-    """Solve ``{Phi_i, H_c} + A_ia u_a ~ 0``, ``A_ia = {Phi_i, phi_a}``, as ``u = U + v_f V_f``.
+    """Solve ``{Phi_i, H_c} + d_t Phi_i + A_ia u_a ~ 0``, ``A_ia = {Phi_i, phi_a}``, as ``u = U + v_f V_f``.
+
+    ``d_t Phi_i``, the partial time derivative, is there only for a time-dependent
+    analysis (``analysis.time``; constraints or gauge conditions that name ``t``).
 
     Pivot rows ``P`` and columns ``Q`` of ``A`` (numeric rank at the surface points; the
     multipliers the analysis reports as determined come first among the columns) give
@@ -139,7 +142,8 @@ def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
     A = sympy.Matrix(m, K, lambda i, a: pb(constraints[i], primary[a]))
     zero = numerics.weakly_zero(list(A), points)
     A = sympy.Matrix(m, K, lambda i, a: sympy.S.Zero if zero[i * K + a] else A[i, a])
-    b = sympy.Matrix([pb(c, H_c) for c in constraints])
+    time = getattr(analysis, "time", None)  # d Phi/dt = {Phi, H_T} + d_t Phi for a time-dependent system
+    b = sympy.Matrix([pb(c, H_c) + (sympy.diff(c, time) if time is not None else 0) for c in constraints])
     A_num = numerics.evaluate(list(A), points).reshape(len(points), m, K)
     b_num = numerics.evaluate(list(b), points).reshape(len(points), m)
     rows = independent(list(A_num), list(range(m)))
