@@ -137,6 +137,23 @@ def test_proper_time_gauge_motion(proper_time):
         assert rates[s["x0"]] == pytest.approx(-point["p_x0"] / M, rel=1e-10)
 
 
+def test_a_multiplier_fixed_as_a_function_of_time(particle):
+    """``x0 = t + t^3/6``: preservation gives ``-e p_0 = 1 + t^2/2``, the condition
+    ``e p_0 + 1 + t^2/2``, whose preservation ``p_0 u_1 + t = 0`` fixes ``u_1 = -t/p_0``.
+    Then ``x0_dot = 1 + t^2/2`` and ``e_dot = u_1 = -t/p_0`` (= d/dt of ``-(1 + t^2/2)/p_0``)."""
+    fixed = particle.fix_gauge(["x0 - t - t**3/6", "e*p_x0 + 1 + t**2/2"])
+    s, t = fixed.symbols, fixed.time
+    assert sympy.simplify(fixed.multipliers["u_1"] + t / s["p_x0"]) == 0
+    exact = fixed.equations_of_motion(["x0", "e"])
+    assert sympy.simplify(exact[s["x0"]] - 1 - t**2 / 2) == 0
+    assert sympy.simplify(exact[s["e"]] + t / s["p_x0"]) == 0
+    point = fixed.surface_point({"t": 1.5, "x1": 0.2}, seed=1)
+    rates = fixed.equations_of_motion(at=point)
+    assert rates[s["x0"]] == pytest.approx(1 + 1.5**2 / 2, rel=1e-10)
+    assert rates[s["e"]] == pytest.approx(-1.5 / point["p_x0"], rel=1e-10)
+    assert rates[s["x1"]] == pytest.approx(point["e"] * point["p_x1"], rel=1e-10)
+
+
 def test_time_dependent_gauges_that_are_not_admissible(particle):
     """``p_x1 - t`` commutes with p_e and T (neither depends on x1): it fixes nothing.
     ``x0 - t`` alone: its derivative ``-e p_0 - 1`` has no multiplier, and is named."""
