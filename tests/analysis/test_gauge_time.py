@@ -86,6 +86,14 @@ def test_the_gauge_is_fixed_completely_and_time_dependent(which, lab_gauge, prop
     assert "time-dependent" in fixed.to_text()
 
 
+def test_sympy_conditions_name_the_time_by_name(particle):
+    """A plain ``sympy.Symbol("t")`` is the time, as ``x0`` is the coordinate."""
+    x0, e, p0, t = sympy.symbols("x0 e p_x0 t")
+    fixed = particle.fix_gauge([x0 - t, e * p0 + 1])
+    assert fixed.time is not None and fixed.first_class == []
+    assert fixed.time in fixed.second_class[2].free_symbols
+
+
 def test_lab_gauge_brackets(lab_gauge):
     s = lab_gauge.symbols
     p0, p1, e = s["p_x0"], s["p_x1"], s["e"]
