@@ -128,7 +128,8 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
         lists them as given, ``first_class`` holds the first-class constraints that
         remain (none when the gauge is fixed completely), the multipliers fixed by the
         preservation of the conditions are in ``multipliers``, and ``dirac_bracket`` is
-        the Dirac bracket (240) in this gauge.
+        the Dirac bracket (240) in this gauge. When a condition names the time ``t``,
+        ``time`` is ``t`` (the analysis is time dependent; the multipliers may depend on ``t``).
 
     Raises
     ------
