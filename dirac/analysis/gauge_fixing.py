@@ -16,9 +16,14 @@ all second-class functions, and the number of physical degrees of freedom,
 conditions than first-class constraints the fixing is partial: the first-class
 constraints that remain are reported.
 
-Time-dependent gauges (``x^0 - t``) need the explicit time of the evolution, which the
-engine does not have yet: a condition naming ``t`` that is not a phase-space variable is
-refused with that explanation.
+Time-dependent gauges (``x^0 - t``; Henneaux–Teitelboim, ch. 4, for the relativistic
+particle): a condition may name the time ``t`` when ``t`` is not a coordinate. Its
+preservation is then ``d chi/dt = {chi, H'} + {chi, gamma_f} v_f + d_t chi ~ 0`` (the
+partial time derivative as in the constraint chain), the multipliers it fixes may depend
+on ``t``, and the gauge-fixed analysis is time dependent (:attr:`time` set): its points
+carry ``t`` as their last component, and its equations of motion have the explicit-time
+term of the Dirac bracket (Gitman–Tyutin), which carries the whole motion in a gauge like
+``x^0 = t`` where ``H_c`` is a combination of constraints.
 """
 
 from __future__ import annotations
@@ -61,8 +66,8 @@ def parse_gauge_condition(text: str | sympy.Expr, analysis: Any) -> sympy.Expr:
     """A gauge condition as a sympy expression in the phase-space variables of ``analysis``.
 
     Strings are parsed safely (:func:`~dirac.model.expressions.parse_expression`); names
-    are those of ``analysis.symbols`` (``x``, ``p_x``, ``lambda_1``...) and the symbolic
-    parameters.
+    are those of ``analysis.symbols`` (``x``, ``p_x``, ``lambda_1``...), the symbolic
+    parameters and the time ``t`` (``Lagrangian.time``: unless a coordinate is called ``t``).
 
     Raises
     ------
@@ -72,6 +77,9 @@ def parse_gauge_condition(text: str | sympy.Expr, analysis: Any) -> sympy.Expr:
     """
     names: dict[str, sympy.Symbol] = dict(analysis.symbols)
     names.update({p.name: p for p in analysis.parameters})
+    time = analysis.lagrangian.time  # None when a coordinate is called t
+    if time is not None and time.name not in names:
+        names[time.name] = time
     if isinstance(text, str):
         try:
             tree = ast.parse(text.strip(), mode="eval")
@@ -81,15 +89,10 @@ def parse_gauge_condition(text: str | sympy.Expr, analysis: Any) -> sympy.Expr:
             for node in ast.walk(tree):
                 if isinstance(node, ast.Name) and node.id not in names and node.id not in ALLOWED_FUNCTIONS \
                         and node.id not in ALLOWED_CONSTANTS:
-                    hint = ""
-                    if node.id == "t":
-                        hint = (
-                            "; a time-dependent gauge needs the explicit time of the evolution, which the "
-                            "analysis does not have: give conditions in the phase-space variables"
-                        )
                     raise InputError(
                         f"gauge condition {text!r}: unknown name {node.id!r}{did_you_mean(node.id, names)}; "
-                        f"the phase-space variables are {', '.join(analysis.symbols)}{hint}"
+                        f"the phase-space variables are {', '.join(analysis.symbols)}"
+                        + (f" and {time} is the time" if time is not None else "")
                     )
         expr = parse_expression(text, names, what="gauge condition")
     else:
@@ -125,7 +128,8 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
         lists them as given, ``first_class`` holds the first-class constraints that
         remain (none when the gauge is fixed completely), the multipliers fixed by the
         preservation of the conditions are in ``multipliers``, and ``dirac_bracket`` is
-        the Dirac bracket (240) in this gauge.
+        the Dirac bracket (240) in this gauge. When a condition names the time ``t``,
+        ``time`` is ``t`` (the analysis is time dependent; the multipliers may depend on ``t``).
 
     Raises
     ------
@@ -148,12 +152,13 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
             f"(gauge condition(s) {', '.join(texts)})"
         )
     space = analysis._space
-    numerics = Numerics(space, analysis._generic, seed=20240607)
+    time = _gauge_time(analysis, exprs)
+    numerics = Numerics(space, analysis._generic, seed=20240607, time=time)
     constraints = list(analysis.constraints) + exprs
     pb = space.poisson_bracket
     points, singular = _regular_points(analysis.name, texts, exprs, first, constraints, numerics, pb)
     split = first_class_hamiltonian(analysis)
-    solved, remaining = _preserve(analysis, texts, exprs, split, points, numerics, pb)
+    solved, remaining = _preserve(analysis, texts, exprs, split, points, numerics, pb, time)
     C = bracket_matrix(space, constraints)
     cls = classify(space, numerics, constraints, points, C)
     dim = space.dimension
@@ -167,6 +172,7 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
     fixed = copy.copy(analysis)
     fixed.constraints = constraints
     fixed.gauge_conditions = tuple(analysis.gauge_conditions) + tuple(texts)
+    fixed.time = time
     fixed.first_class = cls.first_class
     fixed.second_class = cls.second_class
     fixed.bracket_matrix_rank = cls.rank
@@ -194,6 +200,12 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
         + ")"
         + (f"; partial gauge fixing, first class still: {left}" if cls.first_class else "; the gauge is fixed completely")
     ]
+    if time is not None and analysis.time is None:
+        fixed.notes.append(
+            "time-dependent gauge: the conditions depend on t, so the gauge-fixed system is time dependent; "
+            "their preservation is d chi/dt = {chi, H_T} + d_t chi = 0, points carry t, and the equations of "
+            "motion have the explicit-time term of the Dirac bracket"
+        )
     if singular:
         fixed.notes.append(
             f"{singular} sampled point(s) of the gauge surface were singular for the gauge (the brackets of the "
@@ -201,6 +213,17 @@ def fix_gauge(analysis: Any, conditions: Sequence[str | sympy.Expr] | str | symp
             "the gauge is not valid at such points"
         )
     return fixed
+
+
+def _gauge_time(analysis: Any, exprs: Sequence[sympy.Expr]) -> sympy.Symbol | None:
+    """The time ``t`` of the gauge-fixed system: that of ``analysis`` when it is time dependent,
+    else ``t`` when a condition names it (a time-dependent gauge), else ``None``."""
+    if analysis.time is not None:
+        return analysis.time
+    t = analysis.lagrangian.time
+    if t is not None and any(t in chi.free_symbols for chi in exprs):
+        return t
+    return None
 
 
 def _weak_values(numerics: Numerics, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
@@ -286,8 +309,11 @@ def _regular_points(name, texts, exprs, first, constraints, numerics, pb) -> tup
     return regular[:SAMPLE_POINTS], len(sampled) - len(regular)
 
 
-def _preserve(analysis, texts, exprs, split, points, numerics, pb) -> tuple[dict[str, sympy.Expr], set[str]]:
-    """Solve ``{chi, H'} + {chi, gamma_f} v_f ~ 0`` for the free multipliers.
+def _preserve(analysis, texts, exprs, split, points, numerics, pb, time=None) -> tuple[dict[str, sympy.Expr], set[str]]:
+    """Solve ``{chi, H'} + {chi, gamma_f} v_f + d_t chi ~ 0`` for the free multipliers.
+
+    ``d_t chi`` is the partial derivative by the time ``time`` (none when ``time`` is
+    ``None``); the solved multipliers may then depend on ``t``.
 
     Returns ``(solved, remaining)``: multiplier name -> expression for every multiplier
     that the preservation fixes (the free ``u_f = v_f`` and the ``u_q = U_q + v_f V_fq``
@@ -304,7 +330,7 @@ def _preserve(analysis, texts, exprs, split, points, numerics, pb) -> tuple[dict
     gammas = split.primary_first_class
     H1 = split.hamiltonian
     c, F = len(exprs), len(gammas)
-    e_sym = [pb(chi, H1) for chi in exprs]
+    e_sym = [pb(chi, H1) + (sympy.diff(chi, time) if time is not None else sympy.S.Zero) for chi in exprs]
     B_sym = sympy.Matrix(c, F, lambda i, f: pb(exprs[i], gammas[f]))
     zero = numerics.weakly_zero(list(B_sym), points) if F else []
     B_sym = sympy.Matrix(c, F, lambda i, f: sympy.S.Zero if zero[i * F + f] else B_sym[i, f])
@@ -320,9 +346,10 @@ def _preserve(analysis, texts, exprs, split, points, numerics, pb) -> tuple[dict
         i = int(np.argmax(bad))
         zero_row = F == 0 or bool(numerics.weakly_zero(list(B_sym[i, :]), points).all())
         derivative = tidy(e_sym[i], variables)
+        kind = "time-dependent gauge condition" if time is not None and time in exprs[i].free_symbols else "gauge condition"
         if zero_row:
             raise InputError(
-                f"gauge condition {texts[i]!r} is not preserved in time: its time derivative {derivative} does not "
+                f"{kind} {texts[i]!r} is not preserved in time: its time derivative {derivative} does not "
                 "vanish on the gauge surface and no free multiplier enters it; add it as a further gauge condition "
                 f"(--gauge '{derivative}')"
             )

@@ -24,7 +24,9 @@ over the constraints (:func:`_expansion`). In abelian models ``c = 0``; in a
 Yang–Mills-type model they give the covariant derivative ``delta A = eps_dot + [eps, A]``.
 Second-class constraints vanish strongly in the Dirac bracket, so with second-class
 constraints "PFC" is read modulo them (their gradients are allowed in the closing test;
-Henneaux–Teitelboim, ch. 3).
+Henneaux–Teitelboim, ch. 3). For a time-dependent analysis (constraints, ``H'`` or gauge
+conditions with an explicit ``t``) every ``{X, H'}`` above is ``{X, H'} + d_t X``, since
+``dG/dt = d_t G + {G, H_T}`` with ``d_t`` acting on the ``eps^(k)`` and on ``t`` alike.
 
 The conditions are exactly ``dG/dt = dG/dt|_eps + {G, H_T} = PFC`` for every ``eps(t)``:
 then ``delta z`` maps solutions of ``z_dot = {z, H_T}`` to solutions, with the free
@@ -118,7 +120,10 @@ class FirstClassHamiltonian:
 
 
 def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
-    """Solve ``{Phi_i, H_c} + A_ia u_a ~ 0``, ``A_ia = {Phi_i, phi_a}``, as ``u = U + v_f V_f``.
+    """Solve ``{Phi_i, H_c} + d_t Phi_i + A_ia u_a ~ 0``, ``A_ia = {Phi_i, phi_a}``, as ``u = U + v_f V_f``.
+
+    ``d_t Phi_i``, the partial time derivative, is there only for a time-dependent
+    analysis (``analysis.time``; constraints or gauge conditions that name ``t``).
 
     Pivot rows ``P`` and columns ``Q`` of ``A`` (numeric rank at the surface points; the
     multipliers the analysis reports as determined come first among the columns) give
@@ -139,7 +144,8 @@ def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
     A = sympy.Matrix(m, K, lambda i, a: pb(constraints[i], primary[a]))
     zero = numerics.weakly_zero(list(A), points)
     A = sympy.Matrix(m, K, lambda i, a: sympy.S.Zero if zero[i * K + a] else A[i, a])
-    b = sympy.Matrix([pb(c, H_c) for c in constraints])
+    time = getattr(analysis, "time", None)  # d Phi/dt = {Phi, H_T} + d_t Phi for a time-dependent system
+    b = sympy.Matrix([pb(c, H_c) + (sympy.diff(c, time) if time is not None else 0) for c in constraints])
     A_num = numerics.evaluate(list(A), points).reshape(len(points), m, K)
     b_num = numerics.evaluate(list(b), points).reshape(len(points), m)
     rows = independent(list(A_num), list(range(m)))
@@ -332,20 +338,27 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     limit = len(analysis.stages) + 1
     structure = GaugeStructure(second_class_present=bool(second), gauge_fixed=bool(analysis.gauge_conditions))
     multiplier_names = [u.name for u in analysis.primary_multipliers]
-    secondary = [space.poisson_bracket(g, H1) for g in gammas]  # S_a = {gamma_a, H'}
+    time = getattr(analysis, "time", None)
+
+    def evolve(G: sympy.Expr) -> sympy.Expr:
+        """``{G, H'} + d_t G``: the d_t term only for a time-dependent analysis (Castellani's
+        conditions with ``dG/dt = d_t G + {G, H_T}``)."""
+        return space.poisson_bracket(G, H1) + (sympy.diff(G, time) if time is not None else sympy.S.Zero)
+
+    secondary = [evolve(g) for g in gammas]  # S_a = {gamma_a, H'} (+ d_t gamma_a)
     expansion_basis = gammas + secondary + constraints
     for index, (gamma, f) in enumerate(zip(gammas, split.free), start=1):
         chain = [gamma]  # G_N, G_{N-1}, ...
         closed = False
         for _ in range(limit):
-            R = space.poisson_bracket(chain[-1], H1)
+            R = evolve(chain[-1])
             if R == 0 or _closes(space, numerics, R, points, closing_basis):
                 closed = True
                 break
             # G_(k-1) = -R + c_a gamma_a: c_a cancels the S_a-components of {R, H'}, so that
             # {G_(k-1), H'} = -{R, H'} + c_a S_a + PFC loses them (Castellani's PFC freedom)
             following = -R
-            coefficients = _expansion(space, numerics, space.poisson_bracket(R, H1), expansion_basis, points)
+            coefficients = _expansion(space, numerics, evolve(R), expansion_basis, points)
             if coefficients is not None:
                 c = coefficients[len(gammas) : 2 * len(gammas)]
                 following += sum((ca * ga for ca, ga in zip(c, gammas)), sympy.S.Zero)
@@ -354,7 +367,7 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
             structure.unclosed.append(gamma)
             continue
         problem = _first_class_problem(space, numerics, chain, constraints, points) or _chain_problem(
-            space, numerics, list(reversed(chain)), H1, points, closing_basis
+            space, numerics, list(reversed(chain)), H1, points, closing_basis, time
         )
         if problem:
             structure.rejected.append(f"the chain started at {gamma} was built, but {problem}: no generator is reported for it")
@@ -413,13 +426,17 @@ def _closes(space: PhaseSpace, numerics, R: sympy.Expr, points, basis: np.ndarra
     return bool(_in_span(_gradients(space, numerics, [R], points), basis)[0])
 
 
-def _chain_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], H1: sympy.Expr, points, basis) -> str:
+def _chain_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], H1: sympy.Expr, points, basis, time=None) -> str:
     """Castellani's conditions, checked on the final terms ``(G_0, ..., G_N)``: ``G_N`` and every
     ``G_(k-1) + {G_k, H'}`` and ``{G_0, H'}`` are primary first-class combinations (modulo
     second class) at the surface points; together they say ``dG/dt ~ PFC`` for every
     ``eps(t)``, i.e. that ``delta z = {z, G}`` maps solutions of the equations of motion to
-    solutions. Returns what fails, or ``""``."""
-    pb = space.poisson_bracket
+    solutions. For a time-dependent analysis (``time`` given) each ``{G_k, H'}`` is
+    ``{G_k, H'} + d_t G_k``. Returns what fails, or ``""``."""
+
+    def pb(G: sympy.Expr, H: sympy.Expr) -> sympy.Expr:
+        return space.poisson_bracket(G, H) + (sympy.diff(G, time) if time is not None else sympy.S.Zero)
+
     conditions = [terms[-1], pb(terms[0], H1)] + [terms[k - 1] + pb(terms[k], H1) for k in range(1, len(terms))]
     for c in conditions:
         if not (sympy.expand(c) == 0 or _closes(space, numerics, c, points, basis)):

@@ -30,6 +30,8 @@ class AnalysisResult(Protocol):
     @property
     def lagrangian(self) -> Lagrangian: ...
     @property
+    def time(self) -> sympy.Symbol | None: ...
+    @property
     def coordinates(self) -> Sequence[sympy.Symbol]: ...
     @property
     def phase_space(self) -> Sequence[sympy.Symbol]: ...
@@ -156,8 +158,8 @@ def to_json(analysis: AnalysisResult) -> dict:
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
     ``bracket_strategy``, ``notes``, ``reducible_constraints`` (constraints that hold but
     depend on the kept independent set), ``special_parameter_values`` (list of
-    ``{"parameter", "value", "where"}``), ``time_dependent`` (``L`` or a constraint depends
-    explicitly on the time ``t``); ``multiplier_solution`` (the general solution
+    ``{"parameter", "value", "where"}``), ``time_dependent`` (``L``, a constraint or a gauge
+    condition depends explicitly on the time ``t``); ``multiplier_solution`` (the general solution
     ``u = U + v_a V_a``: ``particular``, ``null_vectors``, ``free``);
     ``multiplier_subexpressions`` (name -> text) when a multiplier is too large to print
     as one tree: its text then uses those names (see :func:`shared_form`). Gauge keys:
@@ -190,7 +192,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         "notes": list(analysis.notes) + list(gauge.notes),
         "reducible_constraints": [expression_text(c) for c in analysis.reducible_constraints],
         "special_parameter_values": [s.to_json() for s in analysis.special_parameter_values],
-        "time_dependent": analysis.lagrangian.is_time_dependent,
+        "time_dependent": analysis.time is not None,
         "gauge_generators": [{"terms": [expression_text(g) for g in gen.terms]} for gen in gauge.generators],
         "gauge_transformations": [
             {
@@ -276,7 +278,7 @@ def to_text(analysis: AnalysisResult) -> str:
     lines.append(f"  L = {_short(a.lagrangian.expression)}")
     for k, chi in enumerate(a.lagrangian.constraints, start=1):
         lines.append(f"  constraint {k}: {chi} = 0   (multiplier lambda_{k})")
-    if a.lagrangian.is_time_dependent:
+    if a.time is not None:
         lines.append("time-dependent: t occurs explicitly; consistency is d Phi/dt = {Phi, H_T} + d_t Phi = 0")
     lines.append(
         f"phase space: {2 * n} dimensions ({', '.join(s.name for s in a.coordinates)} and their momenta)"
@@ -368,7 +370,7 @@ def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
     rows.append(rf"L &= {lx(a.lagrangian.expression)}")
     for k, chi in enumerate(a.lagrangian.constraints, start=1):
         rows.append(rf"\chi_{{{k}}} &= {lx(chi)} = 0")
-    if a.lagrangian.is_time_dependent:
+    if a.time is not None:
         rows.append(r"&\text{time-dependent: } \frac{d\Phi}{dt} = \{\Phi, H_T\} + \partial_t \Phi")
     rows.append(rf"H_c &= {lx(a.canonical_hamiltonian)}")
     for k, stage in enumerate(a.stages, start=1):

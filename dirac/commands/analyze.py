@@ -38,7 +38,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         action="append",
         default=[],
         metavar="EXPR",
-        help="add the gauge condition EXPR = 0 (repeatable; names as in the phase space, e.g. z, y, p_z) and "
+        help="add the gauge condition EXPR = 0 (repeatable; names as in the phase space, e.g. z, y, p_z, and "
+        "the time t unless t is a coordinate) and "
         "analyse the gauge-fixed system: Dirac bracket in that gauge, first-class constraints left",
     )
     output = parser.add_mutually_exclusive_group()

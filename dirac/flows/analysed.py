@@ -106,7 +106,7 @@ class AnalysedSystem:
             ``analysis`` is not an analysis, a parameter still symbolic in it has no
             default value, or a multiplier name is not a free multiplier;
             :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a system that
-            depends explicitly on the time ``t``.
+            depends explicitly on the time ``t`` or is analysed in a time-dependent gauge.
         """
         from dirac.codegen import GeneratedFunction, array_function, generate_module
         from dirac.flows.mechanics import refuse_time_dependent
@@ -114,7 +114,7 @@ class AnalysedSystem:
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
             raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
-        refuse_time_dependent(lagrangian)
+        refuse_time_dependent(lagrangian, analysis)
         defaults = {p: float(v) for p, v in lagrangian.parameters.items() if v is not None}
         missing = [p.name for p in lagrangian.parameters if p not in defaults]
         if missing:

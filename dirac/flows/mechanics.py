@@ -46,8 +46,15 @@ class TimeDependentSystemError(InputError):
     flows integrate autonomous systems only, so they refuse it instead of freezing ``t``."""
 
 
-def refuse_time_dependent(lagrangian: Lagrangian) -> None:
-    """Raise :class:`TimeDependentSystemError` when ``lagrangian`` depends explicitly on ``t``."""
+def refuse_time_dependent(lagrangian: Lagrangian, analysis: object | None = None) -> None:
+    """Raise :class:`TimeDependentSystemError` when ``lagrangian`` depends explicitly on ``t``,
+    or when ``analysis`` of it does (a time-dependent gauge such as ``x0 - t``)."""
+    if analysis is not None and getattr(analysis, "time", None) is not None and not lagrangian.is_time_dependent:
+        raise TimeDependentSystemError(
+            f"the gauge conditions {', '.join(getattr(analysis, 'gauge_conditions', ()))} of {lagrangian.name!r} "
+            "depend explicitly on the time t: the numerical flows integrate only systems without explicit time "
+            "dependence; use a gauge without t for a flow, or equations_of_motion of the analysis"
+        )
     if lagrangian.is_time_dependent:
         raise TimeDependentSystemError(
             f"system {lagrangian.name!r} depends explicitly on the time t (a rheonomic system): the "
