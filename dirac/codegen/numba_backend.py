@@ -38,7 +38,7 @@ import sympy
 
 from dirac.codegen.printer import flat_expressions, straight_line
 
-__all__ = ["GeneratedFunction", "generate_module", "cache_directory"]
+__all__ = ["GeneratedFunction", "generate_module", "import_source", "cache_directory"]
 
 
 @dataclass(frozen=True)
@@ -132,6 +132,16 @@ def generate_module(
     ]
     body = [_function_source(f, parameters) for f in functions]
     source = "\n".join(header) + "\n\n".join(body) + "\n\n" + extra_source
+    return import_source(source)
+
+
+def import_source(source: str) -> ModuleType:
+    """Write ``source`` to ``dirac_gen_<hash>.py`` in :func:`cache_directory` (unless a file
+    of that name holds it already) and import it, once per process.
+
+    The module name is the hash of the source, so numba's on-disk cache of the module's
+    ``cache=True`` functions is reused by every later run that generates the same source.
+    """
     digest = hashlib.sha256(source.encode()).hexdigest()[:20]
     module_name = f"dirac_gen_{digest}"
     if module_name in sys.modules:

@@ -73,21 +73,20 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         n = self.mechanics.dimension
         self.q = self.z[:, :n]
         self.p = self.z[:, n:]
-        self._kernel = kernels.midpoint_run
+        self._kernel = self.mechanics.module.midpoint_run
 
     def warm_up(self) -> None:
-        n, m = self.mechanics.dimension, self.mechanics.n_constraints
-        with kernels.quiet():
-            self._kernel(0, self.mechanics.functions, self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
+        self._kernel(self.z[0].copy(), self.time, self.mechanics.params, 1e-6, 1, self.tol, self.max_iter, self.info)
 
     def step(self, n_steps: int, dt: float) -> None:
-        n, m = self.mechanics.dimension, self.mechanics.n_constraints
         for b in range(self.z.shape[0]):
-            with kernels.quiet(), singular_as_step_failure("midpoint"):
-                self._kernel(0, self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
+            with singular_as_step_failure("midpoint"):
+                self._kernel(self.z[b], self.time, self.mechanics.params, dt, n_steps, self.tol, self.max_iter,
+                             self.info)
             self.evaluations += int(self.info[2])
             self._raise_if_failed("midpoint")
         self.steps += n_steps
+        self.time += n_steps * dt
 
 
 class AnalysedMidpointStepper(Stepper):

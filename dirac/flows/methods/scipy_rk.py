@@ -110,7 +110,7 @@ class ScipyStepper(Stepper):
             return analysed_outputs(self.analysed, self.outputs, self.y)
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
-            return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:])
+            return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:], self.t)
 
         M = self.y[:, :3]
         R = self.y[:, 3:].reshape(-1, 3, 3) if self.with_R else None
@@ -121,7 +121,7 @@ class ScipyStepper(Stepper):
             return max(self.analysed.constraint_residual(y) for y in self.y)
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
-            return max(self.problem.mechanics.constraint_residual(y[:n], y[n:]) for y in self.y)
+            return max(self.problem.mechanics.constraint_residual(y[:n], y[n:], self.t) for y in self.y)
         return 0.0  # RK methods do not preserve R^T R = 1; that is what the baseline shows
 
 
