@@ -75,8 +75,8 @@ def dirac_projection(D, e, out, C, rhs, mu, piv):
 def midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info):
     """Implicit midpoint z1 = z0 + dt F((z0 + z1)/2, t + dt/2) on the Dirac vector field
     F of this module (Hairer, Lubich & Wanner IV.2), simplified Newton with a
-    finite-difference Jacobian of F at z0 per step, factored once per step; PROJECT
-    (analysed systems) then projects onto Phi = 0 (Hairer, Lubich & Wanner IV.4)."""
+    finite-difference Jacobian of F at z0 per step, factored once per step; an analysed
+    system then projects onto Phi = 0 (Hairer, Lubich & Wanner IV.4)."""
     NZ = z.shape[0]
     f = np.empty(NZ)
     fz = np.empty(NZ)
@@ -87,6 +87,7 @@ def midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info):
     J = np.empty((NZ, NZ))
     piv = np.empty(NZ, dtype=np.int64)
     work = field_work()
+    PROJECT_WORK
     evals = 0.0
     size = 0.0
     for step in range(n_steps):
@@ -541,16 +542,19 @@ def field_into(z, t, c, out, work):
 
 
 @numba.njit(cache=True)
-def project(z, t, c, tol):
+def project_work():
+    """Work arrays of project."""
+    return (np.empty(__K__), np.empty(__K__), np.empty((__K__, 2 * __N__)), np.empty((__K__, __K__)),
+            np.empty(__K__, dtype=np.int64))
+
+
+@numba.njit(cache=True)
+def project(z, t, c, tol, work):
     """Orthogonal projection of z onto Phi = 0 (Gauss-Newton, at most 5 iterations):
     z <- z - D^T (D D^T)^{-1} Phi(z) (Hairer, Lubich & Wanner IV.4)."""
     if __K__ == 0:
         return
-    phi = np.empty(__K__)
-    y = np.empty(__K__)
-    D = np.empty((__K__, 2 * __N__))
-    A = np.empty((__K__, __K__))
-    piv = np.empty(__K__, dtype=np.int64)
+    phi, y, D, A, piv = work
     for _it in range(5):
         second_class(z, t, c, phi)
         size = 0.0
@@ -598,7 +602,7 @@ def mechanical_templates(n: int, m: int) -> str:
     """Step loops of a mechanical system with ``n`` coordinates and ``m`` constraints:
     ``rattle_constant_mass``, ``rattle_general``, ``field``, ``midpoint_run``,
     ``energy``, ``residuals`` (and their helpers)."""
-    common = _COMMON.replace("        PROJECT\n", "")
+    common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
     return _fill(_MECHANICAL + common, n, m, 2 * m)
 
 
@@ -606,5 +610,6 @@ def analysed_templates(n: int, k: int) -> str:
     """Step loops of an analysed system (``2n`` phase-space variables, ``k`` second-class
     constraints): ``field``, ``midpoint_run`` (projected), ``project``, ``energy``,
     ``residuals``."""
-    common = _COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol)\n")
+    common = (_COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol, project_buffers)\n")
+              .replace("    PROJECT_WORK\n", "    project_buffers = project_work()\n"))
     return _fill(_ANALYSED + common, n, 0, k)

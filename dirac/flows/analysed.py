@@ -7,8 +7,9 @@ coordinates and multipliers, then their momenta), the numerical Hamiltonian vect
     C_ab = {Phi_a, Phi_b}  (240),
 
 over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
-``grad Phi`` are generated from sympy (:mod:`dirac.codegen.numba_backend`), ``C`` is evaluated and
-solved numerically at each point (:func:`dirac.flows.constrained_kernels.analysed_field`).
+``grad Phi`` are generated from sympy into one kernel module with the field and the
+midpoint step loop (:func:`dirac.codegen.kernel_source.analysed_kernel_source`); ``C`` is
+evaluated and solved numerically at each point.
 ``H`` is the canonical Hamiltonian; with first-class constraints the gauge ``u = 0`` is
 taken (their multipliers stay arbitrary in ``H_T``). This path takes every Lagrangian the
 engine can analyse, also those that :class:`MechanicalSystem` refuses (terms linear in the
@@ -49,7 +50,6 @@ class AnalysedSystem:
     parameter_values: dict[str, float]
     params: np.ndarray
     module: Any
-    functions: tuple
     analysis: ConstraintAnalysis = field(repr=False)
     momenta: Callable[..., np.ndarray] = field(repr=False)
 
@@ -94,7 +94,8 @@ class AnalysedSystem:
             ``analysis`` is not an analysis, or a parameter still symbolic in it has no
             default value.
         """
-        from dirac.codegen import GeneratedFunction, array_function, generate_module
+        from dirac.codegen import array_function
+        from dirac.codegen.kernel_source import analysed_kernel_source, load_kernels
 
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
@@ -109,17 +110,8 @@ class AnalysedSystem:
         z = tuple(analysis.phase_space)
         H = analysis.canonical_hamiltonian
         constraints = list(analysis.second_class)
-        gradient = [sympy.diff(H, s) for s in z]
-        jacobian = [sympy.diff(c, s) for c in constraints for s in z]
-        generated = [
-            GeneratedFunction("hamiltonian_gradient", z, gradient, "grad H over the phase space"),
-            GeneratedFunction("second_class", z, constraints, "second-class constraints Phi"),
-            GeneratedFunction("second_class_jacobian", z, jacobian, "grad Phi, (k, N)"),
-            GeneratedFunction("hamiltonian", z, [H], "canonical Hamiltonian H_c"),
-        ]
-        module = generate_module(generated, list(defaults), title=f"analysed system {lagrangian.name}")
-        g = module.hamiltonian_gradient
-        functions = (g, module.second_class, module.second_class_jacobian, module.hamiltonian, g, g, g)
+        module = load_kernels(analysed_kernel_source(z, list(defaults), H, constraints, getattr(lagrangian, "time", None),
+                                                     title=f"analysed system {lagrangian.name}"))
         velocities = list(lagrangian.velocities)
         expression = lagrangian.expression.subs(defaults)
         momenta = array_function([list(lagrangian.coordinates), velocities],
@@ -132,34 +124,26 @@ class AnalysedSystem:
             parameter_values={**lagrangian.fixed_values, **{p.name: v for p, v in defaults.items()}},
             params=np.array(list(defaults.values()), dtype=float),
             module=module,
-            functions=functions,
             analysis=analysis,
             momenta=momenta,
         )
 
-    def _call(self, name: str, z: np.ndarray, size: int) -> np.ndarray:
-        from dirac.flows.constrained_kernels import call
+    def energy(self, z: np.ndarray, time: float = 0.0) -> float:
+        """``H_c(z, t)`` (generated kernel ``energy``)."""
+        return float(self.module.energy(np.ascontiguousarray(z, dtype=float), float(time), self.params))
 
-        return call(getattr(self.module, name), z, self.params, size)
-
-    def energy(self, z: np.ndarray) -> float:
-        """``H_c(z)``."""
-        return float(self._call("hamiltonian", z, 1)[0])
-
-    def constraint_residual(self, z: np.ndarray) -> float:
-        """``max |Phi(z)|`` over the second-class constraints."""
+    def constraint_residual(self, z: np.ndarray, time: float = 0.0) -> float:
+        """``max |Phi(z, t)|`` over the second-class constraints (generated kernel ``residuals``)."""
         if self.n_constraints == 0:
             return 0.0
-        return float(np.max(np.abs(self._call("second_class", z, self.n_constraints))))
+        out = np.empty(self.n_constraints)
+        self.module.residuals(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
+        return float(np.max(np.abs(out)))
 
-    def field(self, z: np.ndarray) -> np.ndarray:
-        """``z_dot`` at ``z``."""
-        from dirac.flows.constrained_kernels import analysed_field, quiet
-
+    def field(self, z: np.ndarray, time: float = 0.0) -> np.ndarray:
+        """``z_dot`` at ``z`` and ``time`` (generated kernel ``field``)."""
         out = np.empty(self.dimension)
-        with quiet():
-            analysed_field(self.functions, np.ascontiguousarray(z, dtype=float), self.params, self.dimension // 2,
-                           self.n_constraints, out)
+        self.module.field(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
         return out
 
     def initial_state(self, q: dict[str, float], q_dot: dict[str, float] | None = None,
@@ -225,7 +209,8 @@ class AnalysedProblem:
         return dict(self.analysed.parameter_values)
 
 
-def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.ndarray) -> dict[str, np.ndarray]:
+def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.ndarray,
+                     time: float = 0.0) -> dict[str, np.ndarray]:
     """Outputs of an analysed system from batched ``z`` (B, N): the state ``z``, its
     coordinate half ``q`` (coordinates and multipliers), momentum half ``p``, ``energy``
     (``H_c``) and ``constraint_residual`` (``max |Phi|``)."""
@@ -239,7 +224,7 @@ def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.nda
         elif name == "p":
             result[name] = z[:, half:].copy()
         elif name == "energy":
-            result[name] = np.array([analysed.energy(x) for x in z])
+            result[name] = np.array([analysed.energy(x, time) for x in z])
         elif name == "constraint_residual":
-            result[name] = np.array([analysed.constraint_residual(x) for x in z])
+            result[name] = np.array([analysed.constraint_residual(x, time) for x in z])
     return result
