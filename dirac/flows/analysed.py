@@ -94,8 +94,7 @@ class AnalysedSystem:
             ``analysis`` is not an analysis, or a parameter still symbolic in it has no
             default value.
         """
-        from dirac.codegen import array_function
-        from dirac.codegen.kernel_source import analysed_kernel_source, load_kernels
+        from dirac.codegen import analysed_kernel_source, array_function, load_kernels
 
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):

@@ -183,7 +183,7 @@ class MechanicalSystem:
         n, m = len(q), len(lagrangian.constraints)
         time = getattr(lagrangian, "time", None)
         constant = all(not (entry.free_symbols & {*q, *([time] if time is not None else [])}) for entry in mass)
-        from dirac.codegen.kernel_source import load_kernels, mechanical_kernel_source
+        from dirac.codegen import load_kernels, mechanical_kernel_source
 
         source = mechanical_kernel_source(q, parameter_symbols, mass, potential, list(chis), time,
                                           title=f"system {lagrangian.name}")
