@@ -34,6 +34,7 @@ import sympy
 from dirac.codegen.kernel_templates import analysed_templates, mechanical_templates
 from dirac.codegen.numba_backend import import_source
 from dirac.codegen.printer import flat_expressions, straight_line
+from dirac.codegen.rattle_scalar import constant_mass_rattle_source
 from dirac.codegen.small_solves import lu_source, solve_source
 
 __all__ = ["mechanical_kernel_source", "analysed_kernel_source", "load_kernels"]
@@ -44,6 +45,11 @@ import numpy as np
 import numba
 
 '''
+
+
+#: the decorator of the expression functions and small helpers: compiled into their callers
+#: (numba inlines them at its own IR level, so the step loop holds straight-line code)
+INLINED = '@numba.njit(cache=True, inline="always")'
 
 
 def _index(position: int, shape: tuple[int, ...]) -> str:
@@ -67,7 +73,7 @@ def emit_function(
     """Source of ``@njit def name(<arrays>, <scalars>, c, out)`` filling ``out`` of ``shape``.
 
     ``arrays`` binds each symbol of a sequence to an entry of the named argument
-    (``q[0]``, ...), ``scalars`` a symbol to a named scalar argument (``None``: an argument
+    (``q[0]``, ...; of a sympy matrix to ``G[a, j]``), ``scalars`` a symbol to a named scalar argument (``None``: an argument
     no expression uses, e.g. the time of a time-independent system), ``parameters`` to
     the entries of ``c``; with ``shape = None`` the function returns its one expression
     instead of filling ``out``.
@@ -76,10 +82,11 @@ def emit_function(
     lines: list[str] = []
     argument_names = [array for array, _ in arrays] + [scalar for scalar, _ in scalars] + ["c"]
     for array, symbols in [*arrays, ("c", parameters)]:
+        where = tuple(symbols.shape) if isinstance(symbols, sympy.MatrixBase) else (len(symbols),)
         for index, symbol in enumerate(symbols):
             local = f"{array}{index}_"
             inputs[symbol] = local
-            lines.append(f"    {local} = {array}[{index}]")
+            lines.append(f"    {local} = {array}[{_index(index, where)}]")
     for scalar, symbol in scalars:
         if symbol is not None:
             inputs[symbol] = f"{scalar}_"
@@ -95,7 +102,7 @@ def emit_function(
         lines.extend(f"    out[{_index(k, shape)}] = {value}" for k, value in enumerate(code.outputs))
         if not code.outputs:
             lines.append("    return")
-    return "\n".join(["@numba.njit(cache=True)", f"def {name}({signature}):", f'    """{doc}"""', *lines]) + "\n"
+    return "\n".join([INLINED, f"def {name}({signature}):", f'    """{doc}"""', *lines]) + "\n"
 
 
 def _solves(sizes: set[int]) -> str:
@@ -165,6 +172,9 @@ def mechanical_kernel_source(
         emit_function("mass_dq_v", "[k, i] = sum_j dM_ij/dq_k v_j, (n, n)", qva, ts, dmass_v, (n, n), parameters),
         emit_function("mass_dt_v", "(dM/dt) v, (n,)", qva, ts, mass_dt_v, (n,), parameters),
     ]
+    constant = not any(entry.free_symbols & {*q, *([time] if time is not None else [])} for entry in mass)
+    if constant:  # M^{-1} once, symbolically; the constant-mass RATTLE is unrolled into scalars
+        functions.append(constant_mass_rattle_source(q, parameters, mass.inv(), potential, list(chi), time))
     body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m)
     return _HEADER.format(title=title) + body
 

@@ -18,7 +18,7 @@ __all__ = ["mechanical_templates", "analysed_templates"]
 
 _COMMON = '''
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def max_abs(x):
     """max |x_i| (inf if any entry is NaN)."""
     r = 0.0
@@ -29,7 +29,7 @@ def max_abs(x):
     return r
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def scale(x, count):
     """1 + sum of x_i^2 over the first count entries: the scale of Newton tolerances."""
     s = 1.0
@@ -38,7 +38,7 @@ def scale(x, count):
     return s
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def report(info, steps_done, failed, evals, residual):
     """info = [steps_done, failed (0/1), evaluations, last_residual]."""
     info[0] = steps_done
@@ -144,7 +144,7 @@ def field(z, t, c, out):
 
 _MECHANICAL = '''
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def velocity(q, p, t, c, v, work, piv):
     """v = M(q, t)^{-1} p; work (n, n) keeps the LU factors of M, piv their row exchanges."""
     mass(q, t, c, work)
@@ -154,7 +154,7 @@ def velocity(q, p, t, c, v, work, piv):
     lu_solve(work, piv, v)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def project_momentum(G, W, u, chi_t, p, h, S, rhs, mu, piv):
     """RATTLE's closing projection onto the hidden constraints G M^{-1} p + d chi/dt = 0:
     with G at the new position, W = M^{-1} G^T and u = M^{-1} p, solve
@@ -176,127 +176,6 @@ def project_momentum(G, W, u, chi_t, p, h, S, rhs, mu, piv):
         for a in range(__M__):
             acc += G[a, i] * mu[a]
         p[i] -= 0.5 * h * acc
-
-
-@numba.njit(cache=True)
-def rattle_constant_mass(q, p, t, minv, c, fractions, dt, n_steps, tol, max_iter, info):
-    """RATTLE (Andersen 1983; Hairer, Lubich & Wanner VII.1.4) with a constant mass M,
-    composed with the sub-steps h = dt fractions[s]:
-
-    p_half = p - h/2 (grad V(q, t) + G(q, t)^T lam),  q1 = q + h M^{-1} p_half,
-    chi(q1, t + h) = 0,  p1 = p_half - h/2 (grad V(q1, t + h) + G(q1, t + h)^T mu),
-    G(q1, t + h) M^{-1} p1 + d chi/dt (q1, t + h) = 0.
-
-    Newton on lam (m unknowns, matrix -h^2/2 G(q1) M^{-1} G(q)^T); mu from an m x m solve."""
-    q_save = np.empty(__N__)
-    p_save = np.empty(__N__)
-    gv = np.empty(__N__)
-    G0 = np.zeros((__M__, __N__))
-    G1 = np.zeros((__M__, __N__))
-    chi = np.zeros(__M__)
-    A = np.zeros((__N__, __M__))
-    lam = np.zeros(__M__)
-    d = np.zeros(__M__)
-    ph = np.empty(__N__)
-    qp = np.empty(__N__)
-    q1 = np.empty(__N__)
-    u = np.empty(__N__)
-    J = np.empty((__M__, __M__))
-    rhs = np.empty(__M__)
-    mu = np.empty(__M__)
-    piv = np.empty(__M__, dtype=np.int64)
-    evals = 0.0
-    residual = 0.0
-    for step in range(n_steps):
-        for i in range(__N__):
-            q_save[i] = q[i]
-            p_save[i] = p[i]
-        tau = t + step * dt
-        for s in range(fractions.shape[0]):
-            h = dt * fractions[s]
-            tau1 = tau + h
-            grad_potential(q, tau, c, gv)
-            evals += 1.0
-            for i in range(__N__):
-                ph[i] = p[i] - 0.5 * h * gv[i]
-            for i in range(__N__):
-                acc = 0.0
-                for j in range(__N__):
-                    acc += minv[i, j] * ph[j]
-                qp[i] = q[i] + h * acc
-            if __M__ > 0:
-                jacobian(q, tau, c, G0)
-                for i in range(__N__):
-                    for a in range(__M__):
-                        acc = 0.0
-                        for j in range(__N__):
-                            acc += minv[i, j] * G0[a, j]
-                        A[i, a] = acc
-                for a in range(__M__):
-                    lam[a] = 0.0
-                for i in range(__N__):
-                    q1[i] = qp[i]
-                converged = False
-                for _it in range(max_iter):
-                    constraints(q1, tau1, c, chi)
-                    evals += 1.0
-                    residual = max_abs(chi)
-                    if residual <= tol * scale(q1, __N__):
-                        converged = True
-                        break
-                    if residual != residual:
-                        break
-                    jacobian(q1, tau1, c, G1)
-                    for a in range(__M__):
-                        for b in range(__M__):
-                            acc = 0.0
-                            for i in range(__N__):
-                                acc += G1[a, i] * A[i, b]
-                            J[a, b] = -0.5 * h * h * acc
-                    solve___M__(J, chi, d, piv)
-                    for a in range(__M__):
-                        lam[a] -= d[a]
-                    for i in range(__N__):
-                        acc = 0.0
-                        for a in range(__M__):
-                            acc += A[i, a] * lam[a]
-                        q1[i] = qp[i] - 0.5 * h * h * acc
-                if not converged:
-                    for i in range(__N__):
-                        q[i] = q_save[i]
-                        p[i] = p_save[i]
-                    report(info, step, True, evals, residual)
-                    return
-                for i in range(__N__):
-                    acc = 0.0
-                    for a in range(__M__):
-                        acc += G0[a, i] * lam[a]
-                    ph[i] -= 0.5 * h * acc
-                    q[i] = q1[i]
-            else:
-                for i in range(__N__):
-                    q[i] = qp[i]
-            grad_potential(q, tau1, c, gv)
-            evals += 1.0
-            for i in range(__N__):
-                p[i] = ph[i] - 0.5 * h * gv[i]
-            if __M__ > 0:
-                jacobian(q, tau1, c, G1)
-                for i in range(__N__):
-                    for a in range(__M__):
-                        acc = 0.0
-                        for j in range(__N__):
-                            acc += minv[i, j] * G1[a, j]
-                        A[i, a] = acc
-                for j in range(__N__):
-                    acc = 0.0
-                    for i in range(__N__):
-                        acc += minv[i, j] * p[i]
-                    u[j] = acc
-                constraints_dt(q, tau1, c, chi)
-                project_momentum(G1, A, u, chi, p, h, J, rhs, mu, piv)
-            tau = tau1
-    report(info, n_steps, False, evals, residual)
 
 
 @numba.njit(cache=True)
@@ -600,8 +479,9 @@ def _fill(text: str, n: int, m: int, k: int) -> str:
 
 def mechanical_templates(n: int, m: int) -> str:
     """Step loops of a mechanical system with ``n`` coordinates and ``m`` constraints:
-    ``rattle_constant_mass``, ``rattle_general``, ``field``, ``midpoint_run``,
-    ``energy``, ``residuals`` (and their helpers)."""
+    ``rattle_general``, ``field``, ``midpoint_run``, ``energy``, ``residuals`` (and
+    their helpers). RATTLE with a constant mass is unrolled per system instead
+    (:mod:`dirac.codegen.rattle_scalar`)."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
     return _fill(_MECHANICAL + common, n, m, 2 * m)
 

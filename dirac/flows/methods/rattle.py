@@ -41,7 +41,6 @@ class RattleStepper(ConstrainedStepper):
         self.constant = self.mechanics.constant_mass is not None
         if self.constant:
             self.mechanics.mass_matrix(self.q[0])  # checks positivity
-            self.minv = np.linalg.inv(self.mechanics.constant_mass)
             self._kernel = self.mechanics.module.rattle_constant_mass
         else:
             for q in self.q:
@@ -51,8 +50,7 @@ class RattleStepper(ConstrainedStepper):
     def _call(self, q: np.ndarray, p: np.ndarray, n_steps: int, dt: float) -> None:
         params = self.mechanics.params
         if self.constant:
-            self._kernel(q, p, self.time, self.minv, params, self.fractions, dt, n_steps, self.tol, self.max_iter,
-                         self.info)
+            self._kernel(q, p, self.time, params, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
         else:
             self._kernel(q, p, self.time, params, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
 
