@@ -27,7 +27,7 @@ import numpy as np
 
 from dirac.bench.targets import Target
 
-__all__ = ["GeneralRow", "general_system_rows", "general_system_targets", "format_general_rows"]
+__all__ = ["GeneralRow", "general_system_rows", "general_system_targets", "format_general_rows", "measure_general_systems"]
 
 DT = 1e-3
 #: per-step ratio (generated / hand-written) that rattle-2 must reach
@@ -183,3 +183,16 @@ def format_general_rows(rows: list[GeneralRow]) -> str:
         lines.append(f"  {row.system:40s} {row.method:9s} {row.generated_ns:10.0f} {row.hand_ns:9.0f} "
                      f"{row.ratio:6.2f} {row.agreement:8.1e}")
     return "\n".join(lines)
+
+
+def measure_general_systems(quick: bool, targets: list[Target], notes: list[str],
+                            progress: Callable[[str], None]) -> list[GeneralRow]:
+    """The general-systems rows of ``dirac bench`` (their targets appended to ``targets``;
+    a failure becomes a note, as for every other measurement)."""
+    try:
+        rows = general_system_rows(5 if quick else 9, 20_000 if quick else 200_000, progress)
+    except Exception as exc:  # one failed measurement must not hide the others
+        notes.append(f"general systems: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
+        return []
+    targets.extend(general_system_targets(rows))
+    return rows

@@ -66,10 +66,13 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
                              "failed": f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}"})
     measured: list[Target] = []
     notes: list[str] = []
+    general_rows: list = []
     if targets:
+        from dirac.bench.general_systems import measure_general_systems
         from dirac.bench.targets import measure_targets
 
         measured, notes = measure_targets(quick, rows, say)
+        general_rows = measure_general_systems(quick, measured, notes, say)
     else:
         from dirac.bench.targets import work_precision_targets
 
@@ -81,6 +84,10 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
     print("CPU ms = median over repeats of the integration's CPU time (compiled kernels, warm-up excluded); "
           "errors at T against independent references")
     print(format_rows(rows))
+    if general_rows:
+        from dirac.bench.general_systems import format_general_rows
+
+        print(format_general_rows(general_rows))
     print(format_targets(measured))
     for note in notes:
         print(f"note: {note}")
@@ -92,6 +99,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         "elapsed_s": elapsed,
         "runs": rows,
         "targets": [t.as_dict() for t in measured],
+        "general_systems": [row.as_dict() for row in general_rows],
         "notes": notes,
     }
     if json_path:

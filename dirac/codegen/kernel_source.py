@@ -173,9 +173,18 @@ def mechanical_kernel_source(
         emit_function("mass_dt_v", "(dM/dt) v, (n,)", qva, ts, mass_dt_v, (n,), parameters),
     ]
     constant = not any(entry.free_symbols & {*q, *([time] if time is not None else [])} for entry in mass)
+    diagonal = all(mass[i, j] == 0 for i in range(n) for j in range(n) if i != j)
+    closed_velocity = diagonal or n <= 2
+    if closed_velocity:  # v = M^{-1} p in closed form (diagonal or 2 x 2 mass); else by elimination
+        p_symbols = [sympy.Symbol(f"_p{i}", real=True) for i in range(n)]
+        inverse = sympy.diag(*[1 / mass[i, i] for i in range(n)]) if diagonal else mass.inv()
+        source = emit_function("velocity", "v = M(q, t)^{-1} p in closed form, (n,)", [("q", q), ("p", p_symbols)], ts,
+                               list(inverse * sympy.Matrix(p_symbols)), (n,), parameters)
+        # the signature of the eliminating version: its work arrays are not needed here
+        functions.append(source.replace("def velocity(q, p, t, c, out):", "def velocity(q, p, t, c, out, work, piv):"))
     if constant:  # M^{-1} once, symbolically; the constant-mass RATTLE is unrolled into scalars
         functions.append(constant_mass_rattle_source(q, parameters, mass.inv(), potential, list(chi), time))
-    body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m)
+    body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m, not closed_velocity)
     return _HEADER.format(title=title) + body
 
 

@@ -47,7 +47,7 @@ def report(info, steps_done, failed, evals, residual):
     info[3] = residual
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def dirac_projection(D, e, out, C, rhs, mu, piv):
     """out <- out - J D^T C^{-1} (D out + e), C = D J D^T: the Dirac correction (240) of
     the Hamiltonian field out = J grad H over __K__ second-class constraints with gradients
@@ -142,7 +142,7 @@ def field(z, t, c, out):
     field_into(z, t, c, out, field_work())
 '''
 
-_MECHANICAL = '''
+_VELOCITY_BY_ELIMINATION = '''
 
 @numba.njit(cache=True, inline="always")
 def velocity(q, p, t, c, v, work, piv):
@@ -152,6 +152,9 @@ def velocity(q, p, t, c, v, work, piv):
     for i in range(__N__):
         v[i] = p[i]
     lu_solve(work, piv, v)
+'''
+
+_MECHANICAL = '''
 
 
 @numba.njit(cache=True, inline="always")
@@ -178,7 +181,7 @@ def project_momentum(G, W, u, chi_t, p, h, S, rhs, mu, piv):
         p[i] -= 0.5 * h * acc
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv):
     """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau)."""
     for i in range(__N__):
@@ -301,9 +304,9 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                 for a in range(__M__):
                     for i in range(__N__):
                         col[i] = G1[a, i]
-                    lu_solve(work, pivn, col)
+                    velocity(q, col, tau1, c, v, work, pivn)
                     for i in range(__N__):
-                        W[i, a] = col[i]
+                        W[i, a] = v[i]
                 constraints_dt(q, tau1, c, chi)
                 project_momentum(G1, W, u, chi, p, h, S, rhs, mu, pivm)
             tau = tau1
@@ -320,7 +323,7 @@ def field_work():
             np.empty(__N__))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def field_into(z, t, c, out, work):
     """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on z = (q, p),
     C = grad Phi J grad Phi^T, over the second-class constraints
@@ -340,9 +343,9 @@ def field_into(z, t, c, out, work):
     for a in range(__M__):
         for i in range(__N__):
             col[i] = G[a, i]
-        lu_solve(Mw, pivn, col)
+        velocity(q, col, t, c, f, Mw, pivn)
         for i in range(__N__):
-            W[i, a] = col[i]
+            W[i, a] = f[i]
     hidden_dq(q, v, t, c, Hq)
     mass_dq_v(q, v, t, c, dMv)
     for a in range(__M__):
@@ -403,7 +406,7 @@ def field_work():
             np.empty(__K__), np.empty(__K__), np.empty(__K__, dtype=np.int64))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def field_into(z, t, c, out, work):
     """z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on
     the phase space of the analysis (coordinates and multipliers, then their momenta),
@@ -427,7 +430,7 @@ def project_work():
             np.empty(__K__, dtype=np.int64))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def project(z, t, c, tol, work):
     """Orthogonal projection of z onto Phi = 0 (Gauss-Newton, at most 5 iterations):
     z <- z - D^T (D D^T)^{-1} Phi(z) (Hairer, Lubich & Wanner IV.4)."""
@@ -477,13 +480,16 @@ def _fill(text: str, n: int, m: int, k: int) -> str:
             .replace("__K__", str(k)))
 
 
-def mechanical_templates(n: int, m: int) -> str:
+def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     """Step loops of a mechanical system with ``n`` coordinates and ``m`` constraints:
     ``rattle_general``, ``field``, ``midpoint_run``, ``energy``, ``residuals`` (and
     their helpers). RATTLE with a constant mass is unrolled per system instead
-    (:mod:`dirac.codegen.rattle_scalar`)."""
+    (:mod:`dirac.codegen.rattle_scalar`). ``velocity(q, p, t, c, v, work, piv)``
+    (``v = M^{-1} p``) comes from here by elimination when ``velocity_by_elimination``,
+    else the module generates it in closed form."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
-    return _fill(_MECHANICAL + common, n, m, 2 * m)
+    velocity = _VELOCITY_BY_ELIMINATION if velocity_by_elimination else ""
+    return _fill(velocity + _MECHANICAL + common, n, m, 2 * m)
 
 
 def analysed_templates(n: int, k: int) -> str:
