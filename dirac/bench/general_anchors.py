@@ -209,7 +209,7 @@ def polar_pendulum_rattle(q, p, mass, g, length, dt, n_steps, tol, max_iter):
                     best, rb = abs(J[k, c]), k
             piv[c] = rb
             if rb != c:
-                for k in range(5):
+                for k in range(c, 5):
                     J[c, k], J[rb, k] = J[rb, k], J[c, k]
             for k in range(c + 1, 5):
                 f = J[k, c] / J[c, c]
@@ -294,7 +294,7 @@ def first_order_midpoint(z, dt, n_steps, tol, max_iter):
                     best, rb = abs(J[k, c]), k
             piv[c] = rb
             if rb != c:
-                for k in range(N):
+                for k in range(c, N):
                     J[c, k], J[rb, k] = J[rb, k], J[c, k]
             for k in range(c + 1, N):
                 fk = J[k, c] / J[c, c]

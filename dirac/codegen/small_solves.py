@@ -53,8 +53,8 @@ def lu_factor(A, piv):
                 best = abs(A[r, c])
                 r_best = r
         piv[c] = r_best
-        if r_best != c:
-            for j in range(k):
+        if r_best != c:  # columns from c on: the multipliers left of c stay with their step
+            for j in range(c, k):
                 tmp = A[c, j]
                 A[c, j] = A[r_best, j]
                 A[r_best, j] = tmp
@@ -69,7 +69,8 @@ def lu_factor(A, piv):
 
 @numba.njit(cache=True, inline="always")
 def lu_solve(A, piv, b):
-    """b <- A^{-1} b with the factors of lu_factor, in place."""
+    """b <- A^{-1} b with the factors of lu_factor, in place (the row exchanges and the
+    eliminations applied to b in the order lu_factor made them)."""
     k = A.shape[0]
     for c in range(k):
         r = piv[c]
