@@ -182,10 +182,51 @@ def mechanical_kernel_source(
                                list(inverse * sympy.Matrix(p_symbols)), (n,), parameters)
         # the signature of the eliminating version: its work arrays are not needed here
         functions.append(source.replace("def velocity(q, p, t, c, out):", "def velocity(q, p, t, c, out, work, piv):"))
+        functions.append(_stage_residual(q, parameters, inverse, force, v, list(chi), time))
     if constant:  # M^{-1} once, symbolically; the constant-mass RATTLE is unrolled into scalars
         functions.append(constant_mass_rattle_source(q, parameters, mass.inv(), potential, list(chi), time))
     body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m, not closed_velocity)
     return _HEADER.format(title=title) + body
+
+
+def _stage_residual(q: list[sympy.Symbol], parameters: Sequence[sympy.Symbol], inverse: sympy.Matrix,
+                    force: list[sympy.Expr], v: list[sympy.Symbol], chi: list[sympy.Expr],
+                    time: sympy.Symbol | None) -> str:
+    """RATTLE's implicit stage (Jay 1996) as one straight-line function: at
+    ``x = (p_half, q1, lam)`` from ``(q, p)`` at ``tau`` to ``tau1``, with ``G0 = G(q, tau)``,
+
+        r = (p_half - p + h/2 (f(q, v0, tau) + G0^T lam),  q1 - q - h/2 (v0 + v1),  chi(q1, tau1)),
+        v0 = M(q, tau)^{-1} p_half,  v1 = M(q1, tau1)^{-1} p_half.
+
+    Same signature as the eliminating version of the templates (its work arrays unused)."""
+    n, m = len(q), len(chi)
+    x = [sympy.Symbol(f"_x{i}", real=True) for i in range(2 * n + m)]
+    q0 = [sympy.Symbol(f"_q{i}", real=True) for i in range(n)]
+    p0 = [sympy.Symbol(f"_p{i}", real=True) for i in range(n)]
+    g0 = sympy.Matrix(m, n, lambda a, j: sympy.Symbol(f"_g{a}_{j}", real=True))
+    h, tau, tau1 = sympy.symbols("_h _tau _tau1", real=True)
+    ph, q1, lam = sympy.Matrix(x[:n]), x[n:2 * n], sympy.Matrix(x[2 * n:])
+
+    def at(expression: sympy.Expr, point: Sequence[sympy.Expr], when: sympy.Symbol) -> sympy.Expr:
+        replace = dict(zip(q, point))
+        if time is not None:
+            replace[time] = when
+        return sympy.sympify(expression).xreplace(replace)
+
+    v0 = [at(e, q0, tau) for e in inverse * ph]
+    v1 = [at(e, q1, tau1) for e in inverse * ph]
+    f0 = [at(e, q0, tau).xreplace(dict(zip(v, v0))) for e in force]
+    reaction = g0.T * lam if m else sympy.zeros(n, 1)
+    residual = [ph[i] - p0[i] + h / 2 * (f0[i] + reaction[i]) for i in range(n)]
+    residual += [q1[i] - q0[i] - h / 2 * (v0[i] + v1[i]) for i in range(n)]
+    residual += [at(e, q1, tau1) for e in chi]
+    source = emit_function("rattle_residual", "RATTLE's implicit stage at x = (p_half, q1, lam), closed form",
+                           [("x", x), ("q", q0), ("p", p0), ("G0", g0)],
+                           [("h", h), ("tau", tau if time is not None else None),
+                            ("tau1", tau1 if time is not None else None)],
+                           residual, (2 * n + m,), parameters)
+    return source.replace("def rattle_residual(x, q, p, G0, h, tau, tau1, c, out):",
+                          "def rattle_residual(x, q, p, G0, h, tau, tau1, c, out, ph, q1, v0, f0, v1, chi, work, piv):")
 
 
 def analysed_kernel_source(
@@ -215,7 +256,24 @@ def analysed_kernel_source(
         emit_function("second_class_dt", "d Phi/dt, (k,)", za, ts, phi_t, (k,), parameters),
         emit_function("second_class_jacobian", "grad Phi, (k, 2n)", za, ts, jacobian, (k, N), parameters),
     ]
-    body = _solves({k}) + "\n\n".join(functions) + analysed_templates(N // 2, k)
+    closed = k <= 2
+    if closed:  # C is 2 x 2 antisymmetric (or empty): the whole field (240) in closed form
+        n = N // 2
+        flow = sympy.Matrix([*gradient[n:], *[-e for e in gradient[:n]]])  # J grad H
+        if k:
+            D = sympy.Matrix(k, N, jacobian)
+            J = sympy.zeros(N, N)
+            for i in range(n):
+                J[i, n + i], J[n + i, i] = 1, -1
+            C = D * J * D.T
+            C_inverse = sympy.Matrix([[0, -1 / C[0, 1]], [1 / C[0, 1], 0]])
+            flow = flow - J * D.T * C_inverse * (D * flow + sympy.Matrix(phi_t))
+        source = emit_function("field_into", "z_dot = {z, H}_D (240) in closed form, C = {Phi_1, Phi_2} inverted "
+                               "by hand", za, ts, list(flow), (N,), parameters)
+        functions.append(source.replace("def field_into(z, t, c, out):", "def field_into(z, t, c, out, work):")
+                         + "\n\n@numba.njit(cache=True)\ndef field_work():\n    \"\"\"No work arrays.\"\"\"\n"
+                         "    return np.empty(0)\n")
+    body = _solves({k}) + "\n\n".join(functions) + analysed_templates(N // 2, k, not closed)
     return _HEADER.format(title=title) + body
 
 

@@ -154,6 +154,30 @@ def velocity(q, p, t, c, v, work, piv):
     lu_solve(work, piv, v)
 '''
 
+_STAGE_RESIDUAL = '''
+
+@numba.njit(cache=True, inline="always")
+def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv):
+    """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau)."""
+    for i in range(__N__):
+        ph[i] = x[i]
+        q1[i] = x[__N__ + i]
+    velocity(q, ph, tau, c, v0, work, piv)
+    force(q, v0, tau, c, f0)
+    for i in range(__N__):
+        acc = 0.0
+        for a in range(__M__):
+            acc += G0[a, i] * x[2 * __N__ + a]
+        r[i] = ph[i] - p[i] + 0.5 * h * (f0[i] + acc)
+    velocity(q1, ph, tau1, c, v1, work, piv)
+    for i in range(__N__):
+        r[__N__ + i] = q1[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+    if __M__ > 0:
+        constraints(q1, tau1, c, chi)
+        for a in range(__M__):
+            r[2 * __N__ + a] = chi[a]
+'''
+
 _MECHANICAL = '''
 
 
@@ -179,28 +203,6 @@ def project_momentum(G, W, u, chi_t, p, h, S, rhs, mu, piv):
         for a in range(__M__):
             acc += G[a, i] * mu[a]
         p[i] -= 0.5 * h * acc
-
-
-@numba.njit(cache=True, inline="always")
-def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv):
-    """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau)."""
-    for i in range(__N__):
-        ph[i] = x[i]
-        q1[i] = x[__N__ + i]
-    velocity(q, ph, tau, c, v0, work, piv)
-    force(q, v0, tau, c, f0)
-    for i in range(__N__):
-        acc = 0.0
-        for a in range(__M__):
-            acc += G0[a, i] * x[2 * __N__ + a]
-        r[i] = ph[i] - p[i] + 0.5 * h * (f0[i] + acc)
-    velocity(q1, ph, tau1, c, v1, work, piv)
-    for i in range(__N__):
-        r[__N__ + i] = q1[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
-    if __M__ > 0:
-        constraints(q1, tau1, c, chi)
-        for a in range(__M__):
-            r[2 * __N__ + a] = chi[a]
 
 
 @numba.njit(cache=True)
@@ -397,14 +399,7 @@ def residuals(q, p, t, c, out):
         out[__M__ + a] = acc
 '''
 
-_ANALYSED = '''
-
-@numba.njit(cache=True)
-def field_work():
-    """Work arrays of field_into."""
-    return (np.empty(2 * __N__), np.zeros((__K__, 2 * __N__)), np.empty(__K__), np.empty((__K__, __K__)),
-            np.empty(__K__), np.empty(__K__), np.empty(__K__, dtype=np.int64))
-
+_ANALYSED_FIELD = '''
 
 @numba.njit(cache=True, inline="always")
 def field_into(z, t, c, out, work):
@@ -421,6 +416,15 @@ def field_into(z, t, c, out, work):
     second_class_jacobian(z, t, c, D)
     second_class_dt(z, t, c, e)
     dirac_projection(D, e, out, C, rhs, mu, piv)
+'''
+
+_ANALYSED = '''
+
+@numba.njit(cache=True)
+def field_work():
+    """Work arrays of field_into."""
+    return (np.empty(2 * __N__), np.zeros((__K__, 2 * __N__)), np.empty(__K__), np.empty((__K__, __K__)),
+            np.empty(__K__), np.empty(__K__), np.empty(__K__, dtype=np.int64))
 
 
 @numba.njit(cache=True)
@@ -485,17 +489,19 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     ``rattle_general``, ``field``, ``midpoint_run``, ``energy``, ``residuals`` (and
     their helpers). RATTLE with a constant mass is unrolled per system instead
     (:mod:`dirac.codegen.rattle_scalar`). ``velocity(q, p, t, c, v, work, piv)``
-    (``v = M^{-1} p``) comes from here by elimination when ``velocity_by_elimination``,
-    else the module generates it in closed form."""
+    (``v = M^{-1} p``) and ``rattle_residual`` (RATTLE's implicit stage) come from here,
+    by elimination, when ``velocity_by_elimination``; else the module generates both in
+    closed form."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
-    velocity = _VELOCITY_BY_ELIMINATION if velocity_by_elimination else ""
-    return _fill(velocity + _MECHANICAL + common, n, m, 2 * m)
+    by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
+    return _fill(by_elimination + _MECHANICAL + common, n, m, 2 * m)
 
 
-def analysed_templates(n: int, k: int) -> str:
+def analysed_templates(n: int, k: int, field_by_elimination: bool = True) -> str:
     """Step loops of an analysed system (``2n`` phase-space variables, ``k`` second-class
     constraints): ``field``, ``midpoint_run`` (projected), ``project``, ``energy``,
-    ``residuals``."""
+    ``residuals``; ``field_into`` too when ``field_by_elimination`` (else the module
+    generates it in closed form)."""
     common = (_COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol, project_buffers)\n")
               .replace("    PROJECT_WORK\n", "    project_buffers = project_work()\n"))
-    return _fill(_ANALYSED + common, n, 0, k)
+    return _fill((_ANALYSED_FIELD if field_by_elimination else "") + _ANALYSED + common, n, 0, k)
