@@ -61,6 +61,10 @@ class ConstraintAnalysis:
         The chain stage by stage (stage 1 = primary) and flat.
     first_class, second_class
         The classes; ``physical_degrees_of_freedom = (2n - 2 #first - #second) / 2``.
+    time
+        The time symbol ``t`` when ``L`` or a constraint depends on it explicitly (a
+        rheonomic system: the constraints, ``H_c`` and the multipliers may depend on
+        ``t``), else ``None``.
     bracket_strategy
         How Dirac brackets are computed ("symbolic", "block" or "numeric", and why).
     notes
@@ -99,8 +103,11 @@ class ConstraintAnalysis:
         self.canonical_hamiltonian = legendre.canonical_hamiltonian
         K = len(legendre.primary)
         self.primary_multipliers = tuple(sympy.Symbol(f"u_{k + 1}", real=True) for k in range(K))
-        self._numerics = Numerics(space, self._generic, seed=seed)
-        chain = ConstraintChain(space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers)
+        self.time = lagrangian.time if lagrangian.is_time_dependent else None
+        self._numerics = Numerics(space, self._generic, seed=seed, time=self.time)
+        chain = ConstraintChain(
+            space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
+        )
         chain.run()
         self._chain = chain
         done(
@@ -148,6 +155,12 @@ class ConstraintAnalysis:
             f"{len(self._points)} random points of each constraint surface"
             + (" (symbolic parameters at generic random values)" if self.parameters else ""),
         ]
+        if self.time is not None:
+            self.notes.append(
+                "time-dependent (rheonomic) system: the consistency conditions are d Phi/dt = {Phi, H_T} + "
+                "d_t Phi with the partial time derivative; t is sampled at random like a variable in the "
+                "numerical decisions, and the constraints may depend on t"
+            )
         self.seconds = time.perf_counter() - start
 
     # ------------------------------------------------------------------ brackets
@@ -185,7 +198,10 @@ class ConstraintAnalysis:
 
         ``H = H_c + u_k phi_k`` over the primary constraints whose multipliers stay free
         (first class); those ``u_k`` stay as symbols. Second-class terms of ``H_T`` drop
-        out of Dirac brackets ((240); for the rigid body (250)-(251) follow).
+        out of Dirac brackets ((240); for the rigid body (250)-(251) follow). When
+        second-class constraints depend explicitly on the time ``t``,
+        ``z_dot = {z, H}_D - {z, Phi_a} (C^{-1})^{ab} d_t Phi_b`` (Gitman–Tyutin), so that
+        the motion stays on the moving surface; ``at`` then needs ``t`` too.
 
         Parameters
         ----------
@@ -220,10 +236,12 @@ class ConstraintAnalysis:
         result: dict = {}
         for z in items:
             if at is not None:
-                result[z] = self._bracket.at(z, H, at)
+                result[z] = self._bracket.at(z, H, at) + self._bracket.explicit_time_term(z, at)
                 continue
             try:
                 result[z] = self._bracket.exact(z, H, time_limit=time_limit)
+                if self.time is not None:  # second-class constraints with explicit t
+                    result[z] = result[z] + self._bracket.explicit_time_term(z, time_limit=time_limit)
             except SolveTooLarge as exc:
                 raise AnalysisError(
                     f"the exact Dirac bracket {{{z}, H}}_D of {self.name!r} cannot be found symbolically: {exc}; "
@@ -239,7 +257,9 @@ class ConstraintAnalysis:
         Parameters are at their defaults (symbolic parameters without a default make this
         fail). Variables given in ``values`` are held fixed; the others are solved for
         (Gauss–Newton from a random start), e.g. given ``q`` and ``p`` this finds the
-        multipliers ``lambda`` (the fourth stage) and ``p_lambda = 0``.
+        multipliers ``lambda`` (the fourth stage) and ``p_lambda = 0``. For a
+        time-dependent system the point is on the surface at the time ``t`` (given in
+        ``values``, else 0), which the returned point includes.
 
         Raises
         ------
@@ -248,15 +268,18 @@ class ConstraintAnalysis:
             surface has.
         """
         values = dict(values or {})
-        self._space.check_names(values, "surface_point")
+        self._space.check_names({k: v for k, v in values.items() if self.time is None or k != self.time.name}, "surface_point")
         missing = [p.name for p, v in self.lagrangian.parameters.items() if v is None]
         if missing:
             raise InputError(f"parameters {', '.join(missing)} have no default value: fix them (Lagrangian.fix) first")
         if self._defaults_numerics is None:
-            self._defaults_numerics = Numerics(self._space, dict(self.lagrangian.parameters))
+            self._defaults_numerics = Numerics(self._space, dict(self.lagrangian.parameters), time=self.time)
         numerics = self._defaults_numerics
         numerics.rng = np.random.default_rng(seed)
         index = {s.name: i for i, s in enumerate(self.phase_space)}
+        if self.time is not None:  # the time is the last component of a point (0 unless given)
+            index[self.time.name] = len(self.phase_space)
+            values.setdefault(self.time.name, 0.0)
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:
             point = numerics.surface_points(self.constraints, 1, fixed=fixed)[0]
@@ -267,7 +290,8 @@ class ConstraintAnalysis:
                     f"({', '.join(f'{k}={v}' for k, v in values.items())}): give values that satisfy the constraints"
                 ) from None
             raise
-        return {s.name: float(x) for s, x in zip(self.phase_space, point)}
+        named = (*self.phase_space, self.time) if self.time is not None else self.phase_space
+        return {s.name: float(x) for s, x in zip(named, point)}
 
     # ------------------------------------------------------------------ reports
     def to_json(self) -> dict:

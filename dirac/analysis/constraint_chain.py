@@ -5,6 +5,12 @@ the time derivative of every constraint found so far must vanish weakly:
 
     {Phi_a, H_c} + u_k {Phi_a, phi_k} ≈ 0          ((210), (213)-(215)).
 
+For a constraint that depends explicitly on the time ``t`` (a rheonomic system) the
+total time derivative has the partial derivative as well,
+``d Phi_a/dt = {Phi_a, H_T} + d_t Phi_a`` (Dirac, "Lectures on quantum mechanics";
+Gitman–Tyutin), so ``b_a = {Phi_a, H_c} + d_t Phi_a`` below; ``t`` is not a phase-space
+variable, so the brackets are unchanged.
+
 Writing ``b_a = {Phi_a, H_c}`` and ``A_ak = {Phi_a, phi_k}``, the rows of ``A`` that are
 independent on the surface fix multipliers; every other row ``a`` is, after eliminating
 ``u`` with those pivot rows, the condition ``psi_a = b_a - c_a . b_P ≈ 0`` (``c_a`` the
@@ -57,6 +63,9 @@ class ConstraintChain:
         Primary constraints ``phi_k`` (stage 1).
     multipliers
         Their multipliers ``u_k`` in ``H_T``.
+    time
+        The time ``t`` when the system depends on it explicitly (then the partial time
+        derivative enters every consistency condition), else ``None``.
 
     After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
     expression, only those the chain determines), ``undetermined`` (multiplier symbols
@@ -73,6 +82,7 @@ class ConstraintChain:
     undetermined: list[sympy.Symbol] = field(default_factory=list)
     points: list[np.ndarray] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    time: sympy.Symbol | None = None
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -89,7 +99,10 @@ class ConstraintChain:
         cached = self._row_cache.get(constraint)
         if cached is None:
             pb = self.phase_space.poisson_bracket
-            cached = (pb(constraint, self.canonical_hamiltonian), [pb(constraint, phi) for phi in self.primary])
+            b = pb(constraint, self.canonical_hamiltonian)
+            if self.time is not None:  # d Phi/dt = {Phi, H_T} + d_t Phi for a rheonomic system
+                b = b + sympy.diff(constraint, self.time)
+            cached = (b, [pb(constraint, phi) for phi in self.primary])
             self._row_cache[constraint] = cached
         return cached
 

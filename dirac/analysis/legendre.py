@@ -6,7 +6,8 @@ constraints, (206)). The engine treats Lagrangians quadratic in the velocities,
 
     L = 1/2 q_dot^T W(q) q_dot + a(q) . q_dot - V(q),
 
-the common mechanical case. Then ``p = W q_dot + a`` ((205), (229)). With ``r = rank W``
+the common mechanical case (other Lagrangians, e.g. with square roots of the velocities,
+go to :mod:`dirac.analysis.velocity_elimination`). Then ``p = W q_dot + a`` ((205), (229)). With ``r = rank W``
 (decided numerically at generic points), a set ``S`` of ``r`` indices with ``W_SS``
 invertible is chosen; the null space of ``W`` is spanned by
 ``n_j = e_j - W_SS^{-1} W_Sj`` (``j`` not in ``S``), which gives the primary constraints
@@ -40,6 +41,7 @@ from dirac.analysis.algebra import tidy
 from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.polynomial_kernel import polynomial_kernel
+from dirac.analysis.velocity_elimination import eliminate_velocities
 from dirac.codegen import array_function
 from dirac.errors import AnalysisError
 from dirac.model.lagrangian import Lagrangian, momentum_name, multiplier_name
@@ -78,8 +80,12 @@ class LegendreTransform:
     velocity_solution: dict = field(default_factory=dict)
 
 
+class NotQuadraticError(AnalysisError):
+    """``L`` is not quadratic in the velocities (then :mod:`dirac.analysis.velocity_elimination` is tried)."""
+
+
 def _quadratic_parts(lagrangian: Lagrangian) -> tuple[sympy.Matrix, list[sympy.Expr], sympy.Expr]:
-    """``W``, ``a`` and ``V`` of a Lagrangian quadratic in the velocities (else AnalysisError)."""
+    """``W``, ``a`` and ``V`` of a Lagrangian quadratic in the velocities (else NotQuadraticError)."""
     v = lagrangian.velocities
     L = lagrangian.expression
     first = [sympy.diff(L, vi) for vi in v]
@@ -90,7 +96,7 @@ def _quadratic_parts(lagrangian: Lagrangian) -> tuple[sympy.Matrix, list[sympy.E
             if W[i, j].free_symbols & vset:
                 W[i, j] = sympy.cancel(W[i, j])
                 if W[i, j].free_symbols & vset:
-                    raise AnalysisError(
+                    raise NotQuadraticError(
                         f"the Lagrangian of {lagrangian.name!r} is not quadratic in the velocities "
                         f"(d2L/d{v[i].name}d{v[j].name} = {W[i, j]} depends on the velocities): its "
                         "primary constraints cannot be found in closed form, so the analysis is refused; "
@@ -153,7 +159,8 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     Raises
     ------
     AnalysisError
-        If ``L`` is not quadratic in the velocities.
+        If ``L`` is not quadratic in the velocities and its velocities cannot be
+        eliminated (:mod:`dirac.analysis.velocity_elimination`).
     """
     q = lagrangian.coordinates
     n = len(q)
@@ -161,16 +168,20 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     coords = q + lambdas
     momenta = tuple(sympy.Symbol(momentum_name(c.name), real=True) for c in coords)
     space = PhaseSpace(coords, momenta, tuple(lagrangian.parameters))
-    W, a, V = _quadratic_parts(lagrangian)
+    try:
+        W, a, V = _quadratic_parts(lagrangian)
+    except NotQuadraticError:
+        return _not_quadratic(lagrangian, space, lambdas, rng, parameter_values)
     p = sympy.Matrix(momenta[:n])
     shifted = p - sympy.Matrix(a)
     # numerical rank and pivots of W at generic configurations
-    args = (*q, *lagrangian.parameters)
+    time = [lagrangian.time] if lagrangian.is_time_dependent else []  # sampled with q
+    args = (*q, *time, *lagrangian.parameters)
     w_fn = array_function(args, W, cse=False)
     pvals = [float(parameter_values[s]) for s in lagrangian.parameters]
     samples = []
     for _ in range(3):
-        z = rng.uniform(0.5, 1.5, n) * rng.choice([-1.0, 1.0], n)
+        z = rng.uniform(0.5, 1.5, n + len(time)) * rng.choice([-1.0, 1.0], n + len(time))
         with np.errstate(all="ignore"):
             samples.append(np.array(w_fn(*z, *pvals), dtype=float).reshape(n, n))
     pivots = independent_rows(samples, list(range(n)))
@@ -193,11 +204,11 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
             a_fn = array_function(args, A, cse=False)
             a_samples = []
             for _ in range(3):
-                z = rng.uniform(0.5, 1.5, n) * rng.choice([-1.0, 1.0], n)
+                z = rng.uniform(0.5, 1.5, n + len(time)) * rng.choice([-1.0, 1.0], n + len(time))
                 a_samples.append(np.array(a_fn(*z, *pvals), dtype=float).reshape(A.shape))
             col_pivots = independent_rows([m.T for m in a_samples], list(range(n)))
             kernel = (
-                polynomial_kernel(A, Numerics(space, parameter_values, seed=int(rng.integers(2**31))), rank, lagrangian.constraints)
+                polynomial_kernel(A, Numerics(space, parameter_values, seed=int(rng.integers(2**31)), time=(time or [None])[0]), rank, lagrangian.constraints)
                 if len(col_pivots) == rank == A.shape[0] else None
             )
             if kernel is not None:
@@ -285,6 +296,26 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
         canonical_hamiltonian=H_c,
         method=method,
         velocity_solution={} if velocity is None else dict(zip(lagrangian.velocities, list(velocity))),
+    )
+
+
+def _not_quadratic(
+    lagrangian: Lagrangian, space: PhaseSpace, lambdas: tuple[sympy.Symbol, ...], rng: np.random.Generator, parameter_values: dict
+) -> LegendreTransform:
+    """The transform of a non-quadratic ``L`` (:func:`~dirac.analysis.velocity_elimination.eliminate_velocities`)
+    with the multipliers' primary constraints ``p_lambda = 0`` and ``lambda_a chi_a`` in ``H_c`` ((206), (207))."""
+    n = len(lagrangian.coordinates)
+    result = eliminate_velocities(lagrangian, space.momenta[:n], rng, parameter_values)
+    potential = sum((lam * chi for lam, chi in zip(lambdas, lagrangian.constraints)), sympy.S.Zero)
+    return LegendreTransform(
+        phase_space=space,
+        multipliers=lambdas,
+        hessian=result.hessian,
+        rank=result.rank,
+        primary=[*space.momenta[n:], *result.primary],
+        canonical_hamiltonian=result.energy + potential,
+        method=result.method,
+        velocity_solution=result.velocity_solution,
     )
 
 

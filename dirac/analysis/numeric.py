@@ -87,16 +87,28 @@ class Numerics:
         Numbers for the parameters that are still symbolic.
     seed
         Seed of the random points (results are reproducible).
+    time
+        The time ``t`` of an explicitly time-dependent system (``None`` otherwise). It is
+        sampled like a variable: every point carries its own random ``t`` as one extra
+        last component (after :attr:`~PhaseSpace.variables`), which surface projections
+        hold fixed (a point of the surface at that time).
     """
 
-    def __init__(self, phase_space: PhaseSpace, parameter_values: Mapping[sympy.Symbol, float], seed: int = 20240607):
+    def __init__(
+        self,
+        phase_space: PhaseSpace,
+        parameter_values: Mapping[sympy.Symbol, float],
+        seed: int = 20240607,
+        time: sympy.Symbol | None = None,
+    ):
         self.phase_space = phase_space
+        self.time = time
         self.parameters = tuple(phase_space.parameters)
         self.parameter_vector = np.array([float(parameter_values[p]) for p in self.parameters], dtype=float)
         self.rng = np.random.default_rng(seed)
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
-        self._args = (*phase_space.variables, *self.parameters)
+        self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
 
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
@@ -176,8 +188,8 @@ class Numerics:
 
     # ------------------------------------------------------------------ surface points
     def random_point(self) -> np.ndarray:
-        """A random phase-space point with components of size 0.5-1.5 and random signs."""
-        n = len(self.phase_space.variables)
+        """A random phase-space point with components of size 0.5-1.5 and random signs (and a time ``t``)."""
+        n = len(self.phase_space.variables) + (self.time is not None)
         return self.rng.uniform(0.5, 1.5, n) * self.rng.choice([-1.0, 1.0], n)
 
     def surface_points(

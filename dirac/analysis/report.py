@@ -141,7 +141,8 @@ def to_json(analysis: AnalysisResult) -> dict:
 
     Extra keys: ``phase_space``, ``parameters``, ``canonical_hamiltonian``,
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
-    ``bracket_strategy``, ``notes``; ``multiplier_subexpressions`` (name -> text) when a
+    ``bracket_strategy``, ``notes``, ``time_dependent`` (``L`` or a constraint depends
+    explicitly on the time ``t``); ``multiplier_subexpressions`` (name -> text) when a
     multiplier is too large to print as one tree: its text then uses those names
     (see :func:`shared_form`).
     """
@@ -165,6 +166,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         "hessian_rank": analysis.hessian_rank,
         "bracket_strategy": analysis.bracket_strategy,
         "notes": list(analysis.notes),
+        "time_dependent": analysis.lagrangian.is_time_dependent,
     }
     if definitions:
         out["multiplier_subexpressions"] = definitions
@@ -181,6 +183,8 @@ def to_text(analysis: AnalysisResult) -> str:
     lines.append(f"  L = {_short(a.lagrangian.expression)}")
     for k, chi in enumerate(a.lagrangian.constraints, start=1):
         lines.append(f"  constraint {k}: {chi} = 0   (multiplier lambda_{k})")
+    if a.lagrangian.is_time_dependent:
+        lines.append("time-dependent: t occurs explicitly; consistency is d Phi/dt = {Phi, H_T} + d_t Phi = 0")
     lines.append(
         f"phase space: {2 * n} dimensions ({', '.join(s.name for s in a.coordinates)} and their momenta)"
     )
@@ -238,6 +242,8 @@ def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
     rows.append(rf"L &= {lx(a.lagrangian.expression)}")
     for k, chi in enumerate(a.lagrangian.constraints, start=1):
         rows.append(rf"\chi_{{{k}}} &= {lx(chi)} = 0")
+    if a.lagrangian.is_time_dependent:
+        rows.append(r"&\text{time-dependent: } \frac{d\Phi}{dt} = \{\Phi, H_T\} + \partial_t \Phi")
     rows.append(rf"H_c &= {lx(a.canonical_hamiltonian)}")
     for k, stage in enumerate(a.stages, start=1):
         title = "primary constraints" if k == 1 else f"stage {k}"

@@ -64,11 +64,13 @@ class AnalysedSystem:
         ------
         InputError
             Unknown parameters, values that are not finite numbers, or parameters
-            without a value.
+            without a value; :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a
+            system that depends explicitly on the time ``t``.
         """
         from dirac.analysis.constraint_analysis import analyze
-        from dirac.flows.mechanics import resolve_parameters
+        from dirac.flows.mechanics import refuse_time_dependent, resolve_parameters
 
+        refuse_time_dependent(lagrangian)
         values = resolve_parameters(lagrangian, parameters)
         return cls.from_analysis(analyze(lagrangian.fix(**values)))
 
@@ -92,13 +94,16 @@ class AnalysedSystem:
         ------
         InputError
             ``analysis`` is not an analysis, or a parameter still symbolic in it has no
-            default value.
+            default value; :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a
+            system that depends explicitly on the time ``t``.
         """
         from dirac.codegen import analysed_kernel_source, array_function, load_kernels
+        from dirac.flows.mechanics import refuse_time_dependent
 
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
             raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
+        refuse_time_dependent(lagrangian)
         defaults = {p: float(v) for p, v in lagrangian.parameters.items() if v is not None}
         missing = [p.name for p in lagrangian.parameters if p not in defaults]
         if missing:
@@ -109,7 +114,8 @@ class AnalysedSystem:
         z = tuple(analysis.phase_space)
         H = analysis.canonical_hamiltonian
         constraints = list(analysis.second_class)
-        module = load_kernels(analysed_kernel_source(z, list(defaults), H, constraints, getattr(lagrangian, "time", None),
+        # time-dependent systems are refused above (the kernels would take t: pass lagrangian.time)
+        module = load_kernels(analysed_kernel_source(z, list(defaults), H, constraints, None,
                                                      title=f"analysed system {lagrangian.name}"))
         velocities = list(lagrangian.velocities)
         expression = lagrangian.expression.subs(defaults)

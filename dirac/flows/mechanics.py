@@ -35,13 +35,33 @@ from dirac.validate import unknown_name_error, validate_finite
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
 
-__all__ = ["MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
+__all__ = ["MechanicalSystem", "NotMechanicalError", "TimeDependentSystemError", "refuse_time_dependent", "resolve_parameters"]
 
 
 class NotMechanicalError(InputError):
     """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
     velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
     flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
+
+
+class TimeDependentSystemError(InputError):
+    """The Lagrangian or a constraint depends explicitly on the time ``t`` and the flow asked
+    for does not integrate such systems (the Dirac flow of a full analysis): it refuses
+    instead of freezing ``t``. :class:`MechanicalSystem` (RATTLE, the midpoint rule on its
+    Dirac field) takes ``chi(q, t)`` and ``V(q, t)``."""
+
+
+def refuse_time_dependent(lagrangian: Lagrangian) -> None:
+    """Raise :class:`TimeDependentSystemError` when ``lagrangian`` depends explicitly on ``t``
+    (used by the flow of a full analysis, :class:`dirac.flows.analysed.AnalysedSystem`)."""
+    if lagrangian.is_time_dependent:
+        raise TimeDependentSystemError(
+            f"system {lagrangian.name!r} depends explicitly on the time t (a rheonomic system): the "
+            "Dirac flow of its full analysis does not integrate explicit time dependence yet; a system "
+            "L = 1/2 q_dot^T M q_dot - V with constraints chi(q, t) integrates with the rattle-* methods "
+            "(ConstrainedProblem; in a scene: method = \"rattle-2\"); dirac analyze (or dirac.analyze) "
+            "includes the partial time derivatives"
+        )
 
 
 def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
@@ -155,6 +175,8 @@ class MechanicalSystem:
         InputError
             Unknown or missing parameter values, velocity-linear terms, a kinetic energy
             that is not quadratic in the velocities, or a mass matrix that is singular.
+            An explicit time ``t`` (``lagrangian.time``) is taken: ``M(q, t)``, ``V(q, t)``,
+            ``chi(q, t)``.
         """
         values = resolve_parameters(lagrangian, parameters)
         q = list(lagrangian.coordinates)
@@ -181,7 +203,7 @@ class MechanicalSystem:
         parameter_symbols = list(lagrangian.parameters)
         param_array = np.array([float(values[p.name]) for p in parameter_symbols], dtype=float)
         n, m = len(q), len(lagrangian.constraints)
-        time = getattr(lagrangian, "time", None)
+        time = lagrangian.time if lagrangian.is_time_dependent else None
         constant = all(not (entry.free_symbols & {*q, *([time] if time is not None else [])}) for entry in mass)
         from dirac.codegen import load_kernels, mechanical_kernel_source
 

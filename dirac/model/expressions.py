@@ -18,7 +18,10 @@ import sympy
 
 from dirac.errors import InputError
 
-__all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS"]
+__all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS", "TIME"]
+
+#: the time ``t`` of an explicitly time-dependent (rheonomic) Lagrangian or constraint
+TIME = sympy.Symbol("t", real=True)
 
 #: function name -> sympy function; the only calls an expression may make
 ALLOWED_FUNCTIONS: dict[str, Callable[..., sympy.Expr]] = {
@@ -53,7 +56,9 @@ _MAX_LENGTH = 100_000
 _MAX_EXPONENT = 1000
 
 
-def parse_expression(text: str, names: Mapping[str, sympy.Symbol], *, what: str = "expression") -> sympy.Expr:
+def parse_expression(
+    text: str, names: Mapping[str, sympy.Symbol], *, what: str = "expression", time: sympy.Symbol | None = None
+) -> sympy.Expr:
     """Parse ``text`` into a sympy expression, allowing only the given ``names``.
 
     Parameters
@@ -65,6 +70,10 @@ def parse_expression(text: str, names: Mapping[str, sympy.Symbol], *, what: str 
         ``<q>_dot``, parameters). Elementary functions and ``pi``, ``E`` are always allowed.
     what
         How to call the expression in error messages, e.g. ``"constraint 2"``.
+    time
+        The time symbol, allowed under its own name (``t``) besides ``names`` when given
+        (explicitly time-dependent Lagrangians and constraints); a name in ``names``
+        takes precedence.
 
     Returns
     -------
@@ -92,12 +101,17 @@ def parse_expression(text: str, names: Mapping[str, sympy.Symbol], *, what: str 
         tree = ast.parse(stripped, mode="eval")
     except SyntaxError as exc:
         raise InputError(f"{what} {stripped!r} is not a valid expression: {exc.msg}") from None
+    if time is not None and time.name not in names:
+        names = {**names, time.name: time}
+        listed = [name for name in names if name != time.name]
+        return _Converter(names, what, stripped, listed).visit(tree.body)
     return _Converter(names, what, stripped).visit(tree.body)
 
 
 class _Converter:
-    def __init__(self, names: Mapping[str, sympy.Symbol], what: str, text: str) -> None:
+    def __init__(self, names: Mapping[str, sympy.Symbol], what: str, text: str, listed: list[str] | None = None) -> None:
         self.names = names
+        self.listed = list(names) if listed is None else listed
         self.what = what
         self.text = text
 
@@ -122,7 +136,7 @@ class _Converter:
                 return ALLOWED_CONSTANTS[name]
             if name in ALLOWED_FUNCTIONS:
                 raise self.fail(f"function {name!r} is used without arguments")
-            known = ", ".join(sorted(self.names)) or "(none)"
+            known = ", ".join(sorted(self.listed)) or "(none)"
             raise self.fail(f"unknown name {name!r}; the names allowed here are: {known}")
         if isinstance(node, ast.BinOp):
             op = _BINARY.get(type(node.op))

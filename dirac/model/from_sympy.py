@@ -9,6 +9,10 @@ real symbol ``q_dot``. A coordinate may be
   ``q_dot``;
 - a function of time ``q(t)`` (``dynamicsymbols("q")``): ``L`` writes its velocity as the
   time derivative ``q(t).diff(t)``, which becomes ``q_dot``, and ``q(t)`` becomes ``q``.
+
+An explicit time dependence is written with the real symbol ``t``
+(:data:`dirac.model.expressions.TIME`, ``sympy.Symbol("t", real=True)``); a symbol named
+``t`` never becomes a parameter.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ import sympy
 from sympy.core.function import AppliedUndef
 
 from dirac.errors import InputError
+from dirac.model.expressions import TIME
 
 __all__ = ["plain_parts", "Parts"]
 
@@ -116,7 +121,8 @@ def plain_parts(
     if parameters is None:
         found = set().union(*(e.free_symbols for e in (expr, *chis)))
         values: dict[str, float | None] = {
-            label: None for label in sorted(s.name for s in found if s.name not in own and s not in times)
+            label: None
+            for label in sorted(s.name for s in found if s.name not in own and s not in times and s.name != TIME.name)
         }
     elif isinstance(parameters, Mapping):
         values = {str(p): value for p, value in parameters.items()}

@@ -1,7 +1,10 @@
 """The symbolic input of the engine: a Lagrangian with holonomic constraints.
 
 A :class:`Lagrangian` holds coordinates ``q``, their velocities ``q_dot``, parameters,
-the expression ``L(q, q_dot)`` and holonomic constraints ``chi_a(q) = 0``. The Dirac
+the expression ``L(q, q_dot)`` and holonomic constraints ``chi_a(q) = 0``. Both may
+depend explicitly on the time ``t`` (a rheonomic system, e.g. a bead on a rotating hoop,
+``chi(q, t) = 0``) unless ``t`` is one of the coordinates (as in the relativistic
+particle, where ``t`` is the coordinate time); see :attr:`Lagrangian.time`. The Dirac
 analysis (:func:`dirac.analyze`) treats the multipliers of the constraints as
 dynamical variables, as in the paper's extended Lagrangian (1):
 
@@ -23,13 +26,29 @@ from dataclasses import dataclass, field
 import sympy
 
 from dirac.errors import InputError
-from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, parse_expression
+from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, TIME, parse_expression
 from dirac.model.from_sympy import plain_parts
 from dirac.validate import is_real_number, unknown_name_error, validate_finite
 
-__all__ = ["Lagrangian", "velocity_name", "momentum_name", "multiplier_name", "latex_name", "latex_names"]
+__all__ = ["Lagrangian", "TIME", "velocity_name", "momentum_name", "multiplier_name", "latex_name", "latex_names"]
 
 _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def _time_hint(unknown: set) -> str:
+    """A hint when an unknown name is a time ``t`` other than :data:`TIME` (e.g. not real)."""
+    if any(s.name == TIME.name for s in unknown):
+        return " (explicit time is the real symbol t: sympy.Symbol('t', real=True), dirac.model.lagrangian.TIME)"
+    return ""
+
+
+def _time_refused(role: str) -> InputError:
+    """The error for a parameter (or other non-coordinate) named ``t``, which is time."""
+    return InputError(
+        f"the name 't' is time (an explicitly time-dependent Lagrangian or constraint may use it), so it "
+        f"cannot be a {role}: rename the {role}, or list t among the coordinates if it is a coordinate "
+        "(as the time coordinate of a relativistic particle)"
+    )
 
 
 def velocity_name(coordinate: str) -> str:
@@ -154,19 +173,23 @@ class Lagrangian:
                 raise InputError(f"parameter {p.name!r} = {value!r} is not finite: give a finite number")
 
         allowed = set(self.coordinates) | set(self.velocities) | set(self.parameters)
+        if self.time is not None:
+            if any(p.name == TIME.name for p in self.parameters):
+                raise _time_refused("parameter")
+            allowed.add(self.time)
         if self.expression == 0:
             raise InputError(f"the Lagrangian of {self.name!r} is empty (zero): give L(q, q_dot)")
         unknown = self.expression.free_symbols - allowed
         if unknown:
             names = ", ".join(sorted(s.name for s in unknown))
-            raise InputError(f"the Lagrangian of {self.name!r} uses unknown names: {names}")
+            raise InputError(f"the Lagrangian of {self.name!r} uses unknown names: {names}{_time_hint(unknown)}")
         velocity_set = set(self.velocities)
         for index, chi in enumerate(self.constraints, start=1):
             label = f"constraint {index} ({chi})"
             extra = chi.free_symbols - allowed
             if extra:
                 names = ", ".join(sorted(s.name for s in extra))
-                raise InputError(f"{label} uses unknown names: {names}")
+                raise InputError(f"{label} uses unknown names: {names}{_time_hint(extra)}")
             in_velocity = sorted(s.name for s in chi.free_symbols & velocity_set)
             if in_velocity:
                 raise InputError(
@@ -193,6 +216,8 @@ class Lagrangian:
     ) -> Lagrangian:
         """Build a Lagrangian from expressions written as text (docs/file_formats.md).
 
+        The name ``t`` is the time (:attr:`time`) unless ``t`` is one of ``coordinates``.
+
         Examples
         --------
         >>> pendulum = Lagrangian.from_strings(
@@ -207,6 +232,8 @@ class Lagrangian:
             raise InputError("constraints must be a list of expressions, e.g. ['x**2 + y**2 - l**2']")
         parameters = dict(parameters or {})
         labels = [str(c) for c in coordinates]
+        if TIME.name in parameters and TIME.name not in labels:
+            raise _time_refused("parameter")
         for label in [*labels, *parameters]:
             if not isinstance(label, str) or not _IDENTIFIER.match(label) or keyword.iskeyword(label):
                 raise InputError(f"name {label!r} is not a valid name: use letters, digits and '_', starting with a letter")
@@ -219,9 +246,9 @@ class Lagrangian:
         constraints = list(constraints)
         _check_names(q, v, tuple(psyms.values()), len(constraints))
         names = {s.name: s for s in (*q, *v, *psyms.values())}
-        expr = parse_expression(lagrangian, names, what="lagrangian")
+        expr = parse_expression(lagrangian, names, what="lagrangian", time=TIME)
         chis = tuple(
-            parse_expression(text, names, what=f"constraint {k}") for k, text in enumerate(constraints, start=1)
+            parse_expression(text, names, what=f"constraint {k}", time=TIME) for k, text in enumerate(constraints, start=1)
         )
         values = {psyms[label]: (None if value is None else value) for label, value in parameters.items()}
         for label, value in parameters.items():
@@ -259,6 +286,25 @@ class Lagrangian:
         return cls(name, *plain_parts(L, coordinates, constraints, parameters, velocity_name), description)
 
     # ----------------------------------------------------------------- derived views
+    @property
+    def time(self) -> sympy.Symbol | None:
+        """The time symbol ``t`` (real) of ``L`` and the constraints; ``None`` if ``t`` is a coordinate.
+
+        A system with a coordinate called ``t`` (the relativistic particle's coordinate
+        time) cannot depend on time explicitly: there ``t`` is that coordinate.
+        """
+        if any(q.name == TIME.name for q in self.coordinates):
+            return None
+        return TIME
+
+    @property
+    def is_time_dependent(self) -> bool:
+        """Whether the time ``t`` occurs explicitly in ``L`` or in a constraint (a rheonomic system)."""
+        t = self.time
+        if t is None:
+            return False
+        return any(t in e.free_symbols for e in (self.expression, *self.constraints))
+
     @property
     def parameter_symbols(self) -> dict[str, sympy.Symbol]:
         """Parameter name -> symbol."""

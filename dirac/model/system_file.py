@@ -1,7 +1,8 @@
 """System files: a :class:`~dirac.model.lagrangian.Lagrangian` read from TOML or from Python.
 
 A TOML system file has one ``[system]`` table (``name``, ``coordinates``, ``lagrangian``,
-optional ``parameters``, ``constraints``, ``description``; docs/file_formats.md); a ``.py``
+optional ``parameters``, ``constraints``, ``description``; docs/file_formats.md; the name
+``t`` is the time unless a coordinate is called ``t``); a ``.py``
 system file defines ``system()`` returning a Lagrangian. Scene files reuse
 :func:`lagrangian_from_table` for a system written inline.
 """

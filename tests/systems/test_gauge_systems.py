@@ -79,7 +79,9 @@ def test_inconsistent_lagrangian_is_reported():
 
 
 def test_non_quadratic_lagrangian_is_refused():
-    L = dirac.Lagrangian.from_strings("relativistic", ["x"], "-m*sqrt(1 - x_dot**2)", parameters={"m": 1.0})
+    """A Lagrangian not algebraic in the velocities (a square root, -m sqrt(1 - x_dot^2), is
+    now transformed: tests/analysis/test_nonquadratic_legendre.py)."""
+    L = dirac.Lagrangian.from_strings("relativistic", ["x"], "-m*exp(x_dot)", parameters={"m": 1.0})
     with pytest.raises(dirac.AnalysisError, match="not quadratic in the velocities"):
         dirac.analyze(L)
 
