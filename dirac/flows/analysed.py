@@ -3,8 +3,10 @@
 From a :class:`dirac.analysis.constraint_analysis.ConstraintAnalysis` (phase space ``z``: the
 coordinates and multipliers, then their momenta), the numerical Hamiltonian vector field
 
-    z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H),
-    C_ab = {Phi_a, Phi_b}  (240),
+    z_dot = {z, H}_D - {z, Phi_a} (C^{-1})^{ab} d_t Phi_b
+          = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + d_t Phi),
+    C_ab = {Phi_a, Phi_b}  (240; the d_t term for explicitly time-dependent constraints,
+    Gitman–Tyutin),
 
 over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
 ``grad Phi`` are generated from sympy into one kernel module with the field and the
@@ -64,13 +66,11 @@ class AnalysedSystem:
         ------
         InputError
             Unknown parameters, values that are not finite numbers, or parameters
-            without a value; :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a
-            system that depends explicitly on the time ``t``.
+            without a value.
         """
         from dirac.analysis.constraint_analysis import analyze
-        from dirac.flows.mechanics import refuse_time_dependent, resolve_parameters
+        from dirac.flows.mechanics import resolve_parameters
 
-        refuse_time_dependent(lagrangian)
         values = resolve_parameters(lagrangian, parameters)
         return cls.from_analysis(analyze(lagrangian.fix(**values)))
 
@@ -94,16 +94,13 @@ class AnalysedSystem:
         ------
         InputError
             ``analysis`` is not an analysis, or a parameter still symbolic in it has no
-            default value; :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a
-            system that depends explicitly on the time ``t``.
+            default value.
         """
         from dirac.codegen import analysed_kernel_source, array_function, load_kernels
-        from dirac.flows.mechanics import refuse_time_dependent
 
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
             raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
-        refuse_time_dependent(lagrangian)
         defaults = {p: float(v) for p, v in lagrangian.parameters.items() if v is not None}
         missing = [p.name for p in lagrangian.parameters if p not in defaults]
         if missing:
@@ -114,8 +111,8 @@ class AnalysedSystem:
         z = tuple(analysis.phase_space)
         H = analysis.canonical_hamiltonian
         constraints = list(analysis.second_class)
-        # time-dependent systems are refused above (the kernels would take t: pass lagrangian.time)
-        module = load_kernels(analysed_kernel_source(z, list(defaults), H, constraints, None,
+        time = lagrangian.time if lagrangian.is_time_dependent else None
+        module = load_kernels(analysed_kernel_source(z, list(defaults), H, constraints, time,
                                                      title=f"analysed system {lagrangian.name}"))
         velocities = list(lagrangian.velocities)
         expression = lagrangian.expression.subs(defaults)

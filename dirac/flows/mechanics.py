@@ -35,33 +35,13 @@ from dirac.validate import unknown_name_error, validate_finite
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
 
-__all__ = ["MechanicalSystem", "NotMechanicalError", "TimeDependentSystemError", "refuse_time_dependent", "resolve_parameters"]
+__all__ = ["MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
 
 
 class NotMechanicalError(InputError):
     """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
     velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
     flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
-
-
-class TimeDependentSystemError(InputError):
-    """The Lagrangian or a constraint depends explicitly on the time ``t`` and the flow asked
-    for does not integrate such systems (the Dirac flow of a full analysis): it refuses
-    instead of freezing ``t``. :class:`MechanicalSystem` (RATTLE, the midpoint rule on its
-    Dirac field) takes ``chi(q, t)`` and ``V(q, t)``."""
-
-
-def refuse_time_dependent(lagrangian: Lagrangian) -> None:
-    """Raise :class:`TimeDependentSystemError` when ``lagrangian`` depends explicitly on ``t``
-    (used by the flow of a full analysis, :class:`dirac.flows.analysed.AnalysedSystem`)."""
-    if lagrangian.is_time_dependent:
-        raise TimeDependentSystemError(
-            f"system {lagrangian.name!r} depends explicitly on the time t (a rheonomic system): the "
-            "Dirac flow of its full analysis does not integrate explicit time dependence yet; a system "
-            "L = 1/2 q_dot^T M q_dot - V with constraints chi(q, t) integrates with the rattle-* methods "
-            "(ConstrainedProblem; in a scene: method = \"rattle-2\"); dirac analyze (or dirac.analyze) "
-            "includes the partial time derivatives"
-        )
 
 
 def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
