@@ -72,7 +72,9 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
     measured: list[Target] = []
     notes: list[str] = []
     field_rows: list[dict] = []
+    general_rows: list = []
     if targets:
+        from dirac.bench.general_systems import measure_general_systems
         from dirac.bench.targets import measure_targets
         from dirac.bench.vector_field import measure_vector_field
 
@@ -83,6 +85,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
             measured.append(field_target)
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"vector field: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
+        general_rows = measure_general_systems(quick, measured, notes, say)
     else:
         from dirac.bench.targets import work_precision_targets
 
@@ -98,6 +101,11 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         from dirac.bench.vector_field import format_vector_field_table
 
         print(format_vector_field_table(field_rows))
+
+    if general_rows:
+        from dirac.bench.general_systems import format_general_rows
+
+        print(format_general_rows(general_rows))
     print(format_targets(measured))
     for note in notes:
         print(f"note: {note}")
@@ -110,6 +118,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         "runs": rows,
         "targets": [t.as_dict() for t in measured],
         "vector_field": field_rows,
+        "general_systems": [row.as_dict() for row in general_rows],
         "notes": notes,
     }
     if json_path:

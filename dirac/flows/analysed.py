@@ -3,12 +3,15 @@
 From a :class:`dirac.analysis.constraint_analysis.ConstraintAnalysis` (phase space ``z``: the
 coordinates and multipliers, then their momenta), the numerical Hamiltonian vector field
 
-    z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H),
-    C_ab = {Phi_a, Phi_b}  (240),
+    z_dot = {z, H}_D - {z, Phi_a} (C^{-1})^{ab} d_t Phi_b
+          = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + d_t Phi),
+    C_ab = {Phi_a, Phi_b}  (240; the d_t term for explicitly time-dependent constraints,
+    Gitman–Tyutin),
 
 over the second-class constraints ``Phi`` is compiled once: ``grad H``, ``Phi`` and
-``grad Phi`` are generated from sympy (:mod:`dirac.codegen.numba_backend`), ``C`` is evaluated and
-solved numerically at each point (:func:`dirac.flows.constrained_kernels.analysed_field`).
+``grad Phi`` are generated from sympy into one kernel module with the field and the
+midpoint step loop (:func:`dirac.codegen.kernel_source.analysed_kernel_source`); ``C`` is
+evaluated and solved numerically at each point.
 ``H`` is the canonical Hamiltonian; with first-class constraints the free multipliers of
 ``H_T`` take the values the user chooses (``multipliers=``, constants or phase-space
 functions; default ``u = 0``): ``H = H_c + v_f phi_f``. Gauge-invariant quantities do not
@@ -52,7 +55,6 @@ class AnalysedSystem:
     parameter_values: dict[str, float]
     params: np.ndarray
     module: Any
-    functions: tuple
     analysis: ConstraintAnalysis = field(repr=False)
     momenta: Callable[..., np.ndarray] = field(repr=False)
     gauge_multipliers: dict[str, str] = field(default_factory=dict)
@@ -68,13 +70,11 @@ class AnalysedSystem:
         ------
         InputError
             Unknown parameters, values that are not finite numbers, or parameters
-            without a value; :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a
-            system that depends explicitly on the time ``t``.
+            without a value.
         """
         from dirac.analysis.constraint_analysis import analyze
-        from dirac.flows.mechanics import refuse_time_dependent, resolve_parameters
+        from dirac.flows.mechanics import resolve_parameters
 
-        refuse_time_dependent(lagrangian)
         values = resolve_parameters(lagrangian, parameters)
         return cls.from_analysis(analyze(lagrangian.fix(**values)))
 
@@ -104,17 +104,13 @@ class AnalysedSystem:
         ------
         InputError
             ``analysis`` is not an analysis, a parameter still symbolic in it has no
-            default value, or a multiplier name is not a free multiplier;
-            :class:`~dirac.flows.mechanics.TimeDependentSystemError` for a system that
-            depends explicitly on the time ``t`` or is analysed in a time-dependent gauge.
+            default value, or a multiplier name is not a free multiplier.
         """
-        from dirac.codegen import GeneratedFunction, array_function, generate_module
-        from dirac.flows.mechanics import refuse_time_dependent
+        from dirac.codegen import analysed_kernel_source, array_function, load_kernels
 
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
             raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
-        refuse_time_dependent(lagrangian, analysis)
         defaults = {p: float(v) for p, v in lagrangian.parameters.items() if v is not None}
         missing = [p.name for p in lagrangian.parameters if p not in defaults]
         if missing:
@@ -127,17 +123,9 @@ class AnalysedSystem:
         constraints = list(analysis.second_class)
         chosen = _free_multipliers(analysis, multipliers or {})
         H_flow = H + sum((v * phi for v, phi in chosen.values()), sympy.S.Zero)
-        gradient = [sympy.diff(H_flow, s) for s in z]
-        jacobian = [sympy.diff(c, s) for c in constraints for s in z]
-        generated = [
-            GeneratedFunction("hamiltonian_gradient", z, gradient, "grad (H_c + v_f phi_f) over the phase space"),
-            GeneratedFunction("second_class", z, constraints, "second-class constraints Phi"),
-            GeneratedFunction("second_class_jacobian", z, jacobian, "grad Phi, (k, N)"),
-            GeneratedFunction("hamiltonian", z, [H], "canonical Hamiltonian H_c"),
-        ]
-        module = generate_module(generated, list(defaults), title=f"analysed system {lagrangian.name}")
-        g = module.hamiltonian_gradient
-        functions = (g, module.second_class, module.second_class_jacobian, module.hamiltonian, g, g, g)
+        time = getattr(analysis, "time", None)  # a time-dependent system, or a gauge such as x0 - t
+        module = load_kernels(analysed_kernel_source(z, list(defaults), H_flow, constraints, time,
+                                                     title=f"analysed system {lagrangian.name}"))
         velocities = list(lagrangian.velocities)
         expression = lagrangian.expression.subs(defaults)
         momenta = array_function([list(lagrangian.coordinates), velocities],
@@ -150,35 +138,27 @@ class AnalysedSystem:
             parameter_values={**lagrangian.fixed_values, **{p.name: v for p, v in defaults.items()}},
             params=np.array(list(defaults.values()), dtype=float),
             module=module,
-            functions=functions,
             analysis=analysis,
             momenta=momenta,
             gauge_multipliers={name: str(v) for name, (v, _) in chosen.items()},
         )
 
-    def _call(self, name: str, z: np.ndarray, size: int) -> np.ndarray:
-        from dirac.flows.constrained_kernels import call
+    def energy(self, z: np.ndarray, time: float = 0.0) -> float:
+        """``H_c(z, t)`` (generated kernel ``energy``)."""
+        return float(self.module.energy(np.ascontiguousarray(z, dtype=float), float(time), self.params))
 
-        return call(getattr(self.module, name), z, self.params, size)
-
-    def energy(self, z: np.ndarray) -> float:
-        """``H_c(z)``."""
-        return float(self._call("hamiltonian", z, 1)[0])
-
-    def constraint_residual(self, z: np.ndarray) -> float:
-        """``max |Phi(z)|`` over the second-class constraints."""
+    def constraint_residual(self, z: np.ndarray, time: float = 0.0) -> float:
+        """``max |Phi(z, t)|`` over the second-class constraints (generated kernel ``residuals``)."""
         if self.n_constraints == 0:
             return 0.0
-        return float(np.max(np.abs(self._call("second_class", z, self.n_constraints))))
+        out = np.empty(self.n_constraints)
+        self.module.residuals(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
+        return float(np.max(np.abs(out)))
 
-    def field(self, z: np.ndarray) -> np.ndarray:
-        """``z_dot`` at ``z``."""
-        from dirac.flows.constrained_kernels import analysed_field, quiet
-
+    def field(self, z: np.ndarray, time: float = 0.0) -> np.ndarray:
+        """``z_dot`` at ``z`` and ``time`` (generated kernel ``field``)."""
         out = np.empty(self.dimension)
-        with quiet():
-            analysed_field(self.functions, np.ascontiguousarray(z, dtype=float), self.params, self.dimension // 2,
-                           self.n_constraints, out)
+        self.module.field(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
         return out
 
     def initial_state(self, q: dict[str, float], q_dot: dict[str, float] | None = None,
@@ -279,7 +259,8 @@ class AnalysedProblem:
         return dict(self.analysed.parameter_values)
 
 
-def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.ndarray) -> dict[str, np.ndarray]:
+def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.ndarray,
+                     time: float = 0.0) -> dict[str, np.ndarray]:
     """Outputs of an analysed system from batched ``z`` (B, N): the state ``z``, its
     coordinate half ``q`` (coordinates and multipliers), momentum half ``p``, ``energy``
     (``H_c``) and ``constraint_residual`` (``max |Phi|``)."""
@@ -293,7 +274,7 @@ def analysed_outputs(analysed: AnalysedSystem, names: tuple[str, ...], z: np.nda
         elif name == "p":
             result[name] = z[:, half:].copy()
         elif name == "energy":
-            result[name] = np.array([analysed.energy(x) for x in z])
+            result[name] = np.array([analysed.energy(x, time) for x in z])
         elif name == "constraint_residual":
-            result[name] = np.array([analysed.constraint_residual(x) for x in z])
+            result[name] = np.array([analysed.constraint_residual(x, time) for x in z])
     return result

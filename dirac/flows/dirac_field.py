@@ -10,7 +10,7 @@ are eliminated here), the motion is the Dirac-bracket flow (240)
 
 with ``J = [[0, 1], [-1, 0]]``. ``C`` is evaluated and solved numerically at each point
 (never a symbolic inverse); the numba kernel is
-:func:`dirac.flows.constrained_kernels.dirac_field`. Every ``Phi_a`` is an exact invariant of this field
+:func:`field` of the system's generated kernel module (:mod:`dirac.codegen.kernel_source`). Every ``Phi_a`` is an exact invariant of this field
 (``{Phi_a, H}_D = 0`` identically), so quadratic constraints are kept by the implicit
 midpoint rule.
 """
@@ -29,34 +29,29 @@ class ConstrainedField:
         self.mechanics = mechanics
         self.n = mechanics.dimension
         self.m = mechanics.n_constraints
-        from dirac.flows.constrained_kernels import dirac_field
-
-        self._kernel = dirac_field
-        self._functions = mechanics.functions
+        self._kernel = mechanics.module.field
         self._params = mechanics.params
 
-    def __call__(self, z: np.ndarray) -> np.ndarray:
-        """``z_dot`` at ``z = (q, p)`` (shape (2n,))."""
-        from dirac.flows.constrained_kernels import quiet
-
+    def __call__(self, z: np.ndarray, time: float = 0.0) -> np.ndarray:
+        """``z_dot`` at ``z = (q, p)`` (shape (2n,)) and ``time``."""
         out = np.empty(2 * self.n)
-        with quiet():
-            self._kernel(self._functions, np.ascontiguousarray(z, dtype=float), self._params, self.n, self.m, out)
+        self._kernel(np.ascontiguousarray(z, dtype=float), float(time), self._params, out)
         return out
 
     def scipy_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """``fun(t, y)`` for scipy's solvers."""
-        return self(y)
+        return self(y, t)
 
-    def outputs(self, names: tuple[str, ...], q: np.ndarray, p: np.ndarray) -> dict[str, np.ndarray]:
-        return constrained_outputs(self.mechanics, names, q, p)
+    def outputs(self, names: tuple[str, ...], q: np.ndarray, p: np.ndarray, time: float = 0.0) -> dict[str, np.ndarray]:
+        return constrained_outputs(self.mechanics, names, q, p, time)
 
 
-def constrained_outputs(mechanics, names: tuple[str, ...], q: np.ndarray, p: np.ndarray) -> dict[str, np.ndarray]:
-    """Outputs of a constrained system from batched ``q`` (B, n) and ``p`` (B, n).
+def constrained_outputs(mechanics, names: tuple[str, ...], q: np.ndarray, p: np.ndarray,
+                        time: float = 0.0) -> dict[str, np.ndarray]:
+    """Outputs of a constrained system from batched ``q`` (B, n) and ``p`` (B, n) at ``time``.
 
-    ``q_dot = M(q)^{-1} p``; ``energy = H``; ``constraint_residual`` is
-    ``max(|chi(q)|, |G M^{-1} p|)`` (positions and velocities).
+    ``q_dot = M(q, t)^{-1} p``; ``energy = H``; ``constraint_residual`` is
+    ``max(|chi(q, t)|, |G M^{-1} p + d chi/dt|)`` (positions and velocities).
     """
     result: dict[str, np.ndarray] = {}
     for name in names:
@@ -65,11 +60,11 @@ def constrained_outputs(mechanics, names: tuple[str, ...], q: np.ndarray, p: np.
         elif name == "p":
             result[name] = p.copy()
         elif name == "q_dot":
-            result[name] = np.array([np.linalg.solve(mechanics.mass_matrix(a), b) for a, b in zip(q, p)])
+            result[name] = np.array([np.linalg.solve(mechanics.mass_matrix(a, time), b) for a, b in zip(q, p)])
         elif name == "energy":
-            result[name] = np.array([mechanics.energy(a, b) for a, b in zip(q, p)])
+            result[name] = np.array([mechanics.energy(a, b, time) for a, b in zip(q, p)])
         elif name == "constraint_residual":
-            result[name] = np.array([mechanics.constraint_residual(a, b) for a, b in zip(q, p)])
+            result[name] = np.array([mechanics.constraint_residual(a, b, time) for a, b in zip(q, p)])
         else:  # pragma: no cover - validated before
             raise KeyError(name)
     return result

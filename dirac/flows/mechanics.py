@@ -10,8 +10,11 @@ Hamiltonian is ``H = 1/2 p^T M(q)^{-1} p + V(q)`` and the constrained equations 
 stage (Sect. X). The multipliers ``lambda`` are those of the extended Lagrangian (1).
 
 :class:`MechanicalSystem` extracts ``M(q)``, ``V(q)`` and ``chi(q)`` from a
-:class:`dirac.Lagrangian` (sympy, once), and generates numba functions for them
-(:mod:`dirac.codegen.numba_backend`). Lagrangians that are not of this form (terms linear in the
+:class:`dirac.Lagrangian` (sympy, once), and generates one numba module of step kernels
+for them (:mod:`dirac.codegen.kernel_source`: RATTLE, the Dirac vector field, the
+midpoint rule, energies and residuals with every expression inlined). A Lagrangian with
+a time symbol (``Lagrangian.time``) gives ``M(q, t)``, ``V(q, t)``, ``chi(q, t)``; the
+hidden constraint is then ``G M^{-1} p + d chi/dt = 0``. Lagrangians that are not of this form (terms linear in the
 velocities, non-quadratic kinetic energy, a singular mass matrix) are refused with an
 :class:`InputError` saying why.
 """
@@ -20,7 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import sympy
@@ -32,35 +35,13 @@ from dirac.validate import unknown_name_error, validate_finite
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
 
-__all__ = ["MechanicalSystem", "NotMechanicalError", "TimeDependentSystemError", "refuse_time_dependent", "resolve_parameters"]
+__all__ = ["MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
 
 
 class NotMechanicalError(InputError):
     """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
     velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
     flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
-
-
-class TimeDependentSystemError(InputError):
-    """The Lagrangian or a constraint depends explicitly on the time ``t``: the compiled
-    flows integrate autonomous systems only, so they refuse it instead of freezing ``t``."""
-
-
-def refuse_time_dependent(lagrangian: Lagrangian, analysis: object | None = None) -> None:
-    """Raise :class:`TimeDependentSystemError` when ``lagrangian`` depends explicitly on ``t``,
-    or when ``analysis`` of it does (a time-dependent gauge such as ``x0 - t``)."""
-    if analysis is not None and getattr(analysis, "time", None) is not None and not lagrangian.is_time_dependent:
-        raise TimeDependentSystemError(
-            f"the gauge conditions {', '.join(getattr(analysis, 'gauge_conditions', ()))} of {lagrangian.name!r} "
-            "depend explicitly on the time t: the numerical flows integrate only systems without explicit time "
-            "dependence; use a gauge without t for a flow, or equations_of_motion of the analysis"
-        )
-    if lagrangian.is_time_dependent:
-        raise TimeDependentSystemError(
-            f"system {lagrangian.name!r} depends explicitly on the time t (a rheonomic system): the "
-            "numerical flows integrate only systems without explicit time dependence; analyse it with "
-            "dirac analyze (or dirac.analyze), which includes the partial time derivatives"
-        )
 
 
 def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
@@ -90,12 +71,11 @@ def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] |
 class MechanicalSystem:
     """Numerical pieces of a natural mechanical system with holonomic constraints.
 
-    Build it with :meth:`from_lagrangian`. Generated numba functions (``f(q, params, out)``
-    with a flat ``out``, coordinates in :attr:`coordinate_names` order): ``mass`` (n, n),
-    ``grad_potential`` (n,), ``potential`` (1,), ``constraints`` (m,),
-    ``constraint_jacobian`` (m, n), ``mass_derivative`` (n, n, n) with
-    ``[k, i, j] = dM_ij/dq_k``, ``constraint_hessian`` (m, n, n); :attr:`functions` is the
-    tuple handed to the kernels of :mod:`dirac.flows.constrained_kernels`.
+    Build it with :meth:`from_lagrangian`. :attr:`module` is the generated kernel module
+    of :func:`dirac.codegen.kernel_source.mechanical_kernel_source` (functions
+    ``f(q, t, c, out)`` of the coordinates in :attr:`coordinate_names` order, the time and
+    the parameter values :attr:`params`; step loops ``rattle_constant_mass``,
+    ``rattle_general``, ``midpoint_run``; ``field``, ``energy``, ``residuals``).
 
     Attributes
     ----------
@@ -108,7 +88,9 @@ class MechanicalSystem:
     parameter_values : dict
         Parameter name -> value used.
     constant_mass : numpy.ndarray or None
-        The mass matrix when it does not depend on ``q`` (fast RATTLE path).
+        The mass matrix when it depends on neither ``q`` nor ``t`` (fast RATTLE path).
+    time_symbol : sympy.Symbol or None
+        The time of a time-dependent system, else None.
     """
 
     name: str
@@ -118,8 +100,8 @@ class MechanicalSystem:
     parameter_values: dict[str, float]
     params: np.ndarray
     constant_mass: np.ndarray | None
-    module: object
-    functions: tuple = field(repr=False, default=())
+    module: Any = field(repr=False, default=None)
+    time_symbol: sympy.Symbol | None = field(repr=False, default=None)
     symbolic: dict[str, object] = field(repr=False, default_factory=dict)
 
     # ------------------------------------------------------------------ building
@@ -166,16 +148,16 @@ class MechanicalSystem:
         parameters
             Overrides of parameter values, by name.
         extra_source
-            Numba source appended to the generated module (step loops).
+            Numba source appended to the generated kernel module.
 
         Raises
         ------
         InputError
             Unknown or missing parameter values, velocity-linear terms, a kinetic energy
-            that is not quadratic in the velocities, a mass matrix that is singular, or
-            (:class:`TimeDependentSystemError`) an explicit dependence on the time ``t``.
+            that is not quadratic in the velocities, or a mass matrix that is singular.
+            An explicit time ``t`` (``lagrangian.time``) is taken: ``M(q, t)``, ``V(q, t)``,
+            ``chi(q, t)``.
         """
-        refuse_time_dependent(lagrangian)
         values = resolve_parameters(lagrangian, parameters)
         q = list(lagrangian.coordinates)
         v = list(lagrangian.velocities)
@@ -201,32 +183,17 @@ class MechanicalSystem:
         parameter_symbols = list(lagrangian.parameters)
         param_array = np.array([float(values[p.name]) for p in parameter_symbols], dtype=float)
         n, m = len(q), len(lagrangian.constraints)
-        jacobian = chis.jacobian(q) if m else sympy.zeros(0, n)
-        grad_v = sympy.Matrix([sympy.diff(potential, s) for s in q])
-        dmass = [mass.diff(s) for s in q]
-        hessians = [e for chi in chis for e in sympy.hessian(chi, q)]
-        constant = all(not (entry.free_symbols & set(q)) for entry in mass)
-        from dirac.codegen import GeneratedFunction, generate_module
+        time = lagrangian.time if lagrangian.is_time_dependent else None
+        constant = all(not (entry.free_symbols & {*q, *([time] if time is not None else [])}) for entry in mass)
+        from dirac.codegen import load_kernels, mechanical_kernel_source
 
-        args = tuple(q)
-        functions = [
-            GeneratedFunction("mass", args, mass, "mass matrix M(q), (n, n)"),
-            GeneratedFunction("potential", args, [potential], "potential V(q), (1,)"),
-            GeneratedFunction("grad_potential", args, grad_v, "dV/dq, (n,)"),
-            GeneratedFunction("constraints", args, list(chis), "holonomic constraints chi(q), (m,)"),
-            GeneratedFunction("constraint_jacobian", args, jacobian, "G = dchi/dq, (m, n)"),
-            GeneratedFunction(
-                "mass_derivative", args, [e for d in dmass for e in d], "dM_ij/dq_k as [k, i, j], (n, n, n)"
-            ),
-            GeneratedFunction("constraint_hessian", args, hessians, "d2 chi_a/dq_k dq_j as [a, k, j], (m, n, n)"),
-        ]
-        from dirac.flows import constrained_kernels
-
-        module = generate_module(functions, parameter_symbols, extra_source, title=f"system {lagrangian.name}")
-        functions_tuple = tuple(getattr(module, name) for name in constrained_kernels.FUNCTION_NAMES)
+        source = mechanical_kernel_source(q, parameter_symbols, mass, potential, list(chis), time,
+                                          title=f"system {lagrangian.name}")
+        module = load_kernels(source + extra_source)
         constant_mass = None
         if constant:
-            constant_mass = constrained_kernels.call(module.mass, np.zeros(n), param_array, n * n).reshape(n, n)
+            constant_mass = np.empty((n, n))
+            module.mass(np.zeros(n), 0.0, param_array, constant_mass)
         system = cls(
             name=lagrangian.name,
             coordinate_names=tuple(s.name for s in q),
@@ -236,24 +203,25 @@ class MechanicalSystem:
             params=param_array,
             constant_mass=constant_mass,
             module=module,
-            functions=functions_tuple,
+            time_symbol=time,
             symbolic={"mass": mass, "potential": potential, "constraints": chis, "coordinates": q,
                       "parameters": parameter_symbols},
         )
         return system
 
     # ------------------------------------------------------------------ numerics (numpy side)
-    def _call(self, name: str, q: np.ndarray, size: int) -> np.ndarray:
-        from dirac.flows.constrained_kernels import call
+    def _evaluate(self, name: str, q: np.ndarray, time: float, shape: tuple[int, ...]) -> np.ndarray:
+        """The generated function ``name(q, t, c, out)`` of the kernel module at one point."""
+        out = np.empty(shape)
+        getattr(self.module, name)(np.ascontiguousarray(q, dtype=float), float(time), self.params, out)
+        return out
 
-        return call(getattr(self.module, name), q, self.params, size)
-
-    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """``M(q)``, checked to be symmetric positive definite."""
+    def mass_matrix(self, q: np.ndarray, time: float = 0.0) -> np.ndarray:
+        """``M(q, t)``, checked to be symmetric positive definite."""
         if self.constant_mass is not None:
             matrix = self.constant_mass.copy()
         else:
-            matrix = self._call("mass", q, self.dimension * self.dimension).reshape(self.dimension, self.dimension)
+            matrix = self._evaluate("mass", q, time, (self.dimension, self.dimension))
         eigenvalues = np.linalg.eigvalsh(matrix)
         if not np.all(np.isfinite(eigenvalues)) or eigenvalues.min() <= 1e-14 * max(1.0, eigenvalues.max()):
             raise InputError(
@@ -262,32 +230,37 @@ class MechanicalSystem:
             )
         return matrix
 
-    def energy(self, q: np.ndarray, p: np.ndarray) -> float:
-        """``H = 1/2 p^T M(q)^{-1} p + V(q)``."""
-        potential = self._call("potential", q, 1)[0]
-        return float(0.5 * p @ np.linalg.solve(self.mass_matrix(q), p) + potential)
+    def energy(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> float:
+        """``H = 1/2 p^T M(q, t)^{-1} p + V(q, t)`` (generated kernel ``energy``)."""
+        self.mass_matrix(q, time)  # refuses a singular mass matrix
+        q = np.ascontiguousarray(q, dtype=float)
+        return float(self.module.energy(q, np.ascontiguousarray(p, dtype=float), float(time), self.params))
 
-    def residuals(self, q: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Position residuals ``chi(q)`` and velocity residuals ``G(q) M(q)^{-1} p``."""
+    def residuals(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """Position residuals ``chi(q, t)`` and velocity residuals ``G(q, t) M(q, t)^{-1} p + d chi/dt``
+        (generated kernel ``residuals``)."""
         m = self.n_constraints
         if m == 0:
             return np.zeros(0), np.zeros(0)
-        chi = self._call("constraints", q, m)
-        G = self._call("constraint_jacobian", q, m * self.dimension).reshape(m, self.dimension)
-        return chi, G @ np.linalg.solve(self.mass_matrix(q), p)
+        self.mass_matrix(q, time)  # refuses a singular mass matrix
+        out = np.empty(2 * m)
+        self.module.residuals(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(p, dtype=float),
+                              float(time), self.params, out)
+        return out[:m], out[m:]
 
-    def constraint_residual(self, q: np.ndarray, p: np.ndarray) -> float:
-        """``max(|chi(q)|, |G M^{-1} p|)``: distance from the constraint surface."""
-        chi, velocity = self.residuals(q, p)
+    def constraint_residual(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> float:
+        """``max(|chi|, |G M^{-1} p + d chi/dt|)``: distance from the constraint surface."""
+        chi, velocity = self.residuals(q, p, time)
         if chi.size == 0:
             return 0.0
         return float(max(np.max(np.abs(chi)), np.max(np.abs(velocity))))
 
-    def project(self, q: np.ndarray, p: np.ndarray, tol: float = 1e-14, max_iter: int = 50) -> tuple[np.ndarray, np.ndarray]:
+    def project(self, q: np.ndarray, p: np.ndarray, tol: float = 1e-14, max_iter: int = 50,
+                time: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Project ``(q, p)`` onto the constraint surface (closest point in the metric ``M``).
 
-        ``q <- q - M^{-1} G^T (G M^{-1} G^T)^{-1} chi(q)`` (Newton, until ``|chi|`` stops
-        decreasing), then ``p <- p - G^T (G M^{-1} G^T)^{-1} G M^{-1} p``.
+        ``q <- q - M^{-1} G^T (G M^{-1} G^T)^{-1} chi(q, t)`` (Newton, until ``|chi|`` stops
+        decreasing), then ``p <- p - G^T (G M^{-1} G^T)^{-1} (G M^{-1} p + d chi/dt)``.
 
         Raises
         ------
@@ -301,19 +274,20 @@ class MechanicalSystem:
             return q, p
         shape = (m, self.dimension)
         for _ in range(max_iter):
-            chi = self._call("constraints", q, m)
+            chi = self._evaluate("constraints", q, time, (m,))
             if np.max(np.abs(chi)) <= tol * (1.0 + q @ q):
                 break
-            G = self._call("constraint_jacobian", q, m * self.dimension).reshape(shape)
-            A = np.linalg.solve(self.mass_matrix(q), G.T)
+            G = self._evaluate("jacobian", q, time, shape)
+            A = np.linalg.solve(self.mass_matrix(q, time), G.T)
             q = q - A @ np.linalg.solve(G @ A, chi)
         else:
             raise InputError(
                 f"could not project the initial q onto the constraints of {self.name!r} "
                 f"(residual {np.max(np.abs(chi)):.3g}): give q closer to the surface"
             )
-        G = self._call("constraint_jacobian", q, m * self.dimension).reshape(shape)
-        mass = self.mass_matrix(q)
+        G = self._evaluate("jacobian", q, time, shape)
+        mass = self.mass_matrix(q, time)
         A = np.linalg.solve(mass, G.T)
-        p = p - G.T @ np.linalg.solve(G @ A, G @ np.linalg.solve(mass, p))
+        hidden = G @ np.linalg.solve(mass, p) + self._evaluate("constraints_dt", q, time, (m,))
+        p = p - G.T @ np.linalg.solve(G @ A, hidden)
         return q, p

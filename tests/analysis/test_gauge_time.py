@@ -38,7 +38,6 @@ import sympy
 
 import dirac
 from dirac.flows.analysed import AnalysedSystem
-from dirac.flows.mechanics import TimeDependentSystemError
 from dirac.model.lagrangian import Lagrangian
 
 M = 1.3
@@ -173,9 +172,27 @@ def test_time_dependent_gauges_that_are_not_admissible(particle):
         particle.fix_gauge(["t - 1"])
 
 
-def test_flows_refuse_a_time_dependent_gauge(lab_gauge):
-    with pytest.raises(TimeDependentSystemError, match="x0 - t"):
-        AnalysedSystem.from_analysis(lab_gauge)
+def test_flow_in_the_time_dependent_gauge_x0_equals_t(lab_gauge):
+    """The flow of the gauge-fixed particle in the gauge x0 = t, e p_0 = -1 (the midpoint rule
+    on the Dirac field with its explicit-time term): by hand the momenta are constant, x0 = t
+    exactly, e = -1/p0 and x1 moves at the constant speed -p1/p0 (the motion of a free
+    relativistic particle in its lab time)."""
+    import numpy as np
+
+    from dirac.flows.analysed import AnalysedProblem
+
+    system = AnalysedSystem.from_analysis(lab_gauge)
+    point = lab_gauge.surface_point({"e": 0.5, "x1": 0.3, "t": 0.0})
+    z0 = np.array([point[name] for name in system.variable_names])
+    solution = dirac.integrate(AnalysedProblem(system, z0), "midpoint", t_end=2.0, dt=0.01, samples=5,
+                               outputs=["z", "constraint_residual"])
+    names = list(system.variable_names)
+    z = solution["z"]
+    assert z[:, names.index("x0")] == pytest.approx(solution.t, abs=1e-10)
+    assert z[:, names.index("e")] == pytest.approx(-1 / point["p_x0"], rel=1e-10)
+    speed = -point["p_x1"] / point["p_x0"]
+    assert z[:, names.index("x1")] == pytest.approx(0.3 + speed * solution.t, abs=1e-10)
+    assert np.max(solution["constraint_residual"]) <= 1e-10
 
 
 def test_cli_time_dependent_gauge(run_cli, tmp_path):

@@ -33,15 +33,16 @@ class ConstrainedStepper(Stepper):
         self.q = np.ascontiguousarray(problem.q0, dtype=float).copy()
         self.p = np.ascontiguousarray(problem.p0, dtype=float).copy()
         self.tol, self.max_iter, self.info = newton_options(options)
+        self.time = 0.0  # the time of the state (time-dependent systems)
 
     def observe(self) -> dict[str, np.ndarray]:
-        return constrained_outputs(self.mechanics, self.outputs, self.q, self.p)
+        return constrained_outputs(self.mechanics, self.outputs, self.q, self.p, self.time)
 
     def finite(self) -> bool:
         return bool(np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.p)))
 
     def drift(self) -> float:
-        return max(self.mechanics.constraint_residual(q, p) for q, p in zip(self.q, self.p))
+        return max(self.mechanics.constraint_residual(q, p, self.time) for q, p in zip(self.q, self.p))
 
     def _raise_if_failed(self, what: str) -> None:
         if self.info[1] != 0.0:

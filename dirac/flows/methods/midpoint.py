@@ -11,7 +11,8 @@ rigid body (Lie–Poisson structure, Austin, Krishnaprasad & Wang 1993): ``|M|^2
   ``dR/dt = R hat(Omega_mid)``, orthogonal by construction); numba kernel
   :func:`dirac.rigidbody.midpoint.midpoint_rigid_body`.
 * General systems: the Dirac vector field of :mod:`dirac.flows.dirac_field` with
-  simplified Newton iterations (numba kernel ``midpoint_run``). Quadratic holonomic
+  simplified Newton iterations (``midpoint_run`` of the system's generated kernel module,
+  :mod:`dirac.codegen.kernel_source`). Quadratic holonomic
   constraints (pendulums) and their quadratic time derivatives are kept to the Newton
   tolerance.
 * Analysed systems (any Lagrangian the Dirac–Bergmann engine analyses): the Dirac vector
@@ -25,7 +26,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from dirac.flows import constrained_kernels as kernels
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.constrained_stepper import ConstrainedStepper, newton_options, singular_as_step_failure
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
@@ -73,21 +73,20 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         n = self.mechanics.dimension
         self.q = self.z[:, :n]
         self.p = self.z[:, n:]
-        self._kernel = kernels.midpoint_run
+        self._kernel = self.mechanics.module.midpoint_run
 
     def warm_up(self) -> None:
-        n, m = self.mechanics.dimension, self.mechanics.n_constraints
-        with kernels.quiet():
-            self._kernel(0, self.mechanics.functions, self.z[0].copy(), self.mechanics.params, n, m, 1e-6, 1, self.tol, self.max_iter, self.info)
+        self._kernel(self.z[0].copy(), self.time, self.mechanics.params, 1e-6, 1, self.tol, self.max_iter, self.info)
 
     def step(self, n_steps: int, dt: float) -> None:
-        n, m = self.mechanics.dimension, self.mechanics.n_constraints
         for b in range(self.z.shape[0]):
-            with kernels.quiet(), singular_as_step_failure("midpoint"):
-                self._kernel(0, self.mechanics.functions, self.z[b], self.mechanics.params, n, m, dt, n_steps, self.tol, self.max_iter, self.info)
+            with singular_as_step_failure("midpoint"):
+                self._kernel(self.z[b], self.time, self.mechanics.params, dt, n_steps, self.tol, self.max_iter,
+                             self.info)
             self.evaluations += int(self.info[2])
             self._raise_if_failed("midpoint")
         self.steps += n_steps
+        self.time += n_steps * dt
 
 
 class AnalysedMidpointStepper(Stepper):
@@ -100,33 +99,34 @@ class AnalysedMidpointStepper(Stepper):
         self.outputs = outputs
         self.z = np.ascontiguousarray(problem.z0, dtype=float).copy()
         self.tol, self.max_iter, self.info = newton_options(options)
-        self._kernel = kernels.midpoint_run
+        self._kernel = self.analysed.module.midpoint_run
+        self.time = 0.0
 
     def _run(self, z: np.ndarray, n_steps: int, dt: float) -> None:
-        with kernels.quiet():
-            self._kernel(1, self.analysed.functions, z, self.analysed.params, self.analysed.dimension // 2,
-                         self.analysed.n_constraints, dt, n_steps, self.tol, self.max_iter, self.info)
+        self._kernel(z, self.time, self.analysed.params, dt, n_steps, self.tol, self.max_iter, self.info)
 
     def warm_up(self) -> None:
         self._run(self.z[0].copy(), 1, 1e-6)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.z.shape[0]):
-            self._run(self.z[b], n_steps, dt)
+            with singular_as_step_failure("midpoint"):
+                self._run(self.z[b], n_steps, dt)
             self.evaluations += int(self.info[2])
             _raise_if_failed(self.info, self.max_iter)
         self.steps += n_steps
+        self.time += n_steps * dt
 
     def observe(self) -> dict[str, np.ndarray]:
         from dirac.flows.analysed import analysed_outputs  # imports sympy: only for analysed systems
 
-        return analysed_outputs(self.analysed, self.outputs, self.z)
+        return analysed_outputs(self.analysed, self.outputs, self.z, self.time)
 
     def finite(self) -> bool:
         return bool(np.all(np.isfinite(self.z)))
 
     def drift(self) -> float:
-        return max(self.analysed.constraint_residual(z) for z in self.z)
+        return max(self.analysed.constraint_residual(z, self.time) for z in self.z)
 
 
 def _rigid_body_factory(method: Method, problem, outputs, options) -> Stepper:

@@ -9,7 +9,9 @@ Kahan–Li) raise its order to 4, 6, 8 (``rattle-4`` ...), with the coefficients
 
 With a constant mass matrix (Cartesian coordinates) the Newton iteration runs on the
 ``m`` multipliers only; otherwise on ``(p_half, q1, lambda)`` (Jay 1996). Both step loops
-are numba kernels compiled once (:mod:`dirac.flows.constrained_kernels`). A step whose
+are generated per system with every expression inlined
+(:mod:`dirac.codegen.kernel_source`) and compiled once per machine. Time-dependent
+constraints and potentials are evaluated at the times of the sub-steps. A step whose
 Newton iteration does not converge within ``max_newton_iterations`` stops the run with
 the state of the last completed step.
 """
@@ -22,7 +24,6 @@ from typing import cast
 import numpy as np
 
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
-from dirac.flows import constrained_kernels as kernels
 from dirac.flows.methods.base import Method, Stepper
 from dirac.flows.methods.constrained_stepper import ConstrainedStepper, singular_as_step_failure
 
@@ -40,33 +41,30 @@ class RattleStepper(ConstrainedStepper):
         self.constant = self.mechanics.constant_mass is not None
         if self.constant:
             self.mechanics.mass_matrix(self.q[0])  # checks positivity
-            self.minv = np.linalg.inv(self.mechanics.constant_mass)
-            self._kernel = kernels.rattle_constant_mass
+            self._kernel = self.mechanics.module.rattle_constant_mass
         else:
             for q in self.q:
                 self.mechanics.mass_matrix(q)
-            self._kernel = kernels.rattle_general
+            self._kernel = self.mechanics.module.rattle_general
 
     def _call(self, q: np.ndarray, p: np.ndarray, n_steps: int, dt: float) -> None:
-        m = self.mechanics.n_constraints
         params = self.mechanics.params
-        fns = self.mechanics.functions
         if self.constant:
-            self._kernel(fns, q, p, self.minv, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
+            self._kernel(q, p, self.time, params, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
         else:
-            self._kernel(fns, q, p, params, m, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
+            self._kernel(q, p, self.time, params, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
 
     def warm_up(self) -> None:
-        with kernels.quiet():
-            self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6)
+        self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.q.shape[0]):
-            with kernels.quiet(), singular_as_step_failure(self.name):
+            with singular_as_step_failure(self.name):
                 self._call(self.q[b], self.p[b], n_steps, dt)
             self.evaluations += int(self.info[2])
             self._raise_if_failed(self.name)
         self.steps += n_steps
+        self.time += n_steps * dt
 
 
 def _factory(method: Method, problem, outputs, options) -> Stepper:

@@ -57,7 +57,7 @@ class ScipyStepper(Stepper):
             states = [np.concatenate([M, R.ravel()]) if self.with_R else M.copy() for M, R in zip(problem.M0, problem.R0)]
         elif kind == "analysed":
             self.analysed = problem.analysed
-            self._fun, self._args = (lambda t, y: self.analysed.field(y)), ()
+            self._fun, self._args = (lambda t, y: self.analysed.field(y, t)), ()
             states = [z.copy() for z in problem.z0]
         else:
             self.field = ConstrainedField(problem.mechanics)
@@ -107,10 +107,10 @@ class ScipyStepper(Stepper):
         if hasattr(self, "analysed"):
             from dirac.flows.analysed import analysed_outputs
 
-            return analysed_outputs(self.analysed, self.outputs, self.y)
+            return analysed_outputs(self.analysed, self.outputs, self.y, self.t)
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
-            return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:])
+            return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:], self.t)
 
         M = self.y[:, :3]
         R = self.y[:, 3:].reshape(-1, 3, 3) if self.with_R else None
@@ -118,10 +118,10 @@ class ScipyStepper(Stepper):
 
     def drift(self) -> float:
         if hasattr(self, "analysed"):
-            return max(self.analysed.constraint_residual(y) for y in self.y)
+            return max(self.analysed.constraint_residual(y, self.t) for y in self.y)
         if hasattr(self, "field"):
             n = self.problem.mechanics.dimension
-            return max(self.problem.mechanics.constraint_residual(y[:n], y[n:]) for y in self.y)
+            return max(self.problem.mechanics.constraint_residual(y[:n], y[n:], self.t) for y in self.y)
         return 0.0  # RK methods do not preserve R^T R = 1; that is what the baseline shows
 
 

@@ -1,0 +1,507 @@
+"""Step loops of the generated kernels (:mod:`dirac.codegen.kernel_source`), as source text.
+
+The loops call the generated expression functions of their module by name
+(``grad_potential``, ``constraints``, ``jacobian``, ... for a mechanical system;
+``hamiltonian_gradient``, ``second_class``, ... for an analysed one) and the solves of
+:mod:`dirac.codegen.small_solves`. The sizes are written in as literals (``__N__``
+coordinates, ``__M__`` constraints, ``__K__`` second-class constraints), so that numba
+compiles loops of fixed length and the solves of exactly these sizes. Work arrays are
+allocated once per call, before the first step. Every loop takes the start time ``t``;
+the sub-step ``s`` of step ``j`` starts at ``t + j dt + dt (c_1 + ... + c_{s-1})``.
+
+``info`` (float64, 4) reports back ``[steps_done, failed (0/1), evaluations, last_residual]``.
+"""
+
+from __future__ import annotations
+
+__all__ = ["mechanical_templates", "analysed_templates"]
+
+_COMMON = '''
+
+@numba.njit(cache=True, inline="always")
+def max_abs(x):
+    """max |x_i| (inf if any entry is NaN)."""
+    r = 0.0
+    for i in range(x.shape[0]):
+        a = abs(x[i])
+        if a > r or a != a:
+            r = a if a == a else np.inf
+    return r
+
+
+@numba.njit(cache=True, inline="always")
+def scale(x, count):
+    """1 + sum of x_i^2 over the first count entries: the scale of Newton tolerances."""
+    s = 1.0
+    for i in range(count):
+        s += x[i] * x[i]
+    return s
+
+
+@numba.njit(cache=True, inline="always")
+def report(info, steps_done, failed, evals, residual):
+    """info = [steps_done, failed (0/1), evaluations, last_residual]."""
+    info[0] = steps_done
+    info[1] = 1.0 if failed else 0.0
+    info[2] = evals
+    info[3] = residual
+
+
+@numba.njit(cache=True, inline="always")
+def dirac_projection(D, e, out, C, rhs, mu, piv):
+    """out <- out - J D^T C^{-1} (D out + e), C = D J D^T: the Dirac correction (240) of
+    the Hamiltonian field out = J grad H over __K__ second-class constraints with gradients
+    D (rows; columns: coordinates, then momenta) and explicit time derivatives e, so
+    that dPhi/dt = D out + e = 0 afterwards."""
+    n = out.shape[0] // 2
+    for a in range(__K__):
+        acc = e[a]
+        for j in range(n):
+            acc += D[a, j] * out[j] + D[a, n + j] * out[n + j]
+        rhs[a] = acc
+        for b in range(__K__):
+            s = 0.0
+            for j in range(n):
+                s += D[a, j] * D[b, n + j] - D[a, n + j] * D[b, j]
+            C[a, b] = s
+    solve___K__(C, rhs, mu, piv)
+    for b in range(__K__):
+        for j in range(n):
+            out[j] -= mu[b] * D[b, n + j]
+            out[n + j] += mu[b] * D[b, j]
+
+
+@numba.njit(cache=True)
+def midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info):
+    """Implicit midpoint z1 = z0 + dt F((z0 + z1)/2, t + dt/2) on the Dirac vector field
+    F of this module (Hairer, Lubich & Wanner IV.2), simplified Newton with a
+    finite-difference Jacobian of F at z0 per step, factored once per step; an analysed
+    system then projects onto Phi = 0 (Hairer, Lubich & Wanner IV.4)."""
+    NZ = z.shape[0]
+    f = np.empty(NZ)
+    fz = np.empty(NZ)
+    zz = np.empty(NZ)
+    zm = np.empty(NZ)
+    z1 = np.empty(NZ)
+    r = np.empty(NZ)
+    J = np.empty((NZ, NZ))
+    piv = np.empty(NZ, dtype=np.int64)
+    work = field_work()
+    PROJECT_WORK
+    evals = 0.0
+    size = 0.0
+    for step in range(n_steps):
+        tm = t + (step + 0.5) * dt
+        field_into(z, tm, c, f, work)
+        evals += 1.0
+        for j in range(NZ):
+            for i in range(NZ):
+                zz[i] = z[i]
+            d = 1e-7 * (1.0 + abs(z[j]))
+            zz[j] += d
+            field_into(zz, tm, c, fz, work)
+            for i in range(NZ):
+                J[i, j] = -0.5 * dt * (fz[i] - f[i]) / d
+            J[j, j] += 1.0
+        evals += NZ
+        lu_factor(J, piv)
+        for i in range(NZ):
+            z1[i] = z[i] + dt * f[i]
+        converged = False
+        for _it in range(max_iter):
+            for i in range(NZ):
+                zm[i] = 0.5 * (z[i] + z1[i])
+            field_into(zm, tm, c, fz, work)
+            evals += 1.0
+            for i in range(NZ):
+                r[i] = z1[i] - z[i] - dt * fz[i]
+            lu_solve(J, piv, r)
+            scl = 1.0
+            for i in range(NZ):
+                z1[i] -= r[i]
+                if abs(z1[i]) > scl:
+                    scl = abs(z1[i])
+            size = max_abs(r)
+            if size <= tol * scl:
+                converged = True
+                break
+            if size != size or size == np.inf:
+                break
+        if not converged:
+            report(info, step, True, evals, size)
+            return
+        for i in range(NZ):
+            z[i] = z1[i]
+        PROJECT
+    report(info, n_steps, False, evals, size)
+
+
+@numba.njit(cache=True)
+def field(z, t, c, out):
+    """The Dirac vector field at (z, t) (allocates its work arrays: for single evaluations)."""
+    field_into(z, t, c, out, field_work())
+'''
+
+_VELOCITY_BY_ELIMINATION = '''
+
+@numba.njit(cache=True, inline="always")
+def velocity(q, p, t, c, v, work, piv):
+    """v = M(q, t)^{-1} p; work (n, n) keeps the LU factors of M, piv their row exchanges."""
+    mass(q, t, c, work)
+    lu_factor(work, piv)
+    for i in range(__N__):
+        v[i] = p[i]
+    lu_solve(work, piv, v)
+'''
+
+_STAGE_RESIDUAL = '''
+
+@numba.njit(cache=True, inline="always")
+def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv):
+    """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau)."""
+    for i in range(__N__):
+        ph[i] = x[i]
+        q1[i] = x[__N__ + i]
+    velocity(q, ph, tau, c, v0, work, piv)
+    force(q, v0, tau, c, f0)
+    for i in range(__N__):
+        acc = 0.0
+        for a in range(__M__):
+            acc += G0[a, i] * x[2 * __N__ + a]
+        r[i] = ph[i] - p[i] + 0.5 * h * (f0[i] + acc)
+    velocity(q1, ph, tau1, c, v1, work, piv)
+    for i in range(__N__):
+        r[__N__ + i] = q1[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+    if __M__ > 0:
+        constraints(q1, tau1, c, chi)
+        for a in range(__M__):
+            r[2 * __N__ + a] = chi[a]
+'''
+
+_MECHANICAL = '''
+
+
+@numba.njit(cache=True, inline="always")
+def project_momentum(G, W, u, chi_t, p, h, S, rhs, mu, piv):
+    """RATTLE's closing projection onto the hidden constraints G M^{-1} p + d chi/dt = 0:
+    with G at the new position, W = M^{-1} G^T and u = M^{-1} p, solve
+    (h/2) G W mu = G u + d chi/dt and set p <- p - (h/2) G^T mu (Hairer, Lubich & Wanner
+    VII.1.4)."""
+    for a in range(__M__):
+        acc = chi_t[a]
+        for i in range(__N__):
+            acc += G[a, i] * u[i]
+        rhs[a] = acc
+        for b in range(__M__):
+            acc = 0.0
+            for i in range(__N__):
+                acc += G[a, i] * W[i, b]
+            S[a, b] = 0.5 * h * acc
+    solve___M__(S, rhs, mu, piv)
+    for i in range(__N__):
+        acc = 0.0
+        for a in range(__M__):
+            acc += G[a, i] * mu[a]
+        p[i] -= 0.5 * h * acc
+
+
+@numba.njit(cache=True)
+def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
+    """RATTLE for H = 1/2 p^T M(q, t)^{-1} p + V(q, t) (Jay 1996; Hairer, Lubich & Wanner
+    VII.1.4, eq. (1.26)), composed with the sub-steps h = dt fractions[s]:
+
+    p_half = p - h/2 (H_q(q, p_half, t) + G(q, t)^T lam)
+    q1 = q + h/2 (H_p(q, p_half, t) + H_p(q1, p_half, t + h)),  chi(q1, t + h) = 0
+    p1 = p_half - h/2 (H_q(q1, p_half, t + h) + G(q1, t + h)^T mu),
+    G(q1, t + h) H_p(q1, p1, t + h) + d chi/dt (q1, t + h) = 0.
+
+    Simplified Newton on (p_half, q1, lam) with a finite-difference Jacobian formed and
+    factored once per sub-step; mu from an m x m solve."""
+    q_save = np.empty(__N__)
+    p_save = np.empty(__N__)
+    x = np.empty(__NX__)
+    xx = np.empty(__NX__)
+    r = np.empty(__NX__)
+    rr = np.empty(__NX__)
+    J = np.empty((__NX__, __NX__))
+    pivx = np.empty(__NX__, dtype=np.int64)
+    v = np.empty(__N__)
+    f = np.empty(__N__)
+    ph = np.empty(__N__)
+    q1 = np.empty(__N__)
+    v0 = np.empty(__N__)
+    f0 = np.empty(__N__)
+    v1 = np.empty(__N__)
+    col = np.empty(__N__)
+    u = np.empty(__N__)
+    work = np.empty((__N__, __N__))
+    pivn = np.empty(__N__, dtype=np.int64)
+    chi = np.zeros(__M__)
+    G0 = np.zeros((__M__, __N__))
+    G1 = np.zeros((__M__, __N__))
+    W = np.zeros((__N__, __M__))
+    S = np.empty((__M__, __M__))
+    rhs = np.empty(__M__)
+    mu = np.empty(__M__)
+    pivm = np.empty(__M__, dtype=np.int64)
+    evals = 0.0
+    residual = 0.0
+    for step in range(n_steps):
+        for i in range(__N__):
+            q_save[i] = q[i]
+            p_save[i] = p[i]
+        tau = t + step * dt
+        for s in range(fractions.shape[0]):
+            h = dt * fractions[s]
+            tau1 = tau + h
+            velocity(q, p, tau, c, v, work, pivn)
+            for i in range(__N__):
+                x[i] = p[i]
+                x[__N__ + i] = q[i] + h * v[i]
+            for a in range(__M__):
+                x[2 * __N__ + a] = 0.0
+            jacobian(q, tau, c, G0)
+            rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, pivn)
+            evals += 1.0
+            for j in range(__NX__):
+                for i in range(__NX__):
+                    xx[i] = x[i]
+                d = 1e-7 * (1.0 + abs(x[j]))
+                xx[j] += d
+                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn)
+                for i in range(__NX__):
+                    J[i, j] = (rr[i] - r[i]) / d
+            evals += __NX__
+            lu_factor(J, pivx)
+            converged = False
+            for _it in range(max_iter):
+                lu_solve(J, pivx, r)
+                for i in range(__NX__):
+                    x[i] -= r[i]
+                rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, pivn)
+                evals += 1.0
+                residual = max_abs(r)
+                if residual <= tol * scale(x, 2 * __N__):
+                    converged = True
+                    break
+                if residual != residual:
+                    break
+            if not converged:
+                for i in range(__N__):
+                    q[i] = q_save[i]
+                    p[i] = p_save[i]
+                report(info, step, True, evals, residual)
+                return
+            for i in range(__N__):
+                ph[i] = x[i]
+                q[i] = x[__N__ + i]
+            velocity(q, ph, tau1, c, v, work, pivn)
+            force(q, v, tau1, c, f)
+            evals += 1.0
+            for i in range(__N__):
+                p[i] = ph[i] - 0.5 * h * f[i]
+            if __M__ > 0:
+                jacobian(q, tau1, c, G1)
+                velocity(q, p, tau1, c, u, work, pivn)
+                for a in range(__M__):
+                    for i in range(__N__):
+                        col[i] = G1[a, i]
+                    velocity(q, col, tau1, c, v, work, pivn)
+                    for i in range(__N__):
+                        W[i, a] = v[i]
+                constraints_dt(q, tau1, c, chi)
+                project_momentum(G1, W, u, chi, p, h, S, rhs, mu, pivm)
+            tau = tau1
+    report(info, n_steps, False, evals, residual)
+
+
+@numba.njit(cache=True)
+def field_work():
+    """Work arrays of field_into."""
+    return (np.empty(__N__), np.empty(__N__), np.zeros((__M__, __N__)), np.empty((__N__, __N__)),
+            np.empty(__N__, dtype=np.int64), np.zeros((__N__, __M__)), np.zeros((__M__, __N__)),
+            np.empty((__N__, __N__)), np.zeros((__K__, 2 * __N__)), np.empty((__K__, __K__)), np.empty(__K__),
+            np.empty(__K__), np.empty(__K__, dtype=np.int64), np.empty(__N__), np.zeros(__K__), np.empty(__M__),
+            np.empty(__N__))
+
+
+@numba.njit(cache=True, inline="always")
+def field_into(z, t, c, out, work):
+    """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on z = (q, p),
+    C = grad Phi J grad Phi^T, over the second-class constraints
+    Phi = (chi(q, t), G(q, t) M^{-1} p + d chi/dt) (the second and third stages; Dirac
+    bracket (240)); C is evaluated and solved at z."""
+    v, f, G, Mw, pivn, W, Hq, dMv, D, C, rhs, mu, pivk, col, e, hdt, mtv = work
+    q = z[:__N__]
+    p = z[__N__:]
+    velocity(q, p, t, c, v, Mw, pivn)
+    force(q, v, t, c, f)
+    for i in range(__N__):
+        out[i] = v[i]
+        out[__N__ + i] = -f[i]
+    if __M__ == 0:
+        return
+    jacobian(q, t, c, G)
+    for a in range(__M__):
+        for i in range(__N__):
+            col[i] = G[a, i]
+        velocity(q, col, t, c, f, Mw, pivn)
+        for i in range(__N__):
+            W[i, a] = f[i]
+    hidden_dq(q, v, t, c, Hq)
+    mass_dq_v(q, v, t, c, dMv)
+    for a in range(__M__):
+        for k in range(__N__):
+            D[a, k] = G[a, k]
+            acc = 0.0
+            for i in range(__N__):
+                acc += W[i, a] * dMv[k, i]
+            D[__M__ + a, k] = Hq[a, k] - acc
+            D[__M__ + a, __N__ + k] = W[k, a]
+    constraints_dt(q, t, c, e)
+    hidden_dt(q, v, t, c, hdt)
+    mass_dt_v(q, v, t, c, mtv)
+    for a in range(__M__):
+        acc = 0.0
+        for i in range(__N__):
+            acc += W[i, a] * mtv[i]
+        e[__M__ + a] = hdt[a] - acc
+    dirac_projection(D, e, out, C, rhs, mu, pivk)
+
+
+@numba.njit(cache=True)
+def energy(q, p, t, c):
+    """H = 1/2 p^T M(q, t)^{-1} p + V(q, t)."""
+    v = np.empty(__N__)
+    velocity(q, p, t, c, v, np.empty((__N__, __N__)), np.empty(__N__, dtype=np.int64))
+    s = 0.0
+    for i in range(__N__):
+        s += p[i] * v[i]
+    return 0.5 * s + potential(q, t, c)
+
+
+@numba.njit(cache=True)
+def residuals(q, p, t, c, out):
+    """out = (chi(q, t), G(q, t) M^{-1} p + d chi/dt): the second- and third-stage
+    constraints (positions and velocities), (2m,)."""
+    v = np.empty(__N__)
+    velocity(q, p, t, c, v, np.empty((__N__, __N__)), np.empty(__N__, dtype=np.int64))
+    chi = np.empty(__M__)
+    G = np.empty((__M__, __N__))
+    constraints(q, t, c, chi)
+    jacobian(q, t, c, G)
+    constraints_dt(q, t, c, out[__M__:])
+    for a in range(__M__):
+        out[a] = chi[a]
+        acc = out[__M__ + a]
+        for i in range(__N__):
+            acc += G[a, i] * v[i]
+        out[__M__ + a] = acc
+'''
+
+_ANALYSED_FIELD = '''
+
+@numba.njit(cache=True, inline="always")
+def field_into(z, t, c, out, work):
+    """z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on
+    the phase space of the analysis (coordinates and multipliers, then their momenta),
+    over the __K__ second-class constraints Phi (240); C is evaluated and solved at z."""
+    g, D, e, C, rhs, mu, piv = work
+    hamiltonian_gradient(z, t, c, g)
+    for i in range(__N__):
+        out[i] = g[__N__ + i]
+        out[__N__ + i] = -g[i]
+    if __K__ == 0:
+        return
+    second_class_jacobian(z, t, c, D)
+    second_class_dt(z, t, c, e)
+    dirac_projection(D, e, out, C, rhs, mu, piv)
+'''
+
+_ANALYSED = '''
+
+@numba.njit(cache=True)
+def field_work():
+    """Work arrays of field_into."""
+    return (np.empty(2 * __N__), np.zeros((__K__, 2 * __N__)), np.empty(__K__), np.empty((__K__, __K__)),
+            np.empty(__K__), np.empty(__K__), np.empty(__K__, dtype=np.int64))
+
+
+@numba.njit(cache=True)
+def project_work():
+    """Work arrays of project."""
+    return (np.empty(__K__), np.empty(__K__), np.empty((__K__, 2 * __N__)), np.empty((__K__, __K__)),
+            np.empty(__K__, dtype=np.int64))
+
+
+@numba.njit(cache=True, inline="always")
+def project(z, t, c, tol, work):
+    """Orthogonal projection of z onto Phi = 0 (Gauss-Newton, at most 5 iterations):
+    z <- z - D^T (D D^T)^{-1} Phi(z) (Hairer, Lubich & Wanner IV.4)."""
+    if __K__ == 0:
+        return
+    phi, y, D, A, piv = work
+    for _it in range(5):
+        second_class(z, t, c, phi)
+        size = 0.0
+        scl = 1.0
+        for a in range(__K__):
+            size = max(size, abs(phi[a]))
+        for i in range(2 * __N__):
+            scl = max(scl, abs(z[i]))
+        if size <= tol * scl:
+            return
+        second_class_jacobian(z, t, c, D)
+        for a in range(__K__):
+            for b in range(__K__):
+                acc = 0.0
+                for i in range(2 * __N__):
+                    acc += D[a, i] * D[b, i]
+                A[a, b] = acc
+        solve___K__(A, phi, y, piv)
+        for i in range(2 * __N__):
+            acc = 0.0
+            for a in range(__K__):
+                acc += D[a, i] * y[a]
+            z[i] -= acc
+
+
+@numba.njit(cache=True)
+def energy(z, t, c):
+    """The canonical Hamiltonian H_c(z, t)."""
+    return hamiltonian(z, t, c)
+
+
+@numba.njit(cache=True)
+def residuals(z, t, c, out):
+    """The second-class constraints Phi(z, t), (k,)."""
+    second_class(z, t, c, out)
+'''
+
+
+def _fill(text: str, n: int, m: int, k: int) -> str:
+    return (text.replace("__NX__", str(2 * n + m)).replace("__N__", str(n)).replace("__M__", str(m))
+            .replace("__K__", str(k)))
+
+
+def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
+    """Step loops of a mechanical system with ``n`` coordinates and ``m`` constraints:
+    ``rattle_general``, ``field``, ``midpoint_run``, ``energy``, ``residuals`` (and
+    their helpers). RATTLE with a constant mass is unrolled per system instead
+    (:mod:`dirac.codegen.rattle_scalar`). ``velocity(q, p, t, c, v, work, piv)``
+    (``v = M^{-1} p``) and ``rattle_residual`` (RATTLE's implicit stage) come from here,
+    by elimination, when ``velocity_by_elimination``; else the module generates both in
+    closed form."""
+    common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
+    by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
+    return _fill(by_elimination + _MECHANICAL + common, n, m, 2 * m)
+
+
+def analysed_templates(n: int, k: int, field_by_elimination: bool = True) -> str:
+    """Step loops of an analysed system (``2n`` phase-space variables, ``k`` second-class
+    constraints): ``field``, ``midpoint_run`` (projected), ``project``, ``energy``,
+    ``residuals``; ``field_into`` too when ``field_by_elimination`` (else the module
+    generates it in closed form)."""
+    common = (_COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol, project_buffers)\n")
+              .replace("    PROJECT_WORK\n", "    project_buffers = project_work()\n"))
+    return _fill((_ANALYSED_FIELD if field_by_elimination else "") + _ANALYSED + common, n, 0, k)
