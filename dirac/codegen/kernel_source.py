@@ -241,11 +241,15 @@ def analysed_kernel_source(
     constraints: Sequence[sympy.Expr],
     time: sympy.Symbol | None = None,
     title: str = "analysed system",
+    energy: sympy.Expr | None = None,
 ) -> str:
     """The numba module of the Dirac vector field (240) on the phase space ``z`` of an
     analysis: ``grad H``, the second-class constraints ``Phi`` and ``grad Phi`` (and their
     time derivatives) generated, the field, the projected implicit midpoint rule,
     energies and residuals as step loops (:mod:`dirac.codegen.kernel_templates`).
+    ``energy`` is the function reported as the energy (default ``hamiltonian``; the
+    canonical ``H_c`` when the flow's ``H`` adds free multipliers times first-class
+    constraints, which differs from it off the surface).
     """
     z = list(variables)
     N, k = len(z), len(constraints)
@@ -255,7 +259,7 @@ def analysed_kernel_source(
     za = [("z", z)]
     ts = [("t", time)]
     functions = [
-        emit_function("hamiltonian", "H(z, t)", za, ts, [hamiltonian], None, parameters),
+        emit_function("hamiltonian", "H(z, t)", za, ts, [hamiltonian if energy is None else energy], None, parameters),
         emit_function("hamiltonian_gradient", "grad H, (2n,)", za, ts, gradient, (N,), parameters),
         emit_function("second_class", "Phi(z, t), (k,)", za, ts, list(constraints), (k,), parameters),
         emit_function("second_class_dt", "d Phi/dt, (k,)", za, ts, phi_t, (k,), parameters),

@@ -125,7 +125,7 @@ class AnalysedSystem:
         H_flow = H + sum((v * phi for v, phi in chosen.values()), sympy.S.Zero)
         time = getattr(analysis, "time", None)  # a time-dependent system, or a gauge such as x0 - t
         module = load_kernels(analysed_kernel_source(z, list(defaults), H_flow, constraints, time,
-                                                     title=f"analysed system {lagrangian.name}"))
+                                                     title=f"analysed system {lagrangian.name}", energy=H))
         velocities = list(lagrangian.velocities)
         expression = lagrangian.expression.subs(defaults)
         momenta = array_function([list(lagrangian.coordinates), velocities],
