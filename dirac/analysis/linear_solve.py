@@ -145,7 +145,15 @@ def weak_solve(
     b_vals = np.asarray(b_num, dtype=float).reshape(-1, k, cols)
     a_zero = _zero_mask(a_vals)
     b_zero = _zero_mask(b_vals)
-    x_vals = np.array([np.linalg.solve(a, b) for a, b in zip(a_vals, b_vals)])
+    try:
+        x_vals = np.array([np.linalg.solve(a, b) for a, b in zip(a_vals, b_vals)])
+    except np.linalg.LinAlgError:
+        raise AnalysisError(
+            f"a {k}x{k} system the analysis solves on the constraint surface is singular at one of its sample "
+            "points, though independent at others: the surface has parts of different structure (a constraint "
+            "whose branches cross, or a rank that changes on it); write the constraints so that each part is a "
+            "system of its own"
+        ) from None
     x_zero = _zero_mask(x_vals)
     A = sympy.Matrix(k, k, lambda i, j: sympy.S.Zero if a_zero[i, j] else a_sym[i, j])
     B = sympy.Matrix(k, cols, lambda i, j: sympy.S.Zero if b_zero[i, j] else b_sym[i, j])
