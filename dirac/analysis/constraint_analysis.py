@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy
@@ -18,8 +19,6 @@ from dirac.analysis.algebra import tidy
 from dirac.analysis.classification import bracket_matrix, classify
 from dirac.analysis.constraint_chain import ConstraintChain
 from dirac.analysis.dirac_bracket import DiracBracket
-from dirac.analysis.gauge_fixing import fix_gauge, regular_gauge_point
-from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure, gauge_structure
 from dirac.analysis.legendre import legendre_transform
 from dirac.analysis.linear_solve import SolveTooLarge
 from dirac.analysis.multiplier_solution import MultiplierSolution, unsolved_multipliers
@@ -27,9 +26,12 @@ from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.regularity import regular_holonomic
 from dirac.analysis.report import to_json, to_latex, to_text
 from dirac.analysis.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
-from dirac.analysis.vector_field import VectorField, vector_field
 from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
+
+if TYPE_CHECKING:  # imported where used: most analyses never ask for them (start-up time of the CLI)
+    from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure
+    from dirac.analysis.vector_field import VectorField
 
 __all__ = ["ConstraintAnalysis", "analyze"]
 
@@ -206,6 +208,8 @@ class ConstraintAnalysis:
         """Castellani's gauge generators and the first-class constraints without one
         (:mod:`dirac.analysis.gauge_generators`); computed on first use."""
         if self._gauge is None:
+            from dirac.analysis.gauge_generators import gauge_structure
+
             self._gauge = gauge_structure(self)
         return self._gauge
 
@@ -223,6 +227,8 @@ class ConstraintAnalysis:
         InputError
             For conditions that are not admissible; the message names the condition.
         """
+        from dirac.analysis.gauge_fixing import fix_gauge
+
         return fix_gauge(self, conditions)
 
     def _special_values(self, chain: ConstraintChain, C: sympy.Matrix, second: list[int], seed: int) -> tuple[list[SpecialValue], list[str]]:
@@ -382,6 +388,8 @@ class ConstraintAnalysis:
         InputError
             Unknown names, parameters without a value, values that are not finite.
         """
+        from dirac.analysis.vector_field import vector_field
+
         return vector_field(self, parameters, multipliers)
 
     # ------------------------------------------------------------------ points
@@ -417,6 +425,8 @@ class ConstraintAnalysis:
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:
             if self.gauge_conditions:
+                from dirac.analysis.gauge_fixing import regular_gauge_point
+
                 point = regular_gauge_point(self, numerics, fixed)
             else:
                 point = numerics.surface_points(self.constraints + self.reducible_constraints, 1, fixed=fixed)[0]

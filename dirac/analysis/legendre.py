@@ -44,7 +44,6 @@ from dirac.analysis.first_order import FIRST_ORDER_METHOD, first_order_primary
 from dirac.analysis.numeric import Numerics, independent_rows
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.polynomial_kernel import polynomial_kernel
-from dirac.analysis.velocity_elimination import eliminate_velocities
 from dirac.codegen import array_function
 from dirac.errors import AnalysisError
 from dirac.model.lagrangian import Lagrangian, momentum_name, multiplier_name
@@ -313,6 +312,8 @@ def _not_quadratic(
     """The transform of a non-quadratic ``L`` (:func:`~dirac.analysis.velocity_elimination.eliminate_velocities`)
     with the multipliers' primary constraints ``p_lambda = 0`` and ``lambda_a chi_a`` in ``H_c`` ((206), (207))."""
     n = len(lagrangian.coordinates)
+    from dirac.analysis.velocity_elimination import eliminate_velocities  # only non-quadratic L need it
+
     result = eliminate_velocities(lagrangian, space.momenta[:n], rng, parameter_values)
     potential = sum((lam * chi for lam, chi in zip(lambdas, lagrangian.constraints)), sympy.S.Zero)
     return LegendreTransform(
