@@ -42,8 +42,8 @@ from dirac.rigidbody.splitting import CompositionScheme
 
 __all__ = ["AutoChoice", "choose_method"]
 
-#: Measured costs (microseconds; ``python /tmp/cost*.py`` style timings on the reference
-#: machine, 2 cores): one exact sample of ``(M, R)`` / of ``M`` alone (vectorised
+#: Measured costs (microseconds; the per-step and per-sample figures of ``dirac bench`` on
+#: the reference machine, 2 cores): one exact sample of ``(M, R)`` / of ``M`` alone (vectorised
 #: elliptic functions), one rotation sub-step of the splitting kernel, and the sampling
 #: overhead of the fixed-step loop per output time (kernel call, guard rails, copy).
 EXACT_SAMPLE_US = 0.5
