@@ -40,16 +40,12 @@ never an exception.
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import os
-import sys
 from collections.abc import Sequence
 from types import ModuleType
 
 import sympy
 
-from dirac.codegen.numba_backend import cache_directory
+from dirac.codegen.numba_backend import import_source
 from dirac.codegen.printer import straight_line
 
 __all__ = ["vector_field_source", "compile_vector_field"]
@@ -398,23 +394,10 @@ def vector_field_source(
 
 
 def compile_vector_field(source: str) -> ModuleType:
-    """Write ``source`` to the cache directory under the hash of its text and import it.
+    """Write ``source`` to the cache directory under the hash of its text and import it
+    (:func:`dirac.codegen.numba_backend.import_source`, the one disk cache of generated code).
 
     The functions compile at import for their one signature each; numba caches the
     machine code on disk next to the file, so a later run with the same source loads it.
     """
-    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
-    module_name = f"dirac_field_{digest}"
-    if module_name in sys.modules:
-        return sys.modules[module_name]
-    path = cache_directory() / f"{module_name}.py"
-    if not path.exists() or path.read_text(encoding="utf-8") != source:
-        temporary = path.with_suffix(f".{os.getpid()}.tmp")
-        temporary.write_text(source, encoding="utf-8")
-        os.replace(temporary, path)
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
-    spec.loader.exec_module(module)
-    return module
+    return import_source(source)

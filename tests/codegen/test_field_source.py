@@ -114,5 +114,5 @@ def test_the_module_is_cached_on_disk_by_the_hash_of_its_source(linear_module):
 
     path = cache_directory() / f"{linear_module.__name__}.py"
     source = path.read_text(encoding="utf-8")
-    assert linear_module.__name__ == f"dirac_field_{hashlib.sha256(source.encode()).hexdigest()[:20]}"
+    assert linear_module.__name__ == f"dirac_gen_{hashlib.sha256(source.encode()).hexdigest()[:20]}"
     assert compile_vector_field(source) is linear_module
