@@ -75,7 +75,10 @@ class ConstraintChain:
     surface, e.g. ``x . J = 0`` among ``J = x × p``; they still define the surface) and
     ``notes`` (``regularity_notes``: regularised and reducible constraints, for the report).
     ``written`` maps the expanded form (as :func:`tidy` gives it) of a constraint the
-    user wrote as a product to that product, so that its branches are checked.
+    user wrote as a product to that product, so that its branches are checked;
+    ``holonomic`` maps the expanded form of each holonomic constraint of the Lagrangian
+    to its number (an irregular one cannot be regularised inside the chain: its
+    multiplier term in ``H_c`` would stay irregular).
     """
 
     phase_space: PhaseSpace
@@ -91,6 +94,7 @@ class ConstraintChain:
     reducible: list[sympy.Expr] = field(default_factory=list)
     regularity_notes: list[str] = field(default_factory=list)
     written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
+    holonomic: dict[sympy.Expr, int] = field(default_factory=dict)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -259,6 +263,12 @@ class ConstraintChain:
             )
         self._refuse_crossing(part, self.constraints)
         regular = tidy(part, self.phase_space.variables, sign=True)
+        if constraint in self.holonomic:
+            raise AnalysisError(
+                f"constraint {self.holonomic[constraint]} ({constraint} = 0) is irregular: its gradient vanishes where it "
+                f"holds, so its multiplier cannot enforce it; write it as its square-free part {regular} = 0 (the same "
+                "surface, described regularly)"
+            )
         self.regularity_notes.append(
             f"stage {len(self.stages) + 1}: the constraint {constraint} = 0 is irregular (its gradient vanishes where it "
             f"holds); it was replaced by its square-free part {regular} = 0, the same surface described regularly; "

@@ -39,9 +39,6 @@ MAX_FACTOR_TERMS = 60
 
 
 
-#: expanded holonomic constraints up to this many terms get a square-free decomposition
-MAX_HOLONOMIC_TERMS = 20
-
 #: a new constraint whose gradient, relative to the size of the gradient's terms, has a
 #: component normal to the earlier constraints' gradients below this at every surface
 #: point (but above round-off) is irregular: its gradient vanishes where it holds (at a
@@ -146,17 +143,16 @@ def regular_holonomic(lagrangian: Lagrangian) -> tuple[Lagrangian, list[str]]:
 
     In ``L_ext = L - lambda chi`` (the paper's (1)) the constraint force is ``lambda dchi``;
     for ``chi = f^2`` it vanishes on the surface, so the multiplier cannot hold the motion
-    there (the chain ends in a contradiction). Constraints written as such a power, and
-    expanded ones of at most ``MAX_HOLONOMIC_TERMS`` terms, are decomposed. The user
-    means the surface ``f = 0``: the
+    there (the chain ends in a contradiction). Constraints written as such a power are
+    decomposed here (an expanded one is found irregular by the chain, which refuses it
+    and names its square-free part). The user means the surface ``f = 0``: the
     square-free part describes it regularly (Henneaux–Teitelboim, Sect. 1.1.2). Returns the
     new Lagrangian (the same one if nothing changed) and one note per replacement.
     """
     notes: list[str] = []
     new: list[sympy.Expr] = []
     for k, chi in enumerate(lagrangian.constraints, start=1):
-        small = len(chi.args) <= MAX_HOLONOMIC_TERMS if isinstance(chi, sympy.Add) else True
-        part = square_free_part(chi, lagrangian.coordinates) if small or _written_power(chi) else None
+        part = square_free_part(chi, lagrangian.coordinates) if _written_power(chi) else None
         if part is None:
             new.append(chi)
             continue
