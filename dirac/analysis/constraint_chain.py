@@ -43,7 +43,14 @@ from dirac.analysis.algebra import tidy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
-from dirac.analysis.regularity import IRREGULAR_GRADIENT, ROUND_OFF, branches, normal_components, square_free_part
+from dirac.analysis.regularity import (
+    IRREGULAR_GRADIENT,
+    ROUND_OFF,
+    branches,
+    factored,
+    normal_components,
+    square_free_part,
+)
 from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]
@@ -187,6 +194,8 @@ class ConstraintChain:
             points = self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
         self.points = points
         self.pivots = (pivots_rows, pivot_cols)
+        if pivots_rows:
+            self._check_consistent_rank(A_num, pivots_rows)
         self._solve_multipliers(points, pivots_rows, pivot_cols)
         return self
 
@@ -322,6 +331,35 @@ class ConstraintChain:
             if np.all(sizes < IRREGULAR_GRADIENT) and np.any(sizes > ROUND_OFF):
                 found.append(i)
         return found
+
+    def _check_consistent_rank(self, A_num: np.ndarray, rows: list[int]) -> None:
+        """The pivot rows of ``A_ak = {Phi_a, phi_k}`` must be independent at every sample point.
+
+        They were chosen by majority; a point where their rank is lower lies on a part of
+        the surface with another structure (the rank is never taken from some points
+        only). Refused, naming a constraint that factors into branches when there is one.
+        """
+        ranks = []
+        for A in A_num:
+            block = A[rows]
+            scale = np.max(np.abs(block)) or 1.0
+            ranks.append(numeric_rank(block / scale))
+        if len(set(ranks)) == 1 and ranks[0] == len(rows):
+            return
+        cause = ""
+        products = factored(self.constraints, self.phase_space.variables)
+        if products:
+            c, parts = products[0]
+            shown = " and ".join(f"{f} = 0" for f in parts)
+            cause = (
+                f"; the constraint {c} = 0 is the union of the branches {shown}: analyse them separately "
+                "(one system each)"
+            )
+        raise AnalysisError(
+            "the rank of the consistency matrix {Phi_a, phi_k} that fixes the multipliers differs between regular "
+            f"points of the constraint surface ({', '.join(map(str, ranks))} for {len(rows)} pivot rows): the surface "
+            f"has parts of different structure{cause or '; analyse each part as a system of its own'}"
+        )
 
     def _keep_reducible(self, candidates: list[sympy.Expr], chosen: list[int]) -> None:
         """Keep the new constraints left out as dependent: they still define the surface (reducible set)."""

@@ -31,7 +31,7 @@ import sympy
 
 from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["square_free_part", "branches", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
+__all__ = ["square_free_part", "branches", "factored", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
 
 #: polynomials with more terms than this are not factored (the cost grows fast); their
 #: regularity is still checked numerically at surface points
@@ -103,6 +103,28 @@ def branches(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.
         if base.free_symbols & set(variables) and base not in found:
             found.append(base)
     return found if len(found) > 1 else [expr]
+
+
+def factored(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> list[tuple[sympy.Expr, list[sympy.Expr]]]:
+    """The constraints that factor into several branches, with their branches (for error messages).
+
+    Multivariate factorisation (``sympy.factor_list``) of each polynomial constraint of at
+    most ``MAX_FACTOR_TERMS`` terms: too costly for every constraint of every analysis,
+    used when a rank is found to differ between points of the surface, to name the cause.
+    """
+    found = []
+    for c in constraints:
+        poly = _polynomial(c, variables)
+        if poly is None:
+            continue
+        try:
+            _, factors = sympy.factor_list(poly.as_expr(), *poly.gens)
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            continue
+        parts = [f for f, _ in factors if f.free_symbols & set(variables)]
+        if len(parts) > 1:
+            found.append((c, parts))
+    return found
 
 
 def normal_components(rows: np.ndarray, base: np.ndarray, scales: np.ndarray) -> np.ndarray:
