@@ -46,8 +46,8 @@ from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.regularity import (
     IRREGULAR_GRADIENT,
     ROUND_OFF,
+    branch_hint,
     branches,
-    factored,
     normal_components,
     square_free_part,
 )
@@ -268,7 +268,7 @@ class ConstraintChain:
                 f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: its gradient vanishes "
                 "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
                 "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
-                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)"
+                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)" + branch_hint(self.constraints, self.phase_space.variables)
             )
         self._refuse_crossing(part, self.constraints)
         regular = tidy(part, self.phase_space.variables, sign=True)
@@ -346,15 +346,7 @@ class ConstraintChain:
             ranks.append(numeric_rank(block / scale))
         if len(set(ranks)) == 1 and ranks[0] == len(rows):
             return
-        cause = ""
-        products = factored(self.constraints, self.phase_space.variables)
-        if products:
-            c, parts = products[0]
-            shown = " and ".join(f"{f} = 0" for f in parts)
-            cause = (
-                f"; the constraint {c} = 0 is the union of the branches {shown}: analyse them separately "
-                "(one system each)"
-            )
+        cause = branch_hint(self.constraints, self.phase_space.variables)
         raise AnalysisError(
             "the rank of the consistency matrix {Phi_a, phi_k} that fixes the multipliers differs between regular "
             f"points of the constraint surface ({', '.join(map(str, ranks))} for {len(rows)} pivot rows): the surface "

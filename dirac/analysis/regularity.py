@@ -31,7 +31,7 @@ import sympy
 
 from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["square_free_part", "branches", "factored", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
+__all__ = ["square_free_part", "branches", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
 
 #: polynomials with more terms than this are not factored (the cost grows fast); their
 #: regularity is still checked numerically at surface points
@@ -125,6 +125,19 @@ def factored(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol
         if len(parts) > 1:
             found.append((c, parts))
     return found
+
+
+def branch_hint(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> str:
+    """``"; the constraint ... is the union of the branches ...: analyse them separately ..."`` or ``""``.
+
+    For refusals caused by a surface whose parts differ (see :func:`factored`).
+    """
+    products = factored(constraints, variables)
+    if not products:
+        return ""
+    c, parts = products[0]
+    shown = " and ".join(f"{f} = 0" for f in parts)
+    return f"; the constraint {c} = 0 is the union of the branches {shown}: analyse them separately (one system each)"
 
 
 def normal_components(rows: np.ndarray, base: np.ndarray, scales: np.ndarray) -> np.ndarray:

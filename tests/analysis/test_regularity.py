@@ -152,3 +152,14 @@ def test_squared_factor_of_a_crossing_product_is_refused():
     L = dirac.Lagrangian.from_strings("corner", ["x", "y"], "(x_dot**2 + y_dot**2)/2 - y", ["(x - 1)**2*(y - 2)"])
     with pytest.raises(AnalysisError, match=r"branches x - 1 = 0 and y - 2 = 0"):
         dirac.analyze(L)
+
+
+def test_expanded_product_met_in_the_chain_is_refused_with_its_branches():
+    """``L = x_dot z_dot + y (x z + z)``: ``p_y = 0`` is primary, ``H_c = p_x p_z - y (x z + z)``,
+    and ``{p_y, H_c} = x z + z = z (x + 1)``: the union of the branches ``z = 0`` and
+    ``x = -1``, which meet at ``(x, z) = (-1, 0)``, written expanded. Points fall on both
+    branches, where the brackets of the chain differ; the analysis is refused (never a
+    rank taken from some points only), naming the two branches."""
+    L = dirac.Lagrangian.from_strings("branches", ["x", "y", "z"], "x_dot*z_dot + y*(x*z + z)")
+    with pytest.raises(AnalysisError, match=r"differs between regular points.*branches z = 0 and x \+ 1 = 0"):
+        dirac.analyze(L)
