@@ -20,6 +20,7 @@ import sympy
 from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
+from dirac.analysis.regularity import branch_hint
 from dirac.errors import AnalysisError
 
 __all__ = ["Classification", "classify", "bracket_matrix"]
@@ -80,7 +81,8 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
         raise AnalysisError(
             f"the rank of the bracket matrix C_ab = {{Phi_a, Phi_b}} differs between regular points of the constraint "
             f"surface ({', '.join(map(str, ranks))}): the first/second-class split is not the same everywhere on it "
-            "(parts of different structure); analyse each part as a system of its own"
+            "(parts of different structure)"
+            + (branch_hint(constraints, space.variables) or "; analyse each part as a system of its own")
         )
     rank = ranks[0] if ranks else 0
     if not rest:

@@ -134,9 +134,9 @@ class ConstraintAnalysis:
         chain = ConstraintChain(
             space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
         )
-        chain.written = {
-            tidy(chi, space.variables, sign=True): chi for chi in lagrangian.constraints if isinstance(chi, sympy.Mul)
-        }
+        expanded = [tidy(chi, space.variables, sign=True) for chi in lagrangian.constraints]
+        chain.written = {e: chi for e, chi in zip(expanded, lagrangian.constraints) if isinstance(chi, sympy.Mul)}
+        chain.holonomic = {e: k for k, e in enumerate(expanded, start=1)}
         chain.run()
         self._chain = chain
         done(

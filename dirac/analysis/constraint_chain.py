@@ -51,7 +51,14 @@ from dirac.analysis.linear_solve import weak_solve
 from dirac.analysis.multiplier_solution import MultiplierSolution, general_multiplier_solution, unsolved_multipliers
 from dirac.analysis.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.phase_space import PhaseSpace
-from dirac.analysis.regularity import IRREGULAR_GRADIENT, ROUND_OFF, branches, normal_components, square_free_part
+from dirac.analysis.regularity import (
+    IRREGULAR_GRADIENT,
+    ROUND_OFF,
+    branch_hint,
+    branches,
+    normal_components,
+    square_free_part,
+)
 from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]
@@ -87,7 +94,10 @@ class ConstraintChain:
     surface, e.g. ``x . J = 0`` among ``J = x × p``; they still define the surface) and
     ``notes`` (``regularity_notes``: regularised and reducible constraints, for the report).
     ``written`` maps the expanded form (as :func:`tidy` gives it) of a constraint the
-    user wrote as a product to that product, so that its branches are checked.
+    user wrote as a product to that product, so that its branches are checked;
+    ``holonomic`` maps the expanded form of each holonomic constraint of the Lagrangian
+    to its number (an irregular one cannot be regularised inside the chain: its
+    multiplier term in ``H_c`` would stay irregular).
     """
 
     phase_space: PhaseSpace
@@ -105,6 +115,7 @@ class ConstraintChain:
     reducible: list[sympy.Expr] = field(default_factory=list)
     regularity_notes: list[str] = field(default_factory=list)
     written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
+    holonomic: dict[sympy.Expr, int] = field(default_factory=dict)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -200,6 +211,8 @@ class ConstraintChain:
             points = self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
         self.points = points
         self.pivots = (pivots_rows, pivot_cols)
+        if pivots_rows:
+            self._check_consistent_rank(A_num, pivots_rows)
         self._solve_multipliers(points, pivots_rows, pivot_cols)
         return self
 
@@ -272,10 +285,16 @@ class ConstraintChain:
                 f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: its gradient vanishes "
                 "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
                 "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
-                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)"
+                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)" + branch_hint(self.constraints, self.phase_space.variables)
             )
         self._refuse_crossing(part, self.constraints)
         regular = tidy(part, self.phase_space.variables, sign=True)
+        if constraint in self.holonomic:
+            raise AnalysisError(
+                f"constraint {self.holonomic[constraint]} ({constraint} = 0) is irregular: its gradient vanishes where it "
+                f"holds, so its multiplier cannot enforce it; write it as its square-free part {regular} = 0 (the same "
+                "surface, described regularly)"
+            )
         self.regularity_notes.append(
             f"stage {len(self.stages) + 1}: the constraint {constraint} = 0 is irregular (its gradient vanishes where it "
             f"holds); it was replaced by its square-free part {regular} = 0, the same surface described regularly; "
@@ -329,6 +348,27 @@ class ConstraintChain:
             if np.all(sizes < IRREGULAR_GRADIENT) and np.any(sizes > ROUND_OFF):
                 found.append(i)
         return found
+
+    def _check_consistent_rank(self, A_num: np.ndarray, rows: list[int]) -> None:
+        """The pivot rows of ``A_ak = {Phi_a, phi_k}`` must be independent at every sample point.
+
+        They were chosen by majority; a point where their rank is lower lies on a part of
+        the surface with another structure (the rank is never taken from some points
+        only). Refused, naming a constraint that factors into branches when there is one.
+        """
+        ranks = []
+        for A in A_num:
+            block = A[rows]
+            scale = np.max(np.abs(block)) or 1.0
+            ranks.append(numeric_rank(block / scale))
+        if len(set(ranks)) == 1 and ranks[0] == len(rows):
+            return
+        cause = branch_hint(self.constraints, self.phase_space.variables)
+        raise AnalysisError(
+            "the rank of the consistency matrix {Phi_a, phi_k} that fixes the multipliers differs between regular "
+            f"points of the constraint surface ({', '.join(map(str, ranks))} for {len(rows)} pivot rows): the surface "
+            f"has parts of different structure{cause or '; analyse each part as a system of its own'}"
+        )
 
     def _keep_reducible(self, candidates: list[sympy.Expr], chosen: list[int]) -> None:
         """Keep the new constraints left out as dependent: they still define the surface (reducible set)."""

@@ -31,16 +31,13 @@ import sympy
 
 from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["square_free_part", "branches", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
+__all__ = ["square_free_part", "branches", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
 
 #: polynomials with more terms than this are not factored (the cost grows fast); their
 #: regularity is still checked numerically at surface points
 MAX_FACTOR_TERMS = 60
 
 
-
-#: expanded holonomic constraints up to this many terms get a square-free decomposition
-MAX_HOLONOMIC_TERMS = 20
 
 #: a new constraint whose gradient, relative to the size of the gradient's terms, has a
 #: component normal to the earlier constraints' gradients below this at every surface
@@ -115,6 +112,41 @@ def branches(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.
     return found if len(found) > 1 else [expr]
 
 
+def factored(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> list[tuple[sympy.Expr, list[sympy.Expr]]]:
+    """The constraints that factor into several branches, with their branches (for error messages).
+
+    Multivariate factorisation (``sympy.factor_list``) of each polynomial constraint of at
+    most ``MAX_FACTOR_TERMS`` terms: too costly for every constraint of every analysis,
+    used when a rank is found to differ between points of the surface, to name the cause.
+    """
+    found = []
+    for c in constraints:
+        poly = _polynomial(c, variables)
+        if poly is None:
+            continue
+        try:
+            _, factors = sympy.factor_list(poly.as_expr(), *poly.gens)
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            continue
+        parts = [f for f, _ in factors if f.free_symbols & set(variables)]
+        if len(parts) > 1:
+            found.append((c, parts))
+    return found
+
+
+def branch_hint(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> str:
+    """``"; the constraint ... is the union of the branches ...: analyse them separately ..."`` or ``""``.
+
+    For refusals caused by a surface whose parts differ (see :func:`factored`).
+    """
+    products = factored(constraints, variables)
+    if not products:
+        return ""
+    c, parts = products[0]
+    shown = " and ".join(f"{f} = 0" for f in parts)
+    return f"; the constraint {c} = 0 is the union of the branches {shown}: analyse them separately (one system each)"
+
+
 def normal_components(rows: np.ndarray, base: np.ndarray, scales: np.ndarray) -> np.ndarray:
     """Size of each row's component normal to the span of ``base``, relative to ``scales``.
 
@@ -153,17 +185,16 @@ def regular_holonomic(lagrangian: Lagrangian) -> tuple[Lagrangian, list[str]]:
 
     In ``L_ext = L - lambda chi`` (the paper's (1)) the constraint force is ``lambda dchi``;
     for ``chi = f^2`` it vanishes on the surface, so the multiplier cannot hold the motion
-    there (the chain ends in a contradiction). Constraints written as such a power, and
-    expanded ones of at most ``MAX_HOLONOMIC_TERMS`` terms, are decomposed. The user
-    means the surface ``f = 0``: the
+    there (the chain ends in a contradiction). Constraints written as such a power are
+    decomposed here (an expanded one is found irregular by the chain, which refuses it
+    and names its square-free part). The user means the surface ``f = 0``: the
     square-free part describes it regularly (Henneaux–Teitelboim, Sect. 1.1.2). Returns the
     new Lagrangian (the same one if nothing changed) and one note per replacement.
     """
     notes: list[str] = []
     new: list[sympy.Expr] = []
     for k, chi in enumerate(lagrangian.constraints, start=1):
-        small = len(chi.args) <= MAX_HOLONOMIC_TERMS if isinstance(chi, sympy.Add) else True
-        part = square_free_part(chi, lagrangian.coordinates) if small or _written_power(chi) else None
+        part = square_free_part(chi, lagrangian.coordinates) if _written_power(chi) else None
         if part is None:
             new.append(chi)
             continue

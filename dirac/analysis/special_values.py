@@ -218,11 +218,13 @@ def _rank_at(
     numbers = dict(generic)
     for p, value in substitution.items():
         numbers[p] = float(sympy.re(value.subs(generic)))
-    numerics = Numerics(space, numbers, seed=seed, time=time)
     matrix = use.matrix.subs(substitution)
     constraints = constraints_at(substitution) if use.on_surface else []
     if any(e.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo) for e in [*matrix, *constraints]):
         return UNDEFINED  # a denominator vanishes: the expressions are undefined there, not of lower rank
+    if not use.on_surface and not matrix.subs(numbers).free_symbols:  # constant in phase space (and time)
+        return numeric_rank(np.array(matrix.subs(numbers).evalf(), dtype=float))
+    numerics = Numerics(space, numbers, seed=seed, time=time)
     if use.on_surface:
         try:
             points = numerics.surface_points(constraints, 4, attempts=20)

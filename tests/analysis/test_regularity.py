@@ -40,20 +40,28 @@ def _pendulum(constraint: str) -> dirac.Lagrangian:
     )
 
 
-@pytest.mark.parametrize("constraint", ["(x**2 + y**2 - l**2)**2", "x**4 + 2*x**2*y**2 + y**4 - 2*l**2*x**2 - 2*l**2*y**2 + l**4"])
-def test_squared_constraint_is_the_pendulum(constraint):
+def test_squared_constraint_is_the_pendulum():
     """``chi = (x^2 + y^2 - l^2)^2``: the force ``lambda dchi = 2 lambda chi dchi_0`` vanishes on
     the surface, so the multiplier cannot hold the bob; the square-free part
     ``x^2 + y^2 - l^2`` is the pendulum, whose chain is ``p_lambda``, ``chi_0``,
     ``x p_x + y p_y`` (times ``2/m``), the equation fixing ``lambda``: four stages of one
     constraint, all second class, ``(6 - 4)/2 = 1`` degree of freedom."""
-    a = dirac.analyze(_pendulum(constraint))
+    a = dirac.analyze(_pendulum("(x**2 + y**2 - l**2)**2"))
     x, y, l = (a.symbols["x"], a.symbols["y"], sympy.Symbol("l", real=True))
     assert [len(stage) for stage in a.stages] == [1, 1, 1, 1]
     assert sympy.expand(a.stages[1][0] - (x**2 + y**2 - l**2)) == 0
     assert len(a.second_class) == 4 and a.first_class == []
     assert a.physical_degrees_of_freedom == 1
     assert any("square-free part" in n for n in a.notes)
+
+
+def test_expanded_squared_constraint_is_refused_with_its_square_free_part():
+    """The same constraint written expanded is found irregular at surface points (gradient
+    ``4 chi_0 (x, y)`` vanishes where it holds); its multiplier term is irregular too, so
+    it is refused, naming the square-free part to write instead."""
+    expanded = "x**4 + 2*x**2*y**2 + y**4 - 2*l**2*x**2 - 2*l**2*y**2 + l**4"
+    with pytest.raises(AnalysisError, match=r"constraint 1 .* is irregular.*square-free part -l\*\*2 \+ x\*\*2 \+ y\*\*2 = 0"):
+        dirac.analyze(_pendulum(expanded))
 
 
 def test_crossing_constraint_is_refused_with_the_branches(run_cli, tmp_path):
@@ -143,4 +151,15 @@ def test_squared_factor_of_a_crossing_product_is_refused():
     vanishes: after regularisation it is still refused, naming both branches."""
     L = dirac.Lagrangian.from_strings("corner", ["x", "y"], "(x_dot**2 + y_dot**2)/2 - y", ["(x - 1)**2*(y - 2)"])
     with pytest.raises(AnalysisError, match=r"branches x - 1 = 0 and y - 2 = 0"):
+        dirac.analyze(L)
+
+
+def test_expanded_product_met_in_the_chain_is_refused_with_its_branches():
+    """``L = x_dot z_dot + y (x z + z)``: ``p_y = 0`` is primary, ``H_c = p_x p_z - y (x z + z)``,
+    and ``{p_y, H_c} = x z + z = z (x + 1)``: the union of the branches ``z = 0`` and
+    ``x = -1``, which meet at ``(x, z) = (-1, 0)``, written expanded. Points fall on both
+    branches, where the brackets of the chain differ; the analysis is refused (never a
+    rank taken from some points only), naming the two branches."""
+    L = dirac.Lagrangian.from_strings("branches", ["x", "y", "z"], "x_dot*z_dot + y*(x*z + z)")
+    with pytest.raises(AnalysisError, match=r"differs between regular points.*branches z = 0 and x \+ 1 = 0"):
         dirac.analyze(L)
