@@ -56,7 +56,6 @@ from dirac.analysis.regularity import (
     ROUND_OFF,
     branch_hint,
     branches,
-    factored,
     normal_components,
     square_free_part,
 )
@@ -67,13 +66,14 @@ __all__ = ["ConstraintChain", "tidy"]
 SAMPLE_POINTS = 4
 
 
-#: new constraints with at most this many terms are factored to find crossing branches
-#: (a few ms each; larger ones are left to the rank checks at the sample points)
+#: new constraints with at most this many terms have their common factors taken out, to find
+#: crossing branches (full factorisation would cost more than the analysis; other products
+#: are left to the rank checks at the sample points)
 FACTOR_TERMS = 8
 
 
 def _small(constraint: sympy.Expr) -> bool:
-    """A constraint small enough to factor on every analysis."""
+    """A constraint small enough to take its common factors out on every analysis."""
     return isinstance(constraint, sympy.Add) and len(constraint.args) <= FACTOR_TERMS
 
 
@@ -239,10 +239,13 @@ class ConstraintChain:
         for c in kept:  # a holonomic constraint written as a product, met in expanded form
             if c in self.written:
                 self._refuse_crossing(self.written[c], self.constraints)
-        for _, parts in factored([c for c in kept if c not in self.written and _small(c)], self.phase_space.variables):
-            # an expanded product (z x + z = z (x + 1)): sample points may all fall on one
-            # branch, so its branches are checked here rather than left to chance
-            self._refuse_crossing(sympy.Mul(*parts), self.constraints)
+        for c in kept:
+            # an expanded product with a common factor (z x + z = z (x + 1)): sample points
+            # may all fall on one branch, so its branches are checked here, not left to chance
+            if c not in self.written and _small(c):
+                common = sympy.factor_terms(c)
+                if isinstance(common, sympy.Mul):
+                    self._refuse_crossing(common, self.constraints)
         return kept
 
     def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
