@@ -332,13 +332,13 @@ def _positive(expr: sympy.Expr, lagrangian: Lagrangian, seconds: float, name: st
     return simplified.xreplace(back)
 
 
-def _regular(
-    lagrangian: Lagrangian, P: list[sympy.Expr], p: list[sympy.Symbol], samples: _Samples, parameter_values: Mapping, seconds: float
-) -> tuple[dict[sympy.Symbol, sympy.Expr], sympy.Expr, str]:
-    """Invert ``p = dL/dq_dot`` on the physical branch; ``H = p . v - L`` there."""
-    v = lagrangian.velocities
-    n = len(v)
-    alg = _Algebraic(v, lagrangian)
+def _momentum_relations(
+    lagrangian: Lagrangian, P: list[sympy.Expr], p: list[sympy.Symbol]
+) -> tuple[_Algebraic, list[sympy.Expr], list[sympy.Symbol], sympy.Symbol]:
+    """The polynomial relations of ``p = dL/dq_dot``: each equation with its denominator
+    cleared, the defining relations of the named roots, and ``w * prod(denominators) = 1``
+    (denominators non-zero); returns the root naming, the relations, the root symbols and ``w``."""
+    alg = _Algebraic(lagrangian.velocities, lagrangian)
     equations, denominators = [], []
     for pi, Pi in zip(p, P):
         num, den = _cleared(pi - alg.convert(Pi))
@@ -346,7 +346,16 @@ def _regular(
         denominators.append(den)
     w = sympy.Symbol("_w")
     relations = [*equations, *alg.relations, sympy.expand(w * sympy.Mul(*denominators) - 1)]
-    roots = list(alg.roots.values())
+    return alg, relations, list(alg.roots.values()), w
+
+
+def _regular(
+    lagrangian: Lagrangian, P: list[sympy.Expr], p: list[sympy.Symbol], samples: _Samples, parameter_values: Mapping, seconds: float
+) -> tuple[dict[sympy.Symbol, sympy.Expr], sympy.Expr, str]:
+    """Invert ``p = dL/dq_dot`` on the physical branch; ``H = p . v - L`` there."""
+    v = lagrangian.velocities
+    n = len(v)
+    alg, relations, roots, w = _momentum_relations(lagrangian, P, p)
     candidates: list[list[sympy.Expr]] = []
     for i, vi in enumerate(v):
         others = [vj for j, vj in enumerate(v) if j != i]
@@ -413,15 +422,7 @@ def _singular(
     """Primary constraints by eliminating the velocities; ``H_c`` = the energy on the surface."""
     v = lagrangian.velocities
     n = len(v)
-    alg = _Algebraic(v, lagrangian)
-    equations, denominators = [], []
-    for pi, Pi in zip(p, P):
-        num, den = _cleared(pi - alg.convert(Pi))
-        equations.append(num)
-        denominators.append(den)
-    w = sympy.Symbol("_w")
-    relations = [*equations, *alg.relations, sympy.expand(w * sympy.Mul(*denominators) - 1)]
-    roots = list(alg.roots.values())
+    alg, relations, roots, w = _momentum_relations(lagrangian, P, p)
     gens = [w, *roots, *v, *p]
     basis = _step(
         "the Gröbner basis eliminating the velocities from p = dL/dq_dot",
