@@ -117,6 +117,7 @@ def test_curve_holds_on_both_branches():
     curve = SpecialValue("b", a**2, "", b - a**2)
     assert curve.is_curve and curve.equation == "b - a**2 = 0"
     assert curve.holds_at({"a": 2.0, "b": 4.0}) and curve.holds_at({"a": -3.0, "b": 9.0})
+    assert curve.holds_at({"a": 0.1, "b": 0.01})  # 0.1**2 is 0.010000000000000002 in floating point
     assert not curve.holds_at({"a": 2.0, "b": 4.1}) and not curve.holds_at({"a": 2.0, "b": None})
     single = SpecialValue("M", sympy.Integer(0), "")
     assert not single.is_curve and single.equation == "M = 0"
