@@ -298,6 +298,18 @@ def _exact_zeros(matrix: sympy.Matrix) -> sympy.Matrix:
 EXACT_OPS = 400
 
 
+def _constant_rank(matrix: sympy.Matrix, numbers: dict[sympy.Symbol, float]) -> int:
+    """Rank of a matrix that depends on the parameters only, with the same zero test as :func:`_rank_at`."""
+    values = np.zeros(len(matrix))
+    scales = np.ones(len(matrix))
+    for k, entry in enumerate(matrix):
+        terms = entry.args if isinstance(entry, sympy.Add) else (entry,)
+        values[k] = float(sympy.re(entry.subs(numbers)))
+        scales[k] += sum(abs(complex(t.subs(numbers))) for t in terms)
+    values = np.where(np.abs(values) <= ZERO_TOLERANCE * scales, 0.0, values)
+    return numeric_rank(values.reshape(matrix.shape), scale=float(np.max(scales)))
+
+
 def _rank_at(
     space: PhaseSpace,
     generic: dict[sympy.Symbol, float],
@@ -325,6 +337,8 @@ def _rank_at(
     if matrix.shape[0] == 0 or matrix.shape[1] == 0:
         return 0
     matrix = _exact_zeros(matrix)
+    if not use.on_surface and not matrix.subs(numbers).free_symbols:  # constant in phase space (and time)
+        return _constant_rank(matrix, numbers)
     numerics = Numerics(space, numbers, seed=seed, time=time)
     if use.on_surface:
         try:
