@@ -523,10 +523,18 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
     if not hits:
         return analysis
     names = {h.parameter for h in hits} | {sym.name for h in hits for sym in h.value.free_symbols}
+    names |= {sym.name for h in hits if h.factor is not None for sym in h.factor.free_symbols}
     given = {n: v for n in sorted(names) if (v := values.get(n)) is not None}
     fixed = analysis.lagrangian.fix(**given)
     at = ConstraintAnalysis(fixed, progress=progress)
-    shown = ", ".join(f"{h.parameter} = {h.value}" for h in hits)
+    shown = ", ".join(f"{h.parameter} = {h.value}" for h in hits if not h.is_curve)
+    curves = "; ".join(h.equation for h in hits if h.is_curve)
+    if curves:  # name the values given and the curve they lie on
+        values_text = ", ".join(f"{n} = {float(v):g}" for n, v in given.items())
+        opening = f"{values_text}, the values given for {analysis.name!r}, lie on the special parameter curve {curves}"
+        opening += f" (special parameter value {shown})" if shown else ""
+    else:
+        opening = f"{shown}, the value given for {analysis.name!r}, is a special parameter value"
     generic = (
         f"{len(analysis.first_class)} first class, {len(analysis.second_class)} second class, "
         f"physical degrees of freedom {analysis.physical_degrees_of_freedom}"
@@ -536,8 +544,9 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
         f"physical degrees of freedom {at.physical_degrees_of_freedom}"
     )
     message = (
-        f"{shown}, the value given for {analysis.name!r}, is a special parameter value "
-        f"({'; '.join(h.where for h in hits)}): the analysis is at that value ({here}); for generic values "
+        f"{opening} "
+        f"({'; '.join(h.where for h in hits)}): the analysis is at {'those values' if curves else 'that value'} "
+        f"({here}); for generic values "
         f"the structure differs ({generic})"
     )
     at.notes.append(message)

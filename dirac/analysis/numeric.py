@@ -40,8 +40,23 @@ class SingularSurface(AnalysisError):
     """Points of a constraint surface were found, but none is regular (irregular constraints)."""
 
 
-def numeric_rank(matrix: np.ndarray, tol: float = 1e-8) -> int:
-    """Rank of ``matrix`` by SVD, with a singular-value cut relative to the largest one."""
+def numeric_rank(matrix: np.ndarray, tol: float = 1e-8, scale: float | None = None) -> int:
+    """Rank of ``matrix`` by SVD: the number of singular values ``s_i > tol * max(s_1, scale)``.
+
+    Parameters
+    ----------
+    matrix
+        The values.
+    tol
+        Relative cut.
+    scale
+        Size of the terms the entries were computed from (e.g. ``max`` of
+        :meth:`Numerics.term_scale` over the entries), before they cancelled. Without it
+        the cut is relative to the largest singular value ``s_1`` alone, so a matrix of
+        pure round-off (``1e-16`` left where exact terms cancelled) would count as rank
+        ``>= 1``; with it, such a matrix has rank 0 (Golub & Van Loan, *Matrix
+        Computations*, Sect. 5.4.1: numerical rank relative to the size of the data's errors).
+    """
     if matrix.size == 0:
         return 0
     if not np.all(np.isfinite(matrix)):
@@ -52,7 +67,7 @@ def numeric_rank(matrix: np.ndarray, tol: float = 1e-8) -> int:
     s = np.linalg.svd(matrix, compute_uv=False)
     if s[0] == 0 or not np.isfinite(s[0]):
         return 0
-    return int(np.sum(s > tol * s[0]))
+    return int(np.sum(s > tol * max(s[0], scale or 0.0)))
 
 
 def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base: Sequence[np.ndarray] | None = None) -> list[int]:

@@ -159,7 +159,8 @@ def to_json(analysis: AnalysisResult) -> dict:
     ``primary_multipliers``, ``undetermined_multipliers``, ``hessian_rank``,
     ``bracket_strategy``, ``notes``, ``reducible_constraints`` (constraints that hold but
     depend on the kept independent set), ``special_parameter_values`` (list of
-    ``{"parameter", "value", "where"}``), ``time_dependent`` (``L``, a constraint or a gauge
+    ``{"parameter", "value", "equation", "where"}``; ``equation`` is the value set or
+    curve as an equation such as ``"b - a**2 = 0"``), ``time_dependent`` (``L``, a constraint or a gauge
     condition depends explicitly on the time ``t``); ``multiplier_solution`` (the general solution
     ``u = U + v_a V_a``: ``particular``, ``null_vectors``, ``free``);
     ``multiplier_subexpressions`` (name -> text) when a multiplier is too large to print
@@ -338,7 +339,10 @@ def to_text(analysis: AnalysisResult) -> str:
     lines.extend(_gauge_lines(a))
     lines.append(f"Dirac bracket: {a.bracket_strategy}")
     for s in a.special_parameter_values:
-        lines.append(f"special parameter value: {s.parameter} = {s.value} ({s.where})")
+        if s.is_curve:
+            lines.append(f"special parameter curve: {s.equation} ({s.where})")
+        else:
+            lines.append(f"special parameter value: {s.parameter} = {s.value} ({s.where})")
     for note in a.notes:
         lines.append(f"note: {note}")
     return "\n".join(lines)

@@ -86,5 +86,5 @@ def test_hessian_special_value_of_the_pendulum():
     """``W = m 1`` (2x2): its rank drops from 2 to 0 at ``m = 0``."""
     a = dirac.analyze(dirac.load_system("pendulum"))
     assert [s.to_json() for s in a.special_parameter_values] == [
-        {"parameter": "m", "value": "0", "where": "rank of the Hessian drops from 2 to 0"}
+        {"parameter": "m", "value": "0", "equation": "m = 0", "where": "rank of the Hessian drops from 2 to 0"}
     ]
