@@ -41,7 +41,7 @@ define the surface on which points are sampled.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 import sympy
@@ -53,9 +53,11 @@ from dirac.analysis.numeric import Numerics, SingularSurface, independent_rows, 
 from dirac.analysis.phase_space import PhaseSpace
 from dirac.analysis.regularity import (
     IRREGULAR_GRADIENT,
+    MAX_FACTOR_TERMS,
     ROUND_OFF,
     branch_hint,
     branches,
+    factors,
     normal_components,
     square_free_part,
 )
@@ -66,15 +68,19 @@ __all__ = ["ConstraintChain", "tidy"]
 SAMPLE_POINTS = 4
 
 
-#: new constraints with at most this many terms have their common factors taken out, to find
-#: crossing branches (full factorisation would cost more than the analysis; other products
-#: are left to the rank checks at the sample points)
-FACTOR_TERMS = 8
+#: new constraints with at most this many terms are factored, to find their branches (a few
+#: ms each; most are linear in a variable and skip it); larger products are left to the
+#: regular-point and rank checks at the sample points. Holonomic constraints of the
+#: Lagrangian (met once) are factored up to ``MAX_FACTOR_TERMS`` terms.
+FACTOR_TERMS = 24
 
 
-def _small(constraint: sympy.Expr) -> bool:
-    """A constraint small enough to take its common factors out on every analysis."""
-    return isinstance(constraint, sympy.Add) and len(constraint.args) <= FACTOR_TERMS
+class _Split(Exception):
+    """A new constraint is the union of branches that do not meet: each is followed on its own."""
+
+    def __init__(self, constraint: sympy.Expr, parts: list[sympy.Expr], stage: int):
+        super().__init__(f"{constraint} splits")
+        self.constraint, self.parts, self.stage = constraint, parts, stage
 
 
 @dataclass
@@ -108,7 +114,9 @@ class ConstraintChain:
     user wrote as a product to that product, so that its branches are checked;
     ``holonomic`` maps the expanded form of each holonomic constraint of the Lagrangian
     to its number (an irregular one cannot be regularised inside the chain: its
-    multiplier term in ``H_c`` would stay irregular).
+    multiplier term in ``H_c`` would stay irregular). ``choices`` maps a constraint that is
+    the union of disjoint branches to the branch this chain follows (or to itself when the
+    union is analysed whole, its branches having the same structure).
     """
 
     phase_space: PhaseSpace
@@ -127,6 +135,7 @@ class ConstraintChain:
     regularity_notes: list[str] = field(default_factory=list)
     written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
     holonomic: dict[sympy.Expr, int] = field(default_factory=dict)
+    choices: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -164,13 +173,23 @@ class ConstraintChain:
     def run(self, max_stages: int | None = None) -> ConstraintChain:
         """Carry out the algorithm; returns ``self``.
 
+        A new constraint that is the union of branches that do not meet (``z (z + 2) = 0``)
+        is followed branch by branch through the next stages (:meth:`_follow_branches`).
+
         Raises
         ------
         InconsistentSystemError
-            When a consistency condition cannot hold (``1 = 0`` kind).
+            When a consistency condition cannot hold (``1 = 0`` kind), on every branch.
         AnalysisError
-            When the chain does not terminate within the phase-space dimension.
+            When the chain does not terminate within the phase-space dimension, or
+            branches with consistent motion differ in structure.
         """
+        try:
+            return self._run(max_stages)
+        except _Split as split:
+            return self._follow_branches(split, max_stages)
+
+    def _run(self, max_stages: int | None) -> ConstraintChain:
         self._row_cache: dict = {}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
         self.primary = primary
@@ -236,17 +255,111 @@ class ConstraintChain:
             if k:  # a product as written: its branches must not meet (read before expanding)
                 self._refuse_crossing(c, self.constraints)
         kept = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
-        for c in kept:  # a holonomic constraint written as a product, met in expanded form
-            if c in self.written:
-                self._refuse_crossing(self.written[c], self.constraints)
-        for c in kept:
-            # an expanded product with a common factor (z x + z = z (x + 1)): sample points
-            # may all fall on one branch, so its branches are checked here, not left to chance
-            if c not in self.written and _small(c):
-                common = sympy.factor_terms(c)
-                if isinstance(common, sympy.Mul):
-                    self._refuse_crossing(common, self.constraints)
-        return kept
+        # a product, written (a holonomic constraint) or expanded (x**2 - y**2, z x + z): sample
+        # points may all fall on one branch or on the crossing, so its branches are found here,
+        # by factorisation, not left to chance
+        return [self._branch(c, self._parts(c)) for c in kept]
+
+    def _parts(self, constraint: sympy.Expr) -> list[sympy.Expr]:
+        """The branches of a new constraint: the factors that can vanish (``[constraint]`` if none)."""
+        if constraint in self.written:
+            return branches(self.written[constraint], self.phase_space.variables)
+        limit = MAX_FACTOR_TERMS if constraint in self.holonomic else FACTOR_TERMS
+        return factors(constraint, self.phase_space.variables, limit)
+
+    def _branch(self, constraint: sympy.Expr, parts: list[sympy.Expr]) -> sympy.Expr:
+        """The constraint this chain follows for a union of ``parts``: refused if they meet, else split.
+
+        Branches that meet are refused (:meth:`_refuse_crossing`); disjoint ones raise
+        :class:`_Split` unless :attr:`choices` already says which branch (or the union)
+        this chain follows.
+        """
+        if len(parts) < 2:
+            return constraint
+        parts = [f for f in parts if self._vanishes_somewhere(f)]  # x for 2 p_x x on x**2 = 1: no branch
+        if len(parts) < 2:
+            return constraint
+        self._refuse_crossing(sympy.Mul(*parts), self.constraints, constraint)
+        if constraint in self.choices:
+            return tidy(self.choices[constraint], self.phase_space.variables, sign=True)
+        raise _Split(constraint, parts, len(self.stages) + 1)
+
+    def _vanishes_somewhere(self, factor: sympy.Expr) -> bool:
+        """Whether ``factor = 0`` has real points on the surface found so far (a branch there)."""
+        try:
+            self.numerics.surface_points(self.constraints + self.reducible + [factor], 1, attempts=8)
+        except AnalysisError:
+            return False
+        return True
+
+    def _follow_branches(self, split: _Split, max_stages: int | None) -> ConstraintChain:
+        """Run the chain once per branch of ``split``; keep the branches with consistent motion.
+
+        On the union ``f g = 0`` of branches that do not meet the motion is that of
+        ``f = 0`` or that of ``g = 0`` (each regular where it holds): a branch whose chain
+        becomes inconsistent has no motion and is dropped with a note (its points are
+        never sampled). One surviving branch is adopted; several with the same structure
+        (stage sizes, reducible constraints, free multipliers, rank of the bracket matrix)
+        are analysed as the union; several of different structure are refused, naming them.
+        """
+        c = split.constraint
+        shown = " and ".join(f"{f} = 0" for f in split.parts)
+        notes = [
+            f"stage {split.stage}: the zero set of the constraint {c} = 0 is the union of the branches {shown} "
+            "(repeated factors taken once), which do not meet; each was followed through the next stages"
+        ]
+        survivors: list[tuple[sympy.Expr, ConstraintChain]] = []
+        reasons = []
+        for part in split.parts:
+            child = self._child({**self.choices, c: part})
+            try:
+                child.run(max_stages)
+            except InconsistentSystemError as error:
+                why = str(error).removesuffix(": the Lagrangian has no consistent motion")
+                reasons.append(f"on {part} = 0 {why}")
+                notes.append(f"stage {split.stage}: the branch {part} = 0 of {c} = 0 was dropped, it has no consistent motion: {why}")
+                continue
+            survivors.append((part, child))
+        if not survivors:
+            raise InconsistentSystemError(f"the stage-{split.stage} constraint {c} = 0 is the union of the branches {shown}, and none has consistent motion: " + "; ".join(reasons))
+        if len(survivors) > 1:
+            structures = {part: child._structure() for part, child in survivors}
+            if len(set(structures.values())) > 1:
+                described = "; ".join(
+                    f"{part} = 0: stages of sizes {', '.join(map(str, s[0]))}, bracket-matrix rank {s[3]}, free multipliers {', '.join(s[2]) or 'none'}"
+                    for part, s in structures.items()
+                )
+                raise AnalysisError(
+                    f"the stage-{split.stage} constraint {c} = 0 is the union of the branches {shown}, which do not meet but "
+                    f"on which the motion has different structure ({described}); analyse the branches separately "
+                    "(one system each, with the branch as its constraint)"
+                )
+            child = self._child({**self.choices, c: c})
+            child.run(max_stages)
+            notes.append(f"stage {split.stage}: the branches {shown} have the same structure; the union {c} = 0 is analysed as one surface")
+            survivors = [(c, child)]
+        adopted = survivors[0][1]
+        for f in fields(self):
+            setattr(self, f.name, getattr(adopted, f.name))
+        self._row_cache = adopted._row_cache
+        self.pivots = adopted.pivots
+        self.regularity_notes = [*adopted.regularity_notes, *notes]
+        return self
+
+    def _child(self, choices: dict[sympy.Expr, sympy.Expr]) -> ConstraintChain:
+        """A fresh chain on the same system that follows the given branches."""
+        return ConstraintChain(
+            self.phase_space, self.numerics, self.canonical_hamiltonian, list(self.primary), self.multipliers,
+            time=self.time, written=dict(self.written), holonomic=dict(self.holonomic), choices=choices,
+        )
+
+    def _structure(self) -> tuple[tuple[int, ...], int, tuple[str, ...], int]:
+        """Stage sizes, reducible count, free multipliers and bracket-matrix rank (to compare branches)."""
+        pb = self.phase_space.poisson_bracket
+        cs = self.constraints
+        C = self.numerics.evaluate([pb(a, b) for a in cs for b in cs], self.points).reshape(len(self.points), len(cs), len(cs)) if cs else np.zeros((1, 0, 0))
+        rank = max(numeric_rank(m) for m in C)
+        return tuple(len(s) for s in self.stages), len(self.reducible), tuple(sorted(u.name for u in self.undetermined)), rank
 
     def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
         """Check new conditions for inconsistency and keep the independent ones (indices into ``candidates``)."""
@@ -307,6 +420,7 @@ class ConstraintChain:
             )
         self._refuse_crossing(part, self.constraints)
         regular = tidy(part, self.phase_space.variables, sign=True)
+        parts = factors(regular, self.phase_space.variables, MAX_FACTOR_TERMS)
         if constraint in self.holonomic:
             raise AnalysisError(
                 f"constraint {self.holonomic[constraint]} ({constraint} = 0) is irregular: its gradient vanishes where it "
@@ -319,11 +433,16 @@ class ConstraintChain:
             "the classes and counts below refer to this regular form (with the irregular form, first-class "
             "constraints need not all generate gauge transformations, as in Cawley's example)"
         )
-        return regular
+        return self._branch(regular, parts)
 
-    def _refuse_crossing(self, constraint: sympy.Expr, constraints: list[sympy.Expr]) -> None:
-        """Refuse a product ``f g = 0`` whose branches meet on the surface (no single regular surface there)."""
+    def _refuse_crossing(self, constraint: sympy.Expr, constraints: list[sympy.Expr], shown_as: sympy.Expr | None = None) -> None:
+        """Refuse a product ``f g = 0`` whose branches meet on the surface (no single regular surface there).
+
+        ``shown_as`` is the constraint as the chain met it (expanded), when ``constraint`` is its product form.
+        """
         parts = branches(constraint, self.phase_space.variables)
+        name = constraint if shown_as is None else shown_as
+        holonomic = self.holonomic.get(name)
         if len(parts) < 2:
             return
         for i in range(len(parts)):
@@ -333,11 +452,12 @@ class ConstraintChain:
                 except AnalysisError:
                     continue  # these branches do not meet: the product is regular where it holds
                 shown = " and ".join(f"{f} = 0" for f in parts)
+                where = f"constraint {holonomic} ({name} = 0)" if holonomic else f"the stage-{len(self.stages) + 1} constraint {name} = 0"
                 raise AnalysisError(
-                    f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: it is the union of the "
+                    f"{where} is irregular: it is the union of the "
                     f"branches {shown}, which meet (where {parts[i]} = {parts[j]} = 0 its gradient vanishes), so there "
                     f"is no single regular constraint surface; analyse the branches {shown} separately "
-                    "(one system each)"
+                    "(one system each" + (", with the branch as its constraint)" if holonomic else ")")
                 )
 
     def _irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:

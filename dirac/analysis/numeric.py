@@ -34,6 +34,11 @@ ZERO_TOLERANCE = 1e-8
 SURFACE_TOLERANCE = 1e-11
 #: smallest singular value of the row-normalised constraint Jacobian at a regular point
 REGULAR_TOLERANCE = 1e-6
+#: a gradient smaller than this, relative to the size of its terms (``1 + sum |term|``), is
+#: vanishing: the point is on a singular locus (a crossing ``x^2 - y^2 = 0`` at the origin),
+#: however independent the row-normalised gradients look there (at a converged point next
+#: to such a locus the gradient is of the order of the square root of the residual, ~1e-6)
+SINGULAR_GRADIENT = 1e-4
 
 
 class SingularSurface(AnalysisError):
@@ -231,6 +236,20 @@ class Numerics:
         s = np.linalg.svd(jacobian / norms[:, None], compute_uv=False)
         return bool(s[-1] > REGULAR_TOLERANCE) if len(s) == jacobian.shape[0] else False
 
+    def _vanishing_gradient(self, gradients: Sequence[sympy.Expr], jacobian: np.ndarray, z: np.ndarray) -> bool:
+        """Whether a constraint's gradient (a row of ``jacobian``) is vanishing at ``z`` relative to its terms.
+
+        Row normalisation in :meth:`_regular_point` hides a gradient that is small only
+        because the point lies next to where it vanishes; here each row's length is
+        compared with ``1 + sum |term|`` of its entries (``gradients``, flattened row by
+        row), below ``SINGULAR_GRADIENT`` the point is singular (Henneaux–Teitelboim,
+        Sect. 1.1.2: regular points have non-vanishing independent gradients).
+        """
+        k, n = jacobian.shape
+        scales = self.term_scale(gradients, [z])[0].reshape(k, n)
+        sizes = np.linalg.norm(jacobian, axis=1) / (1.0 + np.sum(scales - 1.0, axis=1))
+        return bool(np.any(sizes < SINGULAR_GRADIENT))
+
     def random_point(self) -> np.ndarray:
         """A random phase-space point with components of size 0.5-1.5 and random signs (and a time ``t``)."""
         n = len(self.phase_space.variables) + (self.time is not None)
@@ -310,6 +329,9 @@ class Numerics:
                 z = z.copy()
                 z[free] += step
             if ok and regular and not self._regular_point(jac_fn(z).reshape(m, n)[:regular]):
+                singular += 1
+                continue
+            if ok and regular and self._vanishing_gradient(flat[: regular * n], jac_fn(z).reshape(m, n)[:regular], z):
                 singular += 1
                 continue
             if ok:

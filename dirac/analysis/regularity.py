@@ -31,7 +31,7 @@ import sympy
 
 from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["square_free_part", "branches", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
+__all__ = ["square_free_part", "branches", "factors", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
 
 #: polynomials with more terms than this are not factored (the cost grows fast); their
 #: regularity is still checked numerically at surface points
@@ -110,6 +110,83 @@ def branches(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.
         if base.free_symbols & set(variables) and base not in found and not _never_zero(base):
             found.append(base)
     return found if len(found) > 1 else [expr]
+
+
+def _linear_with_constant_coefficient(poly: sympy.Poly) -> bool:
+    """Whether ``poly = c v + R`` for a generator ``v`` absent from ``R`` and ``c`` free of the generators.
+
+    Such a polynomial is irreducible: in a product ``A B`` one factor has degree 0 in ``v``
+    and divides ``c``, so it is a constant (``p_x + 3 x^2 - z``, most constraints met).
+    """
+    n = len(poly.gens)
+    for k, v in enumerate(poly.gens):
+        if poly.degree(v) == 1 and [m for m in poly.monoms() if m[k] == 1] == [tuple(int(j == k) for j in range(n))]:
+            return True
+    return False
+
+
+_PLANE = sympy.polys.rings.ring("s,t", sympy.QQ)[0]
+
+
+def _irreducible_on_a_plane(poly: sympy.Poly, seed: int = 20240607) -> bool:
+    """Whether ``poly`` is shown irreducible by its restriction to a random plane (cheap, one-sided).
+
+    Substitutes random integers for the parameters in the coefficients and
+    ``v_i = a_i + b_i s + c_i t`` (random integers) for the generators. A factorisation
+    ``f g`` restricts to ``f|g|`` with the same degrees on a plane along which the
+    polynomial keeps its total degree, so an irreducible restriction of full degree
+    proves ``poly`` irreducible (for generic parameters); the bivariate factorisation costs
+    ~1 ms where a multivariate one over a parameter field costs up to a second (Bertini;
+    Hilbert's irreducibility theorem makes a reducible restriction of an irreducible
+    polynomial improbable). ``False`` means "not shown": factor in full.
+    """
+    rng = np.random.default_rng(seed)
+    s, t = _PLANE.gens
+    images = [int(rng.integers(-9, 10)) + int(rng.integers(1, 10)) * s + int(rng.integers(-9, 10)) * t for _ in poly.gens]
+    expr = poly.as_expr()
+    params = sorted(expr.free_symbols - set(poly.gens), key=str)
+    total = _PLANE.zero
+    try:
+        if params:
+            expr = expr.subs({p: sympy.Integer(int(rng.integers(2, 14))) for p in params})
+        numeric = sympy.Poly(expr, *poly.gens, domain=sympy.QQ)
+        for monom, coeff in numeric.terms():
+            term = _PLANE(coeff)
+            for image, e in zip(images, monom):
+                if e:
+                    term *= image**e
+            total += term
+        if total.is_zero or max(sum(m) for m in total.monoms()) != poly.total_degree():
+            return False
+        _, found = total.factor_list()
+    except (ZeroDivisionError, sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, TypeError, ValueError):
+        return False
+    return len(found) == 1 and found[0][1] == 1
+
+
+def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int) -> list[sympy.Expr]:
+    """The distinct irreducible factors of a polynomial constraint that can vanish (the branches of ``expr = 0``).
+
+    ``[expr]`` when it is irreducible, not polynomial in the ``variables`` or has more than
+    ``max_terms`` terms. Multiplicities are dropped (the zero set of ``f^k g`` is that of
+    ``f g``), factors free of the variables or without a real zero are left out. A
+    polynomial linear in some variable with a coefficient free of the variables is
+    irreducible and is not factored (:func:`_linear_with_constant_coefficient`), nor is one
+    whose restriction to a random plane is irreducible (:func:`_irreducible_on_a_plane`);
+    the others go through multivariate factorisation (``sympy.factor_list``).
+    """
+    terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
+    if terms > max_terms:
+        return [expr]
+    poly = _polynomial(expr, variables)
+    if poly is None or poly.total_degree() < 2 or _linear_with_constant_coefficient(poly) or _irreducible_on_a_plane(poly):
+        return [expr]
+    try:
+        _, found = sympy.factor_list(poly.as_expr(), *poly.gens)
+    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+        return [expr]
+    parts = [f for f, _ in found if f.free_symbols & set(variables) and not _never_zero(f)]
+    return parts if len(parts) > 1 else [expr]
 
 
 def factored(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> list[tuple[sympy.Expr, list[sympy.Expr]]]:

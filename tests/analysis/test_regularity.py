@@ -157,9 +157,9 @@ def test_squared_factor_of_a_crossing_product_is_refused():
 def test_expanded_product_met_in_the_chain_is_refused_with_its_branches():
     """``L = x_dot z_dot + y (x z + z)``: ``p_y = 0`` is primary, ``H_c = p_x p_z - y (x z + z)``,
     and ``{p_y, H_c} = x z + z = z (x + 1)``: the union of the branches ``z = 0`` and
-    ``x = -1``, which meet at ``(x, z) = (-1, 0)``, written expanded. The chain takes the
-    common factors out of its small new constraints, so the crossing is found whichever branch the sample points fall
+    ``x = -1``, which meet at ``(x, z) = (-1, 0)``, written expanded. The chain factors its
+    small new constraints, so the crossing is found whichever branch the sample points fall
     on (never a rank taken from the points of one branch only); the refusal names both."""
     L = dirac.Lagrangian.from_strings("branches", ["x", "y", "z"], "x_dot*z_dot + y*(x*z + z)")
-    with pytest.raises(AnalysisError, match=r"z\*\(x \+ 1\) = 0 is irregular.*branches z = 0 and x \+ 1 = 0"):
+    with pytest.raises(AnalysisError, match=r"x\*z \+ z = 0 is irregular.*branches z = 0 and x \+ 1 = 0"):
         dirac.analyze(L)
