@@ -72,3 +72,45 @@ def test_each_layer_imports_only_the_layers_below_it():
 
 def test_the_layer_table_has_no_cycle():
     assert cycles({name: set(allowed) for name, allowed in ALLOWED.items()}) == []
+
+
+#: sub-package of dirac.analysis -> the sub-packages it may import (the steps of the algorithm,
+#: docs/architecture.md); the modules on top of dirac.analysis may import every sub-package
+ANALYSIS_ALLOWED: dict[str, set[str]] = {
+    "core": set(),
+    "legendre": {"core"},
+    "classes": {"core", "legendre"},
+    "chain": {"core", "legendre", "classes"},
+    "brackets": {"core"},
+    "gauge": {"core", "chain", "classes", "brackets"},
+}
+
+
+def analysis_step(module: str) -> str | None:
+    """``dirac.analysis.chain.constraint_chain`` -> ``chain``; ``None`` outside a sub-package."""
+    parts = module.split(".")
+    if parts[:2] != ["dirac", "analysis"] or len(parts) < 3 or parts[2] not in ANALYSIS_ALLOWED:
+        return None
+    return parts[2]
+
+
+def test_every_analysis_module_but_the_top_two_is_in_a_step():
+    top = {"dirac.analysis", "dirac.analysis.constraint_analysis", "dirac.analysis.report"}
+    assert sorted(m for m in modules() if m.startswith("dirac.analysis") and m not in top and analysis_step(m) is None) == []
+
+
+def test_each_analysis_step_imports_only_the_steps_it_may():
+    against = sorted(
+        f"{module} -> {target}"
+        for module, imported in import_graph().items()
+        if (step := analysis_step(module)) is not None
+        for target in imported
+        if target.startswith("dirac.analysis")
+        and analysis_step(target) != step
+        and analysis_step(target) not in ANALYSIS_ALLOWED[step]
+    )
+    assert against == []
+
+
+def test_the_analysis_step_table_has_no_cycle():
+    assert cycles({name: set(allowed) for name, allowed in ANALYSIS_ALLOWED.items()}) == []

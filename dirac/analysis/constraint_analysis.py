@@ -15,23 +15,23 @@ from typing import TYPE_CHECKING
 import numpy as np
 import sympy
 
-from dirac.analysis.algebra import tidy
-from dirac.analysis.classification import bracket_matrix, classify
-from dirac.analysis.constraint_chain import ConstraintChain
-from dirac.analysis.dirac_bracket import DiracBracket
-from dirac.analysis.legendre import legendre_transform
-from dirac.analysis.linear_solve import SolveTooLarge
-from dirac.analysis.multiplier_solution import MultiplierSolution, unsolved_multipliers
-from dirac.analysis.numeric import Numerics, independent_rows
-from dirac.analysis.regularity import regular_holonomic
+from dirac.analysis.brackets.dirac_bracket import DiracBracket
+from dirac.analysis.chain.constraint_chain import ConstraintChain
+from dirac.analysis.chain.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
+from dirac.analysis.classes.classification import bracket_matrix, classify
+from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
+from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.linear_solve import SolveTooLarge
+from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.legendre.regularity import regular_holonomic
+from dirac.analysis.legendre.transform import legendre_transform
 from dirac.analysis.report import to_json, to_latex, to_text
-from dirac.analysis.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
 from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
 
 if TYPE_CHECKING:  # imported where used: most analyses never ask for them (start-up time of the CLI)
-    from dirac.analysis.gauge_generators import GaugeGenerator, GaugeStructure
-    from dirac.analysis.vector_field import VectorField
+    from dirac.analysis.brackets.vector_field import VectorField
+    from dirac.analysis.gauge.generators import GaugeGenerator, GaugeStructure
 
 __all__ = ["ConstraintAnalysis", "analyze"]
 
@@ -70,7 +70,7 @@ class ConstraintAnalysis:
         The ``u_k`` not fixed alone (free, or fixed only in combinations).
     multiplier_solution
         The general solution ``u = U + v_a V_a`` of the consistency conditions: a
-        :class:`~dirac.analysis.multiplier_solution.MultiplierSolution` with
+        :class:`~dirac.analysis.classes.multiplier_solution.MultiplierSolution` with
         ``.particular`` (name -> expression), ``.null_vectors`` (list of name ->
         expression), the free ``.free`` (``v_1, ...``), the first-class combinations
         ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``.
@@ -89,8 +89,8 @@ class ConstraintAnalysis:
     bracket_strategy
         How Dirac brackets are computed ("symbolic", "block" or "numeric", and why).
     special_parameter_values
-        :class:`~dirac.analysis.special_values.SpecialValue` list: parameter values at
-        which a rank the analysis used drops (:mod:`dirac.analysis.special_values`).
+        :class:`~dirac.analysis.chain.special_values.SpecialValue` list: parameter values at
+        which a rank the analysis used drops (:mod:`dirac.analysis.chain.special_values`).
     notes
         How the decisions were made (for the report), including regularised and
         reducible constraints.
@@ -206,9 +206,9 @@ class ConstraintAnalysis:
     @property
     def gauge_structure(self) -> GaugeStructure:
         """Castellani's gauge generators and the first-class constraints without one
-        (:mod:`dirac.analysis.gauge_generators`); computed on first use."""
+        (:mod:`dirac.analysis.gauge.generators`); computed on first use."""
         if self._gauge is None:
-            from dirac.analysis.gauge_generators import gauge_structure
+            from dirac.analysis.gauge.generators import gauge_structure
 
             self._gauge = gauge_structure(self)
         return self._gauge
@@ -216,23 +216,23 @@ class ConstraintAnalysis:
     @property
     def gauge_generators(self) -> list[GaugeGenerator]:
         """One generator ``G = sum_k eps^(k) G_k`` per independent gauge parameter (empty
-        without gauge freedom); see :mod:`dirac.analysis.gauge_generators`."""
+        without gauge freedom); see :mod:`dirac.analysis.gauge.generators`."""
         return self.gauge_structure.generators
 
     def fix_gauge(self, conditions: Sequence[sympy.Expr | str]) -> ConstraintAnalysis:
-        """The analysis with gauge conditions ``chi_i = 0`` added (:mod:`dirac.analysis.gauge_fixing`).
+        """The analysis with gauge conditions ``chi_i = 0`` added (:mod:`dirac.analysis.gauge.fixing`).
 
         Raises
         ------
         InputError
             For conditions that are not admissible; the message names the condition.
         """
-        from dirac.analysis.gauge_fixing import fix_gauge
+        from dirac.analysis.gauge.fixing import fix_gauge
 
         return fix_gauge(self, conditions)
 
     def _special_values(self, chain: ConstraintChain, C: sympy.Matrix, second: list[int], seed: int) -> tuple[list[SpecialValue], list[str]]:
-        """Parameter values where the rank of the Hessian, of ``A_PQ`` or of ``C`` drops (:mod:`dirac.analysis.special_values`)."""
+        """Parameter values where the rank of the Hessian, of ``A_PQ`` or of ``C`` drops (:mod:`dirac.analysis.chain.special_values`)."""
         space = self._space
         uses = []
         large: list[str] = []
@@ -374,7 +374,7 @@ class ConstraintAnalysis:
         ``f.names``, in the order of :attr:`symbols`), ``H`` as in
         :meth:`equations_of_motion` with the free multipliers ``u_k`` given (default 0);
         ``f.batch(Y)`` evaluates many states, ``f.residual(y)`` the constraints.
-        See :class:`dirac.analysis.vector_field.VectorField`.
+        See :class:`dirac.analysis.brackets.vector_field.VectorField`.
 
         Parameters
         ----------
@@ -388,7 +388,7 @@ class ConstraintAnalysis:
         InputError
             Unknown names, parameters without a value, values that are not finite.
         """
-        from dirac.analysis.vector_field import vector_field
+        from dirac.analysis.brackets.vector_field import vector_field
 
         return vector_field(self, parameters, multipliers)
 
@@ -425,7 +425,7 @@ class ConstraintAnalysis:
         fixed = {index[k]: float(v) for k, v in values.items()}
         try:
             if self.gauge_conditions:
-                from dirac.analysis.gauge_fixing import regular_gauge_point
+                from dirac.analysis.gauge.fixing import regular_gauge_point
 
                 point = regular_gauge_point(self, numerics, fixed)
             else:
@@ -513,7 +513,7 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
 
     The analysis is symbolic in its parameters (generic structure). When the value a
     parameter has in the system (its default: the system file, or ``--param``) lies on a
-    special parameter value (:mod:`dirac.analysis.special_values`), the structure there
+    special parameter value (:mod:`dirac.analysis.chain.special_values`), the structure there
     differs from the generic one: the analysis is done again with those parameters fixed
     to their values (what the user wrote), with a note and a :class:`~dirac.errors.DiracWarning`
     saying that generic values give another structure.

@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
-from dirac.analysis.gauge_generators import GaugeStructure
+from dirac.analysis.gauge.generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
 if TYPE_CHECKING:  # the report reads a solution; it needs no solver
-    from dirac.analysis.multiplier_solution import MultiplierSolution
+    from dirac.analysis.classes.multiplier_solution import MultiplierSolution
 
 __all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
 

@@ -2,7 +2,7 @@
 
 Text by default (stage by stage, with counts), ``--json`` (docs/file_formats.md) or ``--latex``.
 ``--param NAME=VALUE`` fixes parameters (the others stay symbolic); ``--gauge EXPR``
-(repeatable) adds gauge conditions (:mod:`dirac.analysis.gauge_fixing`); ``--compare SPEC``
+(repeatable) adds gauge conditions (:mod:`dirac.analysis.gauge.fixing`); ``--compare SPEC``
 compares two brackets of the result (see :mod:`dirac.commands.analyze_compare`).
 """
 

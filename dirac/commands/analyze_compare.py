@@ -1,8 +1,8 @@
 """``dirac analyze SYSTEM --compare SPEC``: compare two brackets of the analysed system.
 
 SPEC is ``FIRST,SECOND`` or ``FIRST,SECOND:N`` (bracket names of
-:data:`dirac.analysis.structures.BRACKET_NAMES`, ``N`` sampled points of the constraint
-surface). The comparison itself is :func:`dirac.analysis.comparison.compare_brackets`.
+:data:`dirac.analysis.brackets.structures.BRACKET_NAMES`, ``N`` sampled points of the constraint
+surface). The comparison itself is :func:`dirac.analysis.brackets.comparison.compare_brackets`.
 """
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from dirac.analysis.brackets import StructureBracket, analysis_variables
-from dirac.analysis.casimirs import casimirs, jacobi_residual
-from dirac.analysis.comparison import compare_brackets, surface_points
-from dirac.analysis.structures import BRACKET_NAMES, named_bracket
+from dirac.analysis.brackets.casimirs import casimirs, jacobi_residual
+from dirac.analysis.brackets.comparison import compare_brackets, surface_points
+from dirac.analysis.brackets.named_brackets import StructureBracket, analysis_variables
+from dirac.analysis.brackets.structures import BRACKET_NAMES, named_bracket
 from dirac.errors import AnalysisError, InputError
 
 __all__ = ["DEFAULT_POINTS", "parse_spec", "cli_compare"]

@@ -1,7 +1,7 @@
 """`dirac analyze` and `dirac run` on a system file that uses the time t.
 
 Pendulum of changing length ``chi = x^2 + y^2 - (l0 + a t)^2`` (hand derivation in
-tests/analysis/test_rheonomic_chain.py): four stages of one constraint each, the third
+tests/analysis/chain/test_rheonomic_chain.py): four stages of one constraint each, the third
 ``2 (x p_x + y p_y)/m - 2 a (l0 + a t)`` carrying the partial time derivative, 4 second-class
 constraints, one degree of freedom. `dirac run` integrates it with RATTLE, whose kernel
 takes the time (the rod length at every sample is l0 + a t).

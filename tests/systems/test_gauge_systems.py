@@ -80,7 +80,7 @@ def test_inconsistent_lagrangian_is_reported():
 
 def test_non_quadratic_lagrangian_is_refused():
     """A Lagrangian not algebraic in the velocities (a square root, -m sqrt(1 - x_dot^2), is
-    now transformed: tests/analysis/test_nonquadratic_legendre.py)."""
+    now transformed: tests/analysis/legendre/test_nonquadratic_legendre.py)."""
     L = dirac.Lagrangian.from_strings("relativistic", ["x"], "-m*exp(x_dot)", parameters={"m": 1.0})
     with pytest.raises(dirac.AnalysisError, match="not quadratic in the velocities"):
         dirac.analyze(L)

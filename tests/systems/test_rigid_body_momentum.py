@@ -13,7 +13,7 @@ import sympy
 from rigid_body_analyses import cached_analysis, eps, hat
 
 import dirac
-from dirac.analysis.legendre import legendre_transform
+from dirac.analysis.legendre.transform import legendre_transform
 from dirac.errors import DiracWarning, InputError
 from dirac_systems import rigid_body_momentum
 

@@ -1,0 +1,2 @@
+"""Step 2: the Dirac–Bergmann constraint chain, stage by stage, and the parameter values
+where its ranks drop."""

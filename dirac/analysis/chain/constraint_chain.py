@@ -1,0 +1,599 @@
+"""The Dirac–Bergmann constraint chain: stage-by-stage consistency ``{Phi, H_T} ≈ 0``.
+
+With ``H_T = H_c + u_k phi_k`` (one multiplier per primary constraint, (207), (234)),
+the time derivative of every constraint found so far must vanish weakly:
+
+    {Phi_a, H_c} + u_k {Phi_a, phi_k} ≈ 0          ((210), (213)-(215)).
+
+For a constraint that depends explicitly on the time ``t`` (a rheonomic system) the
+total time derivative has the partial derivative as well,
+``d Phi_a/dt = {Phi_a, H_T} + d_t Phi_a`` (Dirac, "Lectures on quantum mechanics";
+Gitman–Tyutin), so ``b_a = {Phi_a, H_c} + d_t Phi_a`` below; ``t`` is not a phase-space
+variable, so the brackets are unchanged.
+
+Writing ``b_a = {Phi_a, H_c}`` and ``A_ak = {Phi_a, phi_k}``, the rows of ``A`` that are
+independent on the surface fix multipliers; every other row ``a`` is, after eliminating
+``u`` with those pivot rows, the condition ``psi_a = b_a - c_a . b_P ≈ 0`` (``c_a`` the
+coefficients of row ``a`` in the pivot rows). Each ``psi_a`` is (i) weakly zero — an
+identity, or (ii) a new constraint of the next stage. Pivot rows are chosen among rows
+whose ``b`` already vanishes weakly first, so that usually ``psi_a = b_a`` exactly
+(this reproduces the chains (206), (209), (210), (215) of the paper). When a stage has
+new constraints of that direct kind, the conditions that would need multipliers
+eliminated are deferred to the next stage and re-examined there, on the smaller
+surface, where more multipliers are usually fixed by rows with ``b ≈ 0``: the final
+surface is the same (the chain only stops when no row of any kind adds a constraint),
+and the stages follow the paper's order for (228) — ``pi -> R^T R - 1`` first, then
+``d(R^T R)/dt = 0`` fixes ``v = 0`` and ``P_dot = 0`` fixes ``lambda`` (Sect. XI). New constraints
+that follow from the earlier ones (gradient dependent on the new surface) are dropped; a
+condition free of phase-space variables (``1 = 0``) is an inconsistency. The chain stops
+when a stage adds nothing; the last system then fixes the determined multipliers, and its
+general solution ``u = U + v_a V_a`` is built by :mod:`dirac.analysis.classes.multiplier_solution`.
+
+Regularity (Henneaux–Teitelboim, Sect. 1.1.2): every sample point is a regular point of
+the surface found so far (independent gradients of the kept constraints, checked). A
+new constraint whose gradient vanishes where it holds is replaced by its square-free
+part (Cawley's ``z^2 = 0`` -> ``z = 0``, with a note) or refused; a product whose
+branches cross is refused. New constraints whose gradients depend on the others on the
+regular part of the surface (a reducible set, ``x . J = 0`` for ``J = x × p``) are kept
+in :attr:`ConstraintChain.reducible`: they do not enter the classification but still
+define the surface on which points are sampled.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+import sympy
+
+from dirac.analysis.classes.multiplier_solution import (
+    MultiplierSolution,
+    general_multiplier_solution,
+    unsolved_multipliers,
+)
+from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.linear_solve import weak_solve
+from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
+from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.legendre.regularity import (
+    IRREGULAR_GRADIENT,
+    MAX_FACTOR_TERMS,
+    ROUND_OFF,
+    branch_hint,
+    branches,
+    factors,
+    normal_components,
+    square_free_part,
+)
+from dirac.errors import AnalysisError, InconsistentSystemError
+
+__all__ = ["ConstraintChain", "tidy"]
+
+SAMPLE_POINTS = 4
+
+
+#: new constraints with at most this many terms are factored, to find their branches (a few
+#: ms each; most are linear in a variable and skip it); larger products are left to the
+#: regular-point and rank checks at the sample points. Holonomic constraints of the
+#: Lagrangian (met once) are factored up to ``MAX_FACTOR_TERMS`` terms.
+FACTOR_TERMS = 24
+
+
+class _Split(Exception):
+    """A new constraint is the union of branches that do not meet: each is followed on its own."""
+
+    def __init__(self, constraint: sympy.Expr, parts: list[sympy.Expr], stage: int):
+        super().__init__(f"{constraint} splits")
+        self.constraint, self.parts, self.stage = constraint, parts, stage
+
+
+@dataclass
+class ConstraintChain:
+    """Run the Dirac–Bergmann algorithm from the primary constraints.
+
+    Parameters
+    ----------
+    phase_space
+        The canonical phase space.
+    numerics
+        Numerical evaluator (surface points, weak-zero tests).
+    canonical_hamiltonian
+        ``H_c`` on the primary surface.
+    primary
+        Primary constraints ``phi_k`` (stage 1).
+    multipliers
+        Their multipliers ``u_k`` in ``H_T``.
+    time
+        The time ``t`` when the system depends on it explicitly (then the partial time
+        derivative enters every consistency condition), else ``None``.
+
+    After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
+    expression, only those the chain determines), ``undetermined`` (multiplier symbols
+    not fixed alone), ``multiplier_solution`` (the general solution ``u = U + v_a V_a``),
+    ``points`` (regular points of the final surface), ``reducible`` (constraints
+    that hold but whose gradients depend on the kept ones on the regular part of the
+    surface, e.g. ``x . J = 0`` among ``J = x × p``; they still define the surface) and
+    ``notes`` (``regularity_notes``: regularised and reducible constraints, for the report).
+    ``written`` maps the expanded form (as :func:`tidy` gives it) of a constraint the
+    user wrote as a product to that product, so that its branches are checked;
+    ``holonomic`` maps the expanded form of each holonomic constraint of the Lagrangian
+    to its number (an irregular one cannot be regularised inside the chain: its
+    multiplier term in ``H_c`` would stay irregular). ``choices`` maps a constraint that is
+    the union of disjoint branches to the branch this chain follows (or to itself when the
+    union is analysed whole, its branches having the same structure).
+    """
+
+    phase_space: PhaseSpace
+    numerics: Numerics
+    canonical_hamiltonian: sympy.Expr
+    primary: list[sympy.Expr]
+    multipliers: tuple[sympy.Symbol, ...]
+    stages: list[list[sympy.Expr]] = field(default_factory=list)
+    solved_multipliers: dict[str, sympy.Expr] = field(default_factory=dict)
+    undetermined: list[sympy.Symbol] = field(default_factory=list)
+    points: list[np.ndarray] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    multiplier_solution: MultiplierSolution | None = None
+    time: sympy.Symbol | None = None
+    reducible: list[sympy.Expr] = field(default_factory=list)
+    regularity_notes: list[str] = field(default_factory=list)
+    written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
+    holonomic: dict[sympy.Expr, int] = field(default_factory=dict)
+    choices: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
+
+    @property
+    def constraints(self) -> list[sympy.Expr]:
+        """All constraints, stage by stage."""
+        return [c for stage in self.stages for c in stage]
+
+    @property
+    def total_hamiltonian(self) -> sympy.Expr:
+        """``H_T = H_c + sum_k u_k phi_k`` ((207), (234))."""
+        return self.canonical_hamiltonian + sum((u * phi for u, phi in zip(self.multipliers, self.primary)), sympy.S.Zero)
+
+    # ------------------------------------------------------------------ helpers
+    def _rows(self, constraint: sympy.Expr) -> tuple[sympy.Expr, list[sympy.Expr]]:
+        cached = self._row_cache.get(constraint)
+        if cached is None:
+            pb = self.phase_space.poisson_bracket
+            b = pb(constraint, self.canonical_hamiltonian)
+            if self.time is not None:  # d Phi/dt = {Phi, H_T} + d_t Phi for a rheonomic system
+                b = b + sympy.diff(constraint, self.time)
+            cached = (b, [pb(constraint, phi) for phi in self.primary])
+            self._row_cache[constraint] = cached
+        return cached
+
+    def _numeric_rows(self, constraints: list[sympy.Expr], points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        K = len(self.primary)
+        exprs = []
+        for c in constraints:
+            b, A = self._rows(c)
+            exprs.append(b)
+            exprs.extend(A)
+        values = self.numerics.evaluate(exprs, points).reshape(len(points), len(constraints), K + 1)
+        return values[:, :, 0], values[:, :, 1:]
+
+    # ------------------------------------------------------------------ the algorithm
+    def run(self, max_stages: int | None = None) -> ConstraintChain:
+        """Carry out the algorithm; returns ``self``.
+
+        A new constraint that is the union of branches that do not meet (``z (z + 2) = 0``)
+        is followed branch by branch through the next stages (:meth:`_follow_branches`).
+
+        Raises
+        ------
+        InconsistentSystemError
+            When a consistency condition cannot hold (``1 = 0`` kind), on every branch.
+        AnalysisError
+            When the chain does not terminate within the phase-space dimension, or
+            branches with consistent motion differ in structure.
+        """
+        try:
+            return self._run(max_stages)
+        except _Split as split:
+            return self._follow_branches(split, max_stages)
+
+    def _run(self, max_stages: int | None) -> ConstraintChain:
+        self._row_cache: dict = {}
+        primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
+        self.primary = primary
+        points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
+        base_grads = self._independent(primary, [], points) if primary else []
+        self.stages = [[primary[i] for i in base_grads]] if primary else []
+        if primary and len(base_grads) < len(primary):
+            raise AnalysisError("the primary constraints are not independent; the analysis cannot proceed")
+        limit = max_stages or (self.phase_space.dimension + 2)
+        K = len(self.primary)
+        pivots_rows: list[int] = []
+        pivot_cols: list[int] = []
+        while True:
+            constraints = self.constraints
+            if not constraints:
+                break
+            _, A_num = self._numeric_rows(constraints, points)
+            exprs_b = [self._rows(c)[0] for c in constraints]
+            b_zero = self.numerics.weakly_zero(exprs_b, points)
+            a_row_zero = np.all(np.abs(A_num) <= 1e-9 * (1 + np.max(np.abs(A_num), axis=(1, 2), keepdims=True)), axis=(0, 2)) if K else np.ones(len(constraints), bool)
+            order = [i for i in range(len(constraints)) if b_zero[i] and not a_row_zero[i]]
+            order += [i for i in range(len(constraints)) if not b_zero[i] and not a_row_zero[i]]
+            pivots_rows = independent_rows(list(A_num), order) if K else []
+            pivot_cols = independent_rows([m[pivots_rows].T for m in A_num], list(range(K))) if pivots_rows else []
+            direct: list[sympy.Expr] = []
+            deferred: list[tuple[int, list[int]]] = []  # (row, pivot positions it must be reduced by)
+            for i in range(len(constraints)):
+                if i in pivots_rows or (b_zero[i] and a_row_zero[i]):
+                    continue
+                needed = [] if a_row_zero[i] else self._needed(i, pivots_rows, pivot_cols, A_num, b_zero)
+                if needed:
+                    deferred.append((i, needed))
+                else:
+                    direct.append(exprs_b[i])
+            candidates, chosen = self._settle(self._nonzero(direct, points), constraints, limit) if direct else ([], [])
+            if not chosen and deferred:
+                # nothing new without them: build the conditions that need multipliers eliminated
+                eliminated = [self._eliminate(i, needed, constraints, pivots_rows, pivot_cols, A_num) for i, needed in deferred]
+                candidates, chosen = self._settle(self._nonzero(eliminated, points), constraints, limit)
+            elif deferred:
+                self.notes.append(
+                    f"stage {len(self.stages) + 1}: {len(deferred)} consistency condition(s) that need multipliers "
+                    "eliminated were deferred to the next stage and re-examined there on the smaller surface"
+                )
+            if not chosen:
+                break
+            self.stages.append([candidates[i] for i in chosen])
+            self._keep_reducible(candidates, chosen)
+            points = self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
+        self.points = points
+        self.pivots = (pivots_rows, pivot_cols)
+        if pivots_rows:
+            self._check_consistent_rank(A_num, pivots_rows)
+        self._solve_multipliers(points, pivots_rows, pivot_cols)
+        return self
+
+    def _nonzero(self, candidates: list[sympy.Expr], points: list[np.ndarray]) -> list[sympy.Expr]:
+        """The candidates that are not weakly zero, tidied (constraints: the sign is free)."""
+        if not candidates:
+            return []
+        keep = ~self.numerics.weakly_zero(candidates, points)
+        for c, k in zip(candidates, keep):
+            if k:  # a product as written: its branches must not meet (read before expanding)
+                self._refuse_crossing(c, self.constraints)
+        kept = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+        # a product, written (a holonomic constraint) or expanded (x**2 - y**2, z x + z): sample
+        # points may all fall on one branch or on the crossing, so its branches are found here,
+        # by factorisation, not left to chance
+        return [self._branch(c, self._parts(c)) for c in kept]
+
+    def _parts(self, constraint: sympy.Expr) -> list[sympy.Expr]:
+        """The branches of a new constraint: the factors that can vanish (``[constraint]`` if none)."""
+        if constraint in self.written:
+            return branches(self.written[constraint], self.phase_space.variables)
+        limit = MAX_FACTOR_TERMS if constraint in self.holonomic else FACTOR_TERMS
+        return factors(constraint, self.phase_space.variables, limit)
+
+    def _branch(self, constraint: sympy.Expr, parts: list[sympy.Expr]) -> sympy.Expr:
+        """The constraint this chain follows for a union of ``parts``: refused if they meet, else split.
+
+        Branches that meet are refused (:meth:`_refuse_crossing`); disjoint ones raise
+        :class:`_Split` unless :attr:`choices` already says which branch (or the union)
+        this chain follows.
+        """
+        if len(parts) < 2:
+            return constraint
+        parts = [f for f in parts if self._vanishes_somewhere(f)]  # x for 2 p_x x on x**2 = 1: no branch
+        if len(parts) < 2:
+            return constraint
+        self._refuse_crossing(sympy.Mul(*parts), self.constraints, constraint)
+        if constraint in self.choices:
+            return tidy(self.choices[constraint], self.phase_space.variables, sign=True)
+        raise _Split(constraint, parts, len(self.stages) + 1)
+
+    def _vanishes_somewhere(self, factor: sympy.Expr) -> bool:
+        """Whether ``factor = 0`` has real points on the surface found so far (a branch there)."""
+        try:
+            self.numerics.surface_points(self.constraints + self.reducible + [factor], 1, attempts=8)
+        except AnalysisError:
+            return False
+        return True
+
+    def _follow_branches(self, split: _Split, max_stages: int | None) -> ConstraintChain:
+        """Run the chain once per branch of ``split``; keep the branches with consistent motion.
+
+        On the union ``f g = 0`` of branches that do not meet the motion is that of
+        ``f = 0`` or that of ``g = 0`` (each regular where it holds): a branch whose chain
+        becomes inconsistent has no motion and is dropped with a note (its points are
+        never sampled). One surviving branch is adopted; several with the same structure
+        (stage sizes, reducible constraints, free multipliers, rank of the bracket matrix)
+        are analysed as the union; several of different structure are refused, naming them.
+        """
+        c = split.constraint
+        shown = " and ".join(f"{f} = 0" for f in split.parts)
+        notes = [
+            f"stage {split.stage}: the zero set of the constraint {c} = 0 is the union of the branches {shown} "
+            "(repeated factors taken once), which do not meet; each was followed through the next stages"
+        ]
+        survivors: list[tuple[sympy.Expr, ConstraintChain]] = []
+        reasons = []
+        for part in split.parts:
+            child = self._child({**self.choices, c: part})
+            try:
+                child.run(max_stages)
+            except InconsistentSystemError as error:
+                why = str(error).removesuffix(": the Lagrangian has no consistent motion")
+                reasons.append(f"on {part} = 0 {why}")
+                notes.append(f"stage {split.stage}: the branch {part} = 0 of {c} = 0 was dropped, it has no consistent motion: {why}")
+                continue
+            survivors.append((part, child))
+        if not survivors:
+            raise InconsistentSystemError(f"the stage-{split.stage} constraint {c} = 0 is the union of the branches {shown}, and none has consistent motion: " + "; ".join(reasons))
+        if len(survivors) > 1:
+            structures = {part: child._structure() for part, child in survivors}
+            if len(set(structures.values())) > 1:
+                described = "; ".join(
+                    f"{part} = 0: stages of sizes {', '.join(map(str, s[0]))}, bracket-matrix rank {s[3]}, free multipliers {', '.join(s[2]) or 'none'}"
+                    for part, s in structures.items()
+                )
+                raise AnalysisError(
+                    f"the stage-{split.stage} constraint {c} = 0 is the union of the branches {shown}, which do not meet but "
+                    f"on which the motion has different structure ({described}); analyse the branches separately "
+                    "(one system each, with the branch as its constraint)"
+                )
+            child = self._child({**self.choices, c: c})
+            child.run(max_stages)
+            notes.append(f"stage {split.stage}: the branches {shown} have the same structure; the union {c} = 0 is analysed as one surface")
+            survivors = [(c, child)]
+        adopted = survivors[0][1]
+        for f in fields(self):
+            setattr(self, f.name, getattr(adopted, f.name))
+        self._row_cache = adopted._row_cache
+        self.pivots = adopted.pivots
+        self.regularity_notes = [*adopted.regularity_notes, *notes]
+        return self
+
+    def _child(self, choices: dict[sympy.Expr, sympy.Expr]) -> ConstraintChain:
+        """A fresh chain on the same system that follows the given branches."""
+        return ConstraintChain(
+            self.phase_space, self.numerics, self.canonical_hamiltonian, list(self.primary), self.multipliers,
+            time=self.time, written=dict(self.written), holonomic=dict(self.holonomic), choices=choices,
+        )
+
+    def _structure(self) -> tuple[tuple[int, ...], int, tuple[str, ...], int]:
+        """Stage sizes, reducible count, free multipliers and bracket-matrix rank (to compare branches)."""
+        pb = self.phase_space.poisson_bracket
+        cs = self.constraints
+        C = self.numerics.evaluate([pb(a, b) for a in cs for b in cs], self.points).reshape(len(self.points), len(cs), len(cs)) if cs else np.zeros((1, 0, 0))
+        rank = max(numeric_rank(m) for m in C)
+        return tuple(len(s) for s in self.stages), len(self.reducible), tuple(sorted(u.name for u in self.undetermined)), rank
+
+    def _settle(self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], limit: int) -> tuple[list[sympy.Expr], list[int]]:
+        """Check new conditions for inconsistency and keep the independent ones (indices into ``candidates``)."""
+        if not candidates:
+            return [], []
+        nsym = set(self.phase_space.variables)
+        for c in candidates:
+            if not (c.free_symbols & nsym):
+                raise InconsistentSystemError(
+                    f"the consistency conditions of the constraints demand {c} = 0, which cannot hold "
+                    f"(stage {len(self.stages) + 1}): the Lagrangian has no consistent motion"
+                )
+        if len(self.stages) >= limit:
+            raise AnalysisError(f"the constraint chain did not terminate after {limit} stages")
+        for _ in range(2):
+            new_points = self._new_points(constraints, candidates)
+            chosen = self._independent(candidates, constraints, new_points)
+            irregular = self._irregular(candidates, chosen, constraints, new_points)
+            if not irregular:
+                return candidates, chosen
+            candidates = [self._regularised(c) if i in irregular else c for i, c in enumerate(candidates)]
+        raise AnalysisError("the constraint chain could not regularise its new constraints")  # pragma: no cover
+
+    def _new_points(self, constraints: list[sympy.Expr], candidates: list[sympy.Expr]) -> list[np.ndarray]:
+        """Regular points of the old surface on which the candidates vanish too."""
+        try:
+            return self.numerics.surface_points(constraints + self.reducible + candidates, SAMPLE_POINTS, regular=len(constraints))
+        except SingularSurface:
+            raise
+        except AnalysisError:
+            shown = "; ".join(f"{c} = 0" for c in candidates[:4])
+            raise InconsistentSystemError(
+                f"the stage-{len(self.stages) + 1} conditions {shown} have no real solution together with "
+                "the earlier constraints: the Lagrangian has no consistent motion"
+            ) from None
+
+    # ------------------------------------------------------------------ regularity
+    def _regularised(self, constraint: sympy.Expr) -> sympy.Expr:
+        """``f`` for a constraint ``f^k`` (``k > 1``): the same surface, with a gradient that does not vanish on it.
+
+        Henneaux–Teitelboim, Sect. 1.1.2 (regularity conditions) and Sect. 1.2.2 (Cawley's
+        ``z^2 = 0``, regular as ``z = 0``). The replacement is recorded in
+        :attr:`regularity_notes`. Called for a constraint found irregular at surface points.
+
+        Raises
+        ------
+        AnalysisError
+            When the constraint has no repeated factor (e.g. ``x^2 + y^2 = 0``): no
+            regular form is known, the analysis is refused.
+        """
+        part = square_free_part(constraint, self.phase_space.variables)
+        if part is None:
+            raise AnalysisError(
+                f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: its gradient vanishes "
+                "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
+                "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
+                "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)" + branch_hint(self.constraints, self.phase_space.variables)
+            )
+        self._refuse_crossing(part, self.constraints)
+        regular = tidy(part, self.phase_space.variables, sign=True)
+        parts = factors(regular, self.phase_space.variables, MAX_FACTOR_TERMS)
+        if constraint in self.holonomic:
+            raise AnalysisError(
+                f"constraint {self.holonomic[constraint]} ({constraint} = 0) is irregular: its gradient vanishes where it "
+                f"holds, so its multiplier cannot enforce it; write it as its square-free part {regular} = 0 (the same "
+                "surface, described regularly)"
+            )
+        self.regularity_notes.append(
+            f"stage {len(self.stages) + 1}: the constraint {constraint} = 0 is irregular (its gradient vanishes where it "
+            f"holds); it was replaced by its square-free part {regular} = 0, the same surface described regularly; "
+            "the classes and counts below refer to this regular form (with the irregular form, first-class "
+            "constraints need not all generate gauge transformations, as in Cawley's example)"
+        )
+        return self._branch(regular, parts)
+
+    def _refuse_crossing(self, constraint: sympy.Expr, constraints: list[sympy.Expr], shown_as: sympy.Expr | None = None) -> None:
+        """Refuse a product ``f g = 0`` whose branches meet on the surface (no single regular surface there).
+
+        ``shown_as`` is the constraint as the chain met it (expanded), when ``constraint`` is its product form.
+        """
+        parts = branches(constraint, self.phase_space.variables)
+        name = constraint if shown_as is None else shown_as
+        holonomic = self.holonomic.get(name)
+        if len(parts) < 2:
+            return
+        for i in range(len(parts)):
+            for j in range(i + 1, len(parts)):
+                try:
+                    self.numerics.surface_points(constraints + self.reducible + [parts[i], parts[j]], 1, attempts=8)
+                except AnalysisError:
+                    continue  # these branches do not meet: the product is regular where it holds
+                shown = " and ".join(f"{f} = 0" for f in parts)
+                where = f"constraint {holonomic} ({name} = 0)" if holonomic else f"the stage-{len(self.stages) + 1} constraint {name} = 0"
+                raise AnalysisError(
+                    f"{where} is irregular: it is the union of the "
+                    f"branches {shown}, which meet (where {parts[i]} = {parts[j]} = 0 its gradient vanishes), so there "
+                    f"is no single regular constraint surface; analyse the branches {shown} separately "
+                    "(one system each" + (", with the branch as its constraint)" if holonomic else ")")
+                )
+
+    def _irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
+        """New constraints whose gradient is numerically zero where they hold (normal to the others' gradients).
+
+        A kept constraint is compared with the old ones, a dropped one with the old and the
+        kept ones. A component below ``IRREGULAR_GRADIENT`` (relative to the size of the
+        gradient's terms) at every point, yet above round-off, marks a gradient that
+        vanishes on the surface: ``f^2 = 0`` or ``x^2 + y^2 = 0``.
+        """
+        n = len(self.phase_space.variables)
+        everything = old + self.reducible + [candidates[i] for i in chosen]
+        grads = [g for c in everything for g in self.phase_space.gradient(c)]
+        stacked = self.numerics.evaluate(grads, points).reshape(len(points), len(everything), n)
+        n_old = len(old) + len(self.reducible)
+        found = []
+        for i, c in enumerate(candidates):
+            grad = self.phase_space.gradient(c)
+            rows = self.numerics.evaluate(grad, points)
+            base = stacked[:, :n_old] if i in chosen else stacked
+            rough = [normal_components(rows[p : p + 1], base[p], np.ones(1) + np.max(np.abs(base[p]), initial=0.0))[0] for p in range(len(points))]
+            if max(rough) > 1e-2:  # clearly regular: skip the finer test
+                continue
+            scales = self.numerics.term_scale(grad, points).sum(axis=1) - (n - 1)  # 1 + sum of |terms| of the gradient
+            sizes = np.array([normal_components(rows[p : p + 1], base[p], scales[p : p + 1])[0] for p in range(len(points))])
+            if np.all(sizes < IRREGULAR_GRADIENT) and np.any(sizes > ROUND_OFF):
+                found.append(i)
+        return found
+
+    def _check_consistent_rank(self, A_num: np.ndarray, rows: list[int]) -> None:
+        """The pivot rows of ``A_ak = {Phi_a, phi_k}`` must be independent at every sample point.
+
+        They were chosen by majority; a point where their rank is lower lies on a part of
+        the surface with another structure (the rank is never taken from some points
+        only). Refused, naming a constraint that factors into branches when there is one.
+        """
+        ranks = []
+        for A in A_num:
+            block = A[rows]
+            scale = np.max(np.abs(block)) or 1.0
+            ranks.append(numeric_rank(block / scale))
+        if len(set(ranks)) == 1 and ranks[0] == len(rows):
+            return
+        cause = branch_hint(self.constraints, self.phase_space.variables)
+        raise AnalysisError(
+            "the rank of the consistency matrix {Phi_a, phi_k} that fixes the multipliers differs between regular "
+            f"points of the constraint surface ({', '.join(map(str, ranks))} for {len(rows)} pivot rows): the surface "
+            f"has parts of different structure{cause or '; analyse each part as a system of its own'}"
+        )
+
+    def _keep_reducible(self, candidates: list[sympy.Expr], chosen: list[int]) -> None:
+        """Keep the new constraints left out as dependent: they still define the surface (reducible set)."""
+        dropped = [c for i, c in enumerate(candidates) if i not in chosen]
+        if not dropped:
+            return
+        self.reducible.extend(dropped)
+        self.regularity_notes.append(
+            f"stage {len(self.stages)}: the constraints {', '.join(str(c) for c in candidates)} are reducible: on the "
+            f"regular part of their surface {', '.join(str(c) for c in dropped)} depend(s) on the others "
+            f"(independent set kept: {', '.join(str(candidates[i]) for i in chosen)}); the dependent ones still "
+            "define the surface and every sample point satisfies them"
+        )
+
+    def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> list[int]:
+        """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by."""
+        if not P:
+            return []
+        coeff = np.array([np.linalg.lstsq(A[np.ix_(P, Q)].T, A[row, Q], rcond=None)[0] for A in A_num])
+        scale = 1 + np.max(np.abs(coeff), axis=1, keepdims=True)
+        return [k for k, p in enumerate(P) if not b_zero[p] and not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
+
+    def _independent(self, candidates: list[sympy.Expr], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
+        n = len(self.phase_space.variables)
+        grads = [g for c in candidates for g in self.phase_space.gradient(c)]
+        cand = self.numerics.evaluate(grads, points).reshape(len(points), len(candidates), n)
+        if old:
+            og = [g for c in old for g in self.phase_space.gradient(c)]
+            base = list(self.numerics.evaluate(og, points).reshape(len(points), len(old), n))
+        else:
+            base = None
+        return independent_rows(list(cand), list(range(len(candidates))), base=base)
+
+    def _eliminate(self, row, needed, constraints, P, Q, A_num):
+        """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows ``needed``."""
+        b_row = self._rows(constraints[row])[0]
+        A_sym = sympy.Matrix([[self._rows(constraints[p])[1][k] for k in Q] for p in P])
+        rhs = sympy.Matrix([self._rows(constraints[row])[1][k] for k in Q])
+        c = weak_solve(A_sym.T, rhs, [A[np.ix_(P, Q)].T for A in A_num], [A[row, Q].reshape(-1, 1) for A in A_num], variables=self.phase_space.variables)
+        return b_row - sum((c[k, 0] * self._rows(constraints[P[k]])[0] for k in needed), sympy.S.Zero)
+
+    def _solve_multipliers(self, points, P, Q) -> None:
+        """Solve ``b_P + A_PQ u_Q = 0`` for the determined multipliers ((214)-(215) ff.).
+
+        Also the general solution ``u = U + v_a V_a`` (:attr:`multiplier_solution`, see
+        :mod:`dirac.analysis.classes.multiplier_solution`); a multiplier counts as determined when
+        it is fixed alone.
+        """
+        K = len(self.primary)
+        constraints = self.constraints
+        taken = [s.name for s in (*self.phase_space.variables, *self.phase_space.parameters)]
+        self.multiplier_solution = unsolved_multipliers(self.multipliers, self.primary, self.canonical_hamiltonian, taken)
+        if not K:
+            return
+        if not constraints or not P:
+            self.undetermined = list(self.multipliers)
+            return
+        b_num, A_num = self._numeric_rows(constraints, points)
+        determined = []
+        for k in range(K):
+            e = np.zeros(K)
+            e[k] = 1.0
+            votes = 0
+            for A in A_num:
+                M = A[P]
+                s = np.max(np.abs(M)) or 1.0
+                votes += numeric_rank(np.vstack([M, e * s]) / s) == numeric_rank(M / s)
+            if 2 * votes > len(A_num):
+                determined.append(k)
+        self.undetermined = [self.multipliers[k] for k in range(K) if k not in determined]
+        order = determined + [k for k in range(K) if k not in determined]
+        self.multiplier_solution = general_multiplier_solution(
+            self.multipliers,
+            self.primary,
+            self.canonical_hamiltonian,
+            sympy.Matrix([self._rows(constraints[p])[1] for p in P]),
+            sympy.Matrix([self._rows(constraints[p])[0] for p in P]),
+            [A[P] for A in A_num],
+            [b[P] for b in b_num],
+            order,
+            self.phase_space.variables,
+            taken,
+        )
+        for k in determined:
+            name = self.multipliers[k].name
+            self.solved_multipliers[name] = self.multiplier_solution.particular[name]

@@ -1,0 +1,200 @@
+"""The general solution of the consistency conditions for the multipliers of ``H_T``.
+
+At the end of the Dirac–Bergmann chain the time derivatives of all constraints vanish
+weakly when the multipliers ``u_k`` of the primary constraints ``phi_k`` satisfy
+
+    b_a + A_ak u_k ≈ 0,      b_a = {Phi_a, H_c},  A_ak = {Phi_a, phi_k}      ((214)-(215)).
+
+Their general solution is (Dirac, "Lectures on quantum mechanics", Lecture 1;
+Henneaux–Teitelboim Sect. 1.2.2)
+
+    u_k = U_k + v_a V_ak,
+
+``U`` one particular solution, ``V_a`` a basis of the null space of ``A`` on the
+surface and ``v_a`` arbitrary: the total Hamiltonian is
+
+    H_T = H' + v_a phi_a,      H' = H_c + U_k phi_k,      phi_a = V_ak phi_k,
+
+with ``phi_a`` the first-class combinations of the primary constraints. A single
+``u_k`` is *fixed alone* exactly when every ``V_a`` has a zero ``k`` component; when two
+primary constraints coincide only their sum of multipliers is fixed and neither alone.
+
+The rank of ``A`` is decided numerically at the chain's surface points; a set ``Q`` of
+columns with ``A_PQ`` invertible on the surface (``P`` the independent rows) is chosen,
+preferring multipliers that are fixed alone. Then ``U_Q = -A_PQ^{-1} b_P`` and
+``U_k = 0`` off ``Q``; for each ``j`` not in ``Q``, ``V_j = e_j - A_PQ^{-1} A_Pj`` (the ``j``
+component is 1). Both are exact expressions, solved weakly on the surface by
+:func:`~dirac.analysis.core.linear_solve.weak_solve`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy
+
+from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.linear_solve import weak_solve
+from dirac.analysis.core.numeric import independent_rows
+
+__all__ = ["MultiplierSolution", "general_multiplier_solution", "unsolved_multipliers"]
+
+
+@dataclass
+class MultiplierSolution:
+    """``u = U + v_a V_a``: the general solution of ``b + A u ≈ 0`` (Henneaux–Teitelboim (1.32)).
+
+    Attributes
+    ----------
+    multipliers
+        The multipliers ``u_k`` of the primary constraints, in order.
+    primary
+        The primary constraints ``phi_k`` they multiply.
+    canonical_hamiltonian
+        ``H_c``.
+    particular
+        ``U``: multiplier name -> expression (``0`` for the multipliers set to zero).
+    null_vectors
+        The ``V_a``: one dict multiplier name -> component per free parameter.
+    free
+        The free parameters ``v_1, v_2, ...`` (one per null vector).
+    """
+
+    multipliers: tuple[sympy.Symbol, ...]
+    primary: list[sympy.Expr]
+    canonical_hamiltonian: sympy.Expr
+    particular: dict[str, sympy.Expr]
+    null_vectors: list[dict[str, sympy.Expr]]
+    free: tuple[sympy.Symbol, ...] = field(default_factory=tuple)
+
+    @property
+    def first_class_primary(self) -> list[sympy.Expr]:
+        """``phi_a = V_ak phi_k``: the first-class combinations of the primary constraints."""
+        return [
+            sympy.expand(sum((vec[u.name] * phi for u, phi in zip(self.multipliers, self.primary)), sympy.S.Zero))
+            for vec in self.null_vectors
+        ]
+
+    @property
+    def general(self) -> dict[str, sympy.Expr]:
+        """``u_k = U_k + v_a V_ak`` for every multiplier (name -> expression in the ``v_a``)."""
+        return {
+            u.name: self.particular[u.name] + sum((v * vec[u.name] for v, vec in zip(self.free, self.null_vectors)), sympy.S.Zero)
+            for u in self.multipliers
+        }
+
+    @property
+    def first_class_hamiltonian(self) -> sympy.Expr:
+        """``H' = H_c + U_k phi_k``, first class on the surface."""
+        return self.canonical_hamiltonian + sum(
+            (self.particular[u.name] * phi for u, phi in zip(self.multipliers, self.primary)), sympy.S.Zero
+        )
+
+    @property
+    def total_hamiltonian(self) -> sympy.Expr:
+        """``H_T = H' + v_a phi_a``: the total Hamiltonian that keeps the motion on the surface."""
+        return self.first_class_hamiltonian + sum(
+            (v * phi for v, phi in zip(self.free, self.first_class_primary)), sympy.S.Zero
+        )
+
+    @property
+    def fixed_alone(self) -> list[sympy.Symbol]:
+        """The ``u_k`` with a zero component in every null vector (determined by themselves)."""
+        return [u for u in self.multipliers if all(vec[u.name] == 0 for vec in self.null_vectors)]
+
+    @property
+    def each_fixed_or_free(self) -> bool:
+        """True when every ``u_k`` is either fixed alone or entirely free (``V_a = e_k``, ``U_k = 0``).
+
+        Then ``H_T = H_c + u_k phi_k`` with the fixed ``u_k`` substituted and the others
+        arbitrary is already the general form.
+        """
+        units = 0
+        for vec in self.null_vectors:
+            nonzero = [name for name, value in vec.items() if value != 0]
+            if len(nonzero) != 1 or vec[nonzero[0]] != 1 or self.particular[nonzero[0]] != 0:
+                return False
+            units += 1
+        return units == len(self.null_vectors)
+
+
+def free_parameters(count: int, taken: Sequence[str]) -> tuple[sympy.Symbol, ...]:
+    """``v_1, ..., v_count`` (``v_free_1, ...`` when a variable or parameter is already named ``v_k``)."""
+    base = "v"
+    while any(f"{base}_{a + 1}" in taken for a in range(count)):
+        base += "_free"
+    return tuple(sympy.Symbol(f"{base}_{a + 1}", real=True) for a in range(count))
+
+
+def unsolved_multipliers(
+    multipliers: tuple[sympy.Symbol, ...], primary: list[sympy.Expr], canonical_hamiltonian: sympy.Expr, taken: Sequence[str]
+) -> MultiplierSolution:
+    """The solution when no consistency condition involves a multiplier: ``U = 0``, ``V_a = e_a``."""
+    names = [u.name for u in multipliers]
+    return MultiplierSolution(
+        multipliers,
+        list(primary),
+        canonical_hamiltonian,
+        {name: sympy.S.Zero for name in names},
+        [{other: (sympy.S.One if other == name else sympy.S.Zero) for other in names} for name in names],
+        free_parameters(len(names), taken),
+    )
+
+
+def general_multiplier_solution(
+    multipliers: tuple[sympy.Symbol, ...],
+    primary: list[sympy.Expr],
+    canonical_hamiltonian: sympy.Expr,
+    a_rows: sympy.Matrix,
+    b_rows: sympy.Matrix,
+    a_num: Sequence[np.ndarray],
+    b_num: Sequence[np.ndarray],
+    order: Sequence[int],
+    variables: Sequence[sympy.Symbol],
+    taken: Sequence[str],
+) -> MultiplierSolution:
+    """Solve ``b_P + A_P u ≈ 0`` in general form ``u = U + v_a V_a``.
+
+    Parameters
+    ----------
+    multipliers, primary, canonical_hamiltonian
+        The ``u_k``, the ``phi_k`` and ``H_c``.
+    a_rows, b_rows
+        ``A_P`` (``|P| x K``) and ``b_P`` (``|P| x 1``): the rows of the consistency
+        conditions that are independent on the surface.
+    a_num, b_num
+        The same at the surface points (one ``|P| x K`` and one ``|P|`` array per point).
+    order
+        Multiplier indices in order of preference for the pivot columns ``Q`` (those
+        fixed alone first, so that their ``U_k`` is their unique value).
+    variables
+        Phase-space variables (for readable normal forms).
+    taken
+        Names already in use (variables, parameters): the free ``v_a`` avoid them.
+    """
+    K = len(multipliers)
+    names = [u.name for u in multipliers]
+    A_num = [np.asarray(A, dtype=float).reshape(-1, K) for A in a_num]
+    B_num = [np.asarray(b, dtype=float).reshape(-1, 1) for b in b_num]
+    Q = independent_rows([A.T for A in A_num], list(order))
+    F = [k for k in range(K) if k not in Q]
+    A_PQ = a_rows[:, Q]
+    A_num_Q = [A[:, Q] for A in A_num]
+    particular = {name: sympy.S.Zero for name in names}
+    sol = weak_solve(A_PQ, -b_rows, A_num_Q, [-b for b in B_num], variables=variables)
+    for r, k in enumerate(Q):
+        particular[names[k]] = sol[r, 0]
+    null_vectors: list[dict[str, sympy.Expr]] = []
+    if F:
+        N = weak_solve(A_PQ, -a_rows[:, F], A_num_Q, [-A[:, F] for A in A_num], variables=variables)
+        for c, j in enumerate(F):
+            vec = {name: sympy.S.Zero for name in names}
+            vec[names[j]] = sympy.S.One
+            for r, k in enumerate(Q):
+                vec[names[k]] = tidy(N[r, c], variables) if N[r, c] != 0 else sympy.S.Zero
+            null_vectors.append(vec)
+    return MultiplierSolution(
+        multipliers, list(primary), canonical_hamiltonian, particular, null_vectors, free_parameters(len(F), taken)
+    )

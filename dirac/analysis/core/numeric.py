@@ -1,0 +1,352 @@
+"""Numerical decisions of the symbolic engine: points on constraint surfaces, weak zeros, ranks.
+
+The Dirac–Bergmann algorithm keeps its expressions exact, but deciding whether an
+expression vanishes *weakly* (on the surface of the constraints found so far), whether
+constraints are independent, and what rank a bracket matrix has on the surface is done
+numerically at several random points of that surface (probabilistic identity testing):
+an expression that vanishes at independent random points of an irreducible surface
+vanishes on it, up to an event of probability zero. Points are found by Gauss–Newton
+projection (minimum-norm steps) of random points, with compiled residuals and
+Jacobians; with ``regular=k`` only regular points are kept (the first ``k``
+constraints' gradients independent there), so that no rank is read at a crossing or
+another singular point. Parameters that are still symbolic take generic random values
+for these decisions, so the answers hold for generic parameters (the values where
+they do not are found by :mod:`dirac.analysis.chain.special_values`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import sympy
+
+from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.codegen import UnsupportedExpression, array_function, scalar_function
+from dirac.errors import AnalysisError
+
+__all__ = ["Numerics", "SingularSurface", "numeric_rank", "independent_rows"]
+
+#: relative size below which a value counts as zero
+ZERO_TOLERANCE = 1e-8
+#: residual (relative to the constraint's own term sizes) of a converged surface point
+SURFACE_TOLERANCE = 1e-11
+#: smallest singular value of the row-normalised constraint Jacobian at a regular point
+REGULAR_TOLERANCE = 1e-6
+#: a gradient smaller than this, relative to the size of its terms (``1 + sum |term|``), is
+#: vanishing: the point is on a singular locus (a crossing ``x^2 - y^2 = 0`` at the origin),
+#: however independent the row-normalised gradients look there (at a converged point next
+#: to such a locus the gradient is of the order of the square root of the residual, ~1e-6)
+SINGULAR_GRADIENT = 1e-4
+
+
+class SingularSurface(AnalysisError):
+    """Points of a constraint surface were found, but none is regular (irregular constraints)."""
+
+
+def numeric_rank(matrix: np.ndarray, tol: float = 1e-8, scale: float | None = None) -> int:
+    """Rank of ``matrix`` by SVD: the number of singular values ``s_i > tol * max(s_1, scale)``.
+
+    Parameters
+    ----------
+    matrix
+        The values.
+    tol
+        Relative cut.
+    scale
+        Size of the terms the entries were computed from (e.g. ``max`` of
+        :meth:`Numerics.term_scale` over the entries), before they cancelled. Without it
+        the cut is relative to the largest singular value ``s_1`` alone, so a matrix of
+        pure round-off (``1e-16`` left where exact terms cancelled) would count as rank
+        ``>= 1``; with it, such a matrix has rank 0 (Golub & Van Loan, *Matrix
+        Computations*, Sect. 5.4.1: numerical rank relative to the size of the data's errors).
+    """
+    if matrix.size == 0:
+        return 0
+    if not np.all(np.isfinite(matrix)):
+        raise AnalysisError(
+            "a rank was needed where the expressions are not finite (a denominator vanishes at a sample "
+            "point of the constraint surface): the analysis cannot decide it there"
+        )
+    s = np.linalg.svd(matrix, compute_uv=False)
+    if s[0] == 0 or not np.isfinite(s[0]):
+        return 0
+    return int(np.sum(s > tol * max(s[0], scale or 0.0)))
+
+
+def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base: Sequence[np.ndarray] | None = None) -> list[int]:
+    """Greedy choice of rows that raise the rank, in the given order of preference.
+
+    Parameters
+    ----------
+    matrices
+        The same symbolic matrix evaluated at several surface points.
+    order
+        Row indices in order of preference.
+    base
+        Rows already chosen (one block per point) that every candidate must be
+        independent of.
+
+    Returns
+    -------
+    list of int
+        Chosen row indices; a row is kept when it raises the rank at a majority of points.
+    """
+    chosen: list[int] = []
+    for row in order:
+        votes = 0
+        for k, m in enumerate(matrices):
+            stack = [m[chosen]] if chosen else []
+            if base is not None and len(base[k]):
+                stack.insert(0, base[k])
+            current = np.vstack(stack) if stack else np.zeros((0, m.shape[1]))
+            scale = (np.max(np.abs(m)) if m.size else 0.0) or 1.0  # an all-zero matrix has rank 0, not NaN
+            before = numeric_rank(current / scale) if len(current) else 0
+            after = numeric_rank(np.vstack([current, m[row : row + 1]]) / scale)
+            votes += after > before
+        if 2 * votes > len(matrices):
+            chosen.append(row)
+    return chosen
+
+
+class Numerics:
+    """Lambdified evaluation, surface points and weak-zero tests for one phase space.
+
+    Parameters
+    ----------
+    phase_space
+        The canonical phase space (its :attr:`~PhaseSpace.variables` order the vectors).
+    parameter_values
+        Numbers for the parameters that are still symbolic.
+    seed
+        Seed of the random points (results are reproducible).
+    time
+        The time ``t`` of an explicitly time-dependent system (``None`` otherwise). It is
+        sampled like a variable: every point carries its own random ``t`` as one extra
+        last component (after :attr:`~PhaseSpace.variables`), which surface projections
+        hold fixed (a point of the surface at that time).
+    """
+
+    def __init__(
+        self,
+        phase_space: PhaseSpace,
+        parameter_values: Mapping[sympy.Symbol, float],
+        seed: int = 20240607,
+        time: sympy.Symbol | None = None,
+    ):
+        self.phase_space = phase_space
+        self.time = time
+        self.parameters = tuple(phase_space.parameters)
+        self.parameter_vector = np.array([float(parameter_values[p]) for p in self.parameters], dtype=float)
+        self.rng = np.random.default_rng(seed)
+        self._index: dict[sympy.Expr, tuple[int, int]] = {}
+        self._batches: list[Callable] = []
+        self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
+
+    # ------------------------------------------------------------------ compiled functions
+    def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
+        """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""
+        exprs = [sympy.sympify(e) for e in exprs]
+        self._compile(exprs)
+        # (batch, index in it) of a compiled expression, (None, value) of a number
+        plan: list[tuple[int | None, Any]] = [(self._index[e] if not e.is_number else (None, float(e))) for e in exprs]
+        batches = sorted({b for b, _ in plan if b is not None})
+
+        def fn(z: np.ndarray) -> np.ndarray:
+            got = {b: self._call(b, z) for b in batches}
+            return np.array([got[b][i] if b is not None else i for b, i in plan], dtype=float)
+
+        return fn
+
+    def _compile(self, exprs: Sequence[sympy.Expr]) -> None:
+        missing = list(dict.fromkeys(e for e in exprs if not e.is_number and e not in self._index))
+        if not missing:
+            return
+        raw: Callable
+        try:
+            raw = scalar_function(self._args, missing)
+        except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
+            raw = array_function(self._args, missing)
+        batch = len(self._batches)
+        self._batches.append(raw)
+        for i, e in enumerate(missing):
+            self._index[e] = (batch, i)
+
+    def _call(self, batch: int, z: np.ndarray) -> list[float]:
+        with np.errstate(all="ignore"):
+            out = self._batches[batch](*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
+        return [complex(v).real if isinstance(v, complex) else float(v) for v in out]
+
+    def evaluate(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray] | np.ndarray) -> np.ndarray:
+        """Values of ``exprs`` at each point: array of shape ``(len(points), len(exprs))``."""
+        fn = self.function(exprs)
+        return np.array([fn(z) for z in points], dtype=float).reshape(len(points), len(exprs))
+
+    def term_scale(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
+        """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests)."""
+        terms: list[sympy.Expr] = []
+        owner: list[int] = []
+        for k, e in enumerate(exprs):
+            e = sympy.sympify(e)
+            parts = e.args if isinstance(e, sympy.Add) else (e,)
+            terms.extend(parts)
+            owner.extend([k] * len(parts))
+        values = np.abs(self.evaluate(terms, points)) if terms else np.zeros((len(points), 0))
+        scale = np.ones((len(points), len(exprs)))
+        for j, k in enumerate(owner):
+            scale[:, k] += values[:, j]
+        return scale
+
+    def weakly_zero(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
+        """Boolean mask: which expressions vanish at every given (surface) point.
+
+        A value counts as zero when it is below ``ZERO_TOLERANCE`` times the size of the
+        expression's terms there; values above ``1e-6`` count as non-zero at once.
+        """
+        exprs = [sympy.sympify(e) for e in exprs]
+        mask = np.array([e == 0 for e in exprs], dtype=bool)
+        rest = [k for k, e in enumerate(exprs) if e != 0]
+        if rest and len(points):
+            values = self.evaluate([exprs[k] for k in rest], points)
+            finite = np.all(np.isfinite(values), axis=0)
+            big = np.any(np.abs(values) > 1e-6, axis=0) | ~finite
+            unclear = [j for j in range(len(rest)) if not big[j]]
+            if unclear:
+                sub = [exprs[rest[j]] for j in unclear]
+                scale = self.term_scale(sub, points)
+                small = np.all(np.abs(values[:, unclear]) <= ZERO_TOLERANCE * scale, axis=0)
+                for j, flag in zip(unclear, small):
+                    mask[rest[j]] = bool(flag)
+        return mask
+
+    # ------------------------------------------------------------------ surface points
+    @staticmethod
+    def _regular_point(jacobian: np.ndarray) -> bool:
+        """Whether the rows of ``jacobian`` (constraint gradients at a point) are independent.
+
+        Each row is scaled to unit length (constraints may be multiplied by any non-zero
+        function), then the smallest singular value must exceed ``REGULAR_TOLERANCE``.
+        """
+        if not np.all(np.isfinite(jacobian)):
+            return False
+        norms = np.linalg.norm(jacobian, axis=1)
+        if np.any(norms == 0):
+            return False
+        s = np.linalg.svd(jacobian / norms[:, None], compute_uv=False)
+        return bool(s[-1] > REGULAR_TOLERANCE) if len(s) == jacobian.shape[0] else False
+
+    def _vanishing_gradient(self, gradients: Sequence[sympy.Expr], jacobian: np.ndarray, z: np.ndarray) -> bool:
+        """Whether a constraint's gradient (a row of ``jacobian``) is vanishing at ``z`` relative to its terms.
+
+        Row normalisation in :meth:`_regular_point` hides a gradient that is small only
+        because the point lies next to where it vanishes; here each row's length is
+        compared with ``1 + sum |term|`` of its entries (``gradients``, flattened row by
+        row), below ``SINGULAR_GRADIENT`` the point is singular (Henneaux–Teitelboim,
+        Sect. 1.1.2: regular points have non-vanishing independent gradients).
+        """
+        k, n = jacobian.shape
+        scales = self.term_scale(gradients, [z])[0].reshape(k, n)
+        sizes = np.linalg.norm(jacobian, axis=1) / (1.0 + np.sum(scales - 1.0, axis=1))
+        return bool(np.any(sizes < SINGULAR_GRADIENT))
+
+    def random_point(self) -> np.ndarray:
+        """A random phase-space point with components of size 0.5-1.5 and random signs (and a time ``t``)."""
+        n = len(self.phase_space.variables) + (self.time is not None)
+        return self.rng.uniform(0.5, 1.5, n) * self.rng.choice([-1.0, 1.0], n)
+
+    def surface_points(
+        self,
+        constraints: Sequence[sympy.Expr],
+        count: int,
+        fixed: Mapping[int, float] | None = None,
+        attempts: int = 40,
+        start: np.ndarray | None = None,
+        regular: int = 0,
+    ) -> list[np.ndarray]:
+        """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
+
+        Parameters
+        ----------
+        constraints
+            Expressions in the phase-space variables (and symbolic parameters).
+        count
+            Number of points wanted.
+        fixed
+            Variable index -> value held fixed; the other variables are solved for.
+        attempts
+            Random restarts allowed in total before giving up.
+        start
+            First starting point (random ones follow).
+        regular
+            The first ``regular`` constraints must have independent gradients at each point
+            returned (a full-rank Jacobian, the regularity condition of Henneaux–Teitelboim,
+            Sect. 1.1.2): points where they do not (crossings, singular points) are dropped
+            and others sampled, so that no decision is taken at a singular point.
+
+        Raises
+        ------
+        AnalysisError
+            If no point is found: the surface may be empty (no real solution), or it has
+            no regular point (its constraints are irregular).
+        """
+        constraints = [sympy.sympify(c) for c in constraints]
+        residual = self.function(constraints)
+        grads = [self.phase_space.gradient(c) for c in constraints]
+        flat = [g for row in grads for g in row]
+        jac_fn = self.function(flat)
+        n = len(self.phase_space.variables)
+        m = len(constraints)
+        fixed = dict(fixed or {})
+        free = np.array([i for i in range(n) if i not in fixed], dtype=int)
+        points: list[np.ndarray] = []
+        tries = 0
+        singular = 0
+        while len(points) < count and tries < attempts:
+            tries += 1
+            z = start.copy() if (start is not None and tries == 1) else self.random_point()
+            for i, v in fixed.items():
+                z[i] = v
+            if m == 0:
+                points.append(z)
+                continue
+            ok = False
+            for _ in range(60):
+                r = residual(z)
+                if not np.all(np.isfinite(r)):
+                    break
+                size = self.term_scale(constraints, [z])[0] if np.max(np.abs(r)) < 1e-6 else None
+                if size is not None and np.all(np.abs(r) <= SURFACE_TOLERANCE * size):
+                    ok = True
+                    break
+                jac = jac_fn(z).reshape(m, n)[:, free]
+                if not np.all(np.isfinite(jac)):
+                    break
+                step = np.linalg.lstsq(jac, -r, rcond=1e-12)[0]
+                norm = np.linalg.norm(step)
+                if norm > 10.0:  # keep steps bounded far from the surface
+                    step *= 10.0 / norm
+                z = z.copy()
+                z[free] += step
+            if ok and regular and not self._regular_point(jac_fn(z).reshape(m, n)[:regular]):
+                singular += 1
+                continue
+            if ok and regular and self._vanishing_gradient(flat[: regular * n], jac_fn(z).reshape(m, n)[:regular], z):
+                singular += 1
+                continue
+            if ok:
+                points.append(z)
+        if len(points) < count:
+            names = "; ".join(str(c) for c in constraints[:6])
+            if singular:
+                raise SingularSurface(
+                    f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
+                    f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
+                    "(irregular constraints); write the surface with constraints whose gradients are independent on it"
+                )
+            raise AnalysisError(
+                f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
+                "after many random starts: the constraints may have no real solution for these parameters"
+            )
+        return points
+

@@ -1,0 +1,1 @@
+"""Step 5: gauge generators (Castellani) and gauge fixing."""

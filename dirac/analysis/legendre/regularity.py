@@ -1,0 +1,288 @@
+"""Regular constraints: square-free parts, crossing branches, irregular gradients.
+
+The Dirac–Bergmann algorithm assumes *regular* constraints: on the surface
+``Phi = 0`` the gradients ``dPhi_a`` of an independent set are linearly independent
+(Henneaux–Teitelboim, Sect. 1.1.2, the "regularity conditions"). Two ways to fail:
+
+* a constraint with a repeated factor, ``f^k = 0`` with ``k > 1``: its gradient
+  ``k f^(k-1) df`` vanishes wherever it holds. The same surface is described regularly by
+  the square-free part ``f = 0`` (:func:`square_free_part`); Cawley's Lagrangian
+  ``x_dot z_dot + y z^2/2`` gives ``z^2 = 0``, regular as ``z = 0`` (Henneaux–Teitelboim,
+  Sect. 1.2.2);
+* a product of distinct factors ``f g = 0`` whose branches ``f = 0`` and ``g = 0`` meet:
+  at the crossing the gradient ``f dg + g df`` vanishes, and no single regular surface
+  contains both branches (:func:`branches`); each branch is a system of its own.
+
+Square-free parts are computed only for constraints found irregular at surface points
+(and for the holonomic constraints of the Lagrangian), since multivariate gcds cost more
+than the analysis on large constraints.
+
+Whether branches meet, and whether a gradient is numerically zero on a surface, is
+decided at surface points (:mod:`dirac.analysis.core.numeric`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+import sympy
+
+from dirac.model.lagrangian import Lagrangian
+
+__all__ = ["square_free_part", "branches", "factors", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
+
+#: polynomials with more terms than this are not factored (the cost grows fast); their
+#: regularity is still checked numerically at surface points
+MAX_FACTOR_TERMS = 60
+
+
+
+#: a new constraint whose gradient, relative to the size of the gradient's terms, has a
+#: component normal to the earlier constraints' gradients below this at every surface
+#: point (but above round-off) is irregular: its gradient vanishes where it holds (at a
+#: converged point of ``f^2 = 0`` the gradient is of the order of the square root of the
+#: residual tolerance, about 1e-6)
+IRREGULAR_GRADIENT = 1e-4
+
+#: normal components below this (relative) are round-off: the gradient is dependent
+ROUND_OFF = 1e-9
+
+
+def _polynomial(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sympy.Poly | None:
+    """``expr`` as a polynomial in the ``variables`` it contains (parameters in the coefficients), or None."""
+    present = [v for v in variables if v in expr.free_symbols]
+    if not present:
+        return None
+    terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
+    if terms > MAX_FACTOR_TERMS:
+        return None
+    try:
+        if not expr.is_polynomial(*present):
+            return None
+        return sympy.Poly(expr, *present)
+    except (sympy.PolynomialError, sympy.CoercionFailed, ValueError, TypeError):
+        return None
+
+
+def _never_zero(factor: sympy.Expr) -> bool:
+    """``factor`` has no real zero (``exp(-y)``, ``y**2 + 1``; all symbols are real): it is no branch."""
+    return bool(factor.is_positive or factor.is_negative)
+
+
+def square_free_part(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sympy.Expr | None:
+    """The square-free part of a constraint with a repeated factor, else ``None``.
+
+    For ``Phi = c f_1^k_1 ... f_r^k_r`` (``f_i`` distinct, non-constant in the phase-space
+    ``variables``, ``c`` free of them or without a real zero, like ``exp(-y)``) with some ``k_i > 1`` returns ``f_1 ... f_r``: the
+    same zero set, with a gradient that does not vanish on it identically (square-free
+    decomposition, Yun's algorithm, via :meth:`sympy.Poly.sqf_list`).
+    """
+    if isinstance(expr, sympy.Mul):  # factors that never vanish (exp(-y), y**2 + 1) do not shape the surface
+        expr = sympy.Mul(*[f for f in expr.args if not _never_zero(f)])
+    poly = _polynomial(expr, variables)
+    if poly is None:
+        return None
+    try:
+        _, factors = poly.sqf_list()
+    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+        return None
+    if all(k == 1 for _, k in factors):
+        return None
+    return sympy.Mul(*[f.as_expr() for f, _ in factors if f.total_degree() > 0])
+
+
+def branches(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
+    """Distinct factors of a constraint written as a product, that depend on the phase-space ``variables``.
+
+    One element (the constraint itself) unless ``expr`` is a product ``f g ...`` (powers
+    counted once) of at least two factors in the variables; its zero set is then the union
+    of the branches ``f = 0``, ``g = 0``, ... Only the written product structure is read
+    (multivariate factorisation of every constraint would cost more than the analysis);
+    a product hidden by expansion is caught by the regular-point and rank checks instead.
+    """
+    if not isinstance(expr, sympy.Mul):
+        return [expr]
+    found: list[sympy.Expr] = []
+    for arg in expr.args:
+        base = arg.base if isinstance(arg, sympy.Pow) and arg.exp.is_Integer and arg.exp > 0 else arg
+        if base.free_symbols & set(variables) and base not in found and not _never_zero(base):
+            found.append(base)
+    return found if len(found) > 1 else [expr]
+
+
+def _linear_with_constant_coefficient(poly: sympy.Poly) -> bool:
+    """Whether ``poly = c v + R`` for a generator ``v`` absent from ``R`` and ``c`` free of the generators.
+
+    Such a polynomial is irreducible: in a product ``A B`` one factor has degree 0 in ``v``
+    and divides ``c``, so it is a constant (``p_x + 3 x^2 - z``, most constraints met).
+    """
+    n = len(poly.gens)
+    for k, v in enumerate(poly.gens):
+        if poly.degree(v) == 1 and [m for m in poly.monoms() if m[k] == 1] == [tuple(int(j == k) for j in range(n))]:
+            return True
+    return False
+
+
+_PLANE = sympy.polys.rings.ring("s,t", sympy.QQ)[0]
+
+
+def _irreducible_on_a_plane(poly: sympy.Poly, seed: int = 20240607) -> bool:
+    """Whether ``poly`` is shown irreducible by its restriction to a random plane (cheap, one-sided).
+
+    Substitutes random integers for the parameters in the coefficients and
+    ``v_i = a_i + b_i s + c_i t`` (random integers) for the generators. A factorisation
+    ``f g`` restricts to ``f|g|`` with the same degrees on a plane along which the
+    polynomial keeps its total degree, so an irreducible restriction of full degree
+    proves ``poly`` irreducible (for generic parameters); the bivariate factorisation costs
+    ~1 ms where a multivariate one over a parameter field costs up to a second (Bertini;
+    Hilbert's irreducibility theorem makes a reducible restriction of an irreducible
+    polynomial improbable). ``False`` means "not shown": factor in full.
+    """
+    rng = np.random.default_rng(seed)
+    s, t = _PLANE.gens
+    images = [int(rng.integers(-9, 10)) + int(rng.integers(1, 10)) * s + int(rng.integers(-9, 10)) * t for _ in poly.gens]
+    expr = poly.as_expr()
+    params = sorted(expr.free_symbols - set(poly.gens), key=str)
+    total = _PLANE.zero
+    try:
+        if params:
+            expr = expr.subs({p: sympy.Integer(int(rng.integers(2, 14))) for p in params})
+        numeric = sympy.Poly(expr, *poly.gens, domain=sympy.QQ)
+        for monom, coeff in numeric.terms():
+            term = _PLANE(coeff)
+            for image, e in zip(images, monom):
+                if e:
+                    term *= image**e
+            total += term
+        if total.is_zero or max(sum(m) for m in total.monoms()) != poly.total_degree():
+            return False
+        _, found = total.factor_list()
+    except (ZeroDivisionError, sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, TypeError, ValueError):
+        return False
+    return len(found) == 1 and found[0][1] == 1
+
+
+def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int) -> list[sympy.Expr]:
+    """The distinct irreducible factors of a polynomial constraint that can vanish (the branches of ``expr = 0``).
+
+    ``[expr]`` when it is irreducible, not polynomial in the ``variables`` or has more than
+    ``max_terms`` terms. Multiplicities are dropped (the zero set of ``f^k g`` is that of
+    ``f g``), factors free of the variables or without a real zero are left out. A
+    polynomial linear in some variable with a coefficient free of the variables is
+    irreducible and is not factored (:func:`_linear_with_constant_coefficient`), nor is one
+    whose restriction to a random plane is irreducible (:func:`_irreducible_on_a_plane`);
+    the others go through multivariate factorisation (``sympy.factor_list``).
+    """
+    terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
+    if terms > max_terms:
+        return [expr]
+    poly = _polynomial(expr, variables)
+    if poly is None or poly.total_degree() < 2 or _linear_with_constant_coefficient(poly) or _irreducible_on_a_plane(poly):
+        return [expr]
+    try:
+        _, found = sympy.factor_list(poly.as_expr(), *poly.gens)
+    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+        return [expr]
+    parts = [f for f, _ in found if f.free_symbols & set(variables) and not _never_zero(f)]
+    return parts if len(parts) > 1 else [expr]
+
+
+def factored(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> list[tuple[sympy.Expr, list[sympy.Expr]]]:
+    """The constraints that factor into several branches, with their branches (for error messages).
+
+    Multivariate factorisation (``sympy.factor_list``) of each polynomial constraint of at
+    most ``MAX_FACTOR_TERMS`` terms: too costly for every constraint of every analysis,
+    used when a rank is found to differ between points of the surface, to name the cause.
+    """
+    found = []
+    for c in constraints:
+        poly = _polynomial(c, variables)
+        if poly is None:
+            continue
+        try:
+            _, factors = sympy.factor_list(poly.as_expr(), *poly.gens)
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            continue
+        parts = [f for f, _ in factors if f.free_symbols & set(variables)]
+        if len(parts) > 1:
+            found.append((c, parts))
+    return found
+
+
+def branch_hint(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> str:
+    """``"; the constraint ... is the union of the branches ...: analyse them separately ..."`` or ``""``.
+
+    For refusals caused by a surface whose parts differ (see :func:`factored`).
+    """
+    products = factored(constraints, variables)
+    if not products:
+        return ""
+    c, parts = products[0]
+    shown = " and ".join(f"{f} = 0" for f in parts)
+    return f"; the constraint {c} = 0 is the union of the branches {shown}: analyse them separately (one system each)"
+
+
+def normal_components(rows: np.ndarray, base: np.ndarray, scales: np.ndarray) -> np.ndarray:
+    """Size of each row's component normal to the span of ``base``, relative to ``scales``.
+
+    Parameters
+    ----------
+    rows
+        Gradients of new constraints at one point, shape ``(k, n)``.
+    base
+        Gradients of the earlier constraints at that point, shape ``(m, n)`` (``m`` may be 0).
+    scales
+        Size of each new gradient's terms at the point (``1 + sum |term|``), shape ``(k,)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``|(1 - P) row| / scale`` for each row, ``P`` the orthogonal projector onto the rows of ``base``.
+    """
+    if base.size:
+        q, r = np.linalg.qr(base.T)
+        keep = np.abs(np.diag(r)) > 1e-12 * (np.max(np.abs(r)) if r.size else 1.0)
+        q = q[:, keep]
+        normal = rows - (rows @ q) @ q.T
+    else:
+        normal = rows
+    return np.linalg.norm(normal, axis=1) / scales
+
+
+def _written_power(expr: sympy.Expr) -> bool:
+    """Whether ``expr`` is written as a power ``f**k`` (``k > 1``) or a product containing one."""
+    parts = expr.args if isinstance(expr, sympy.Mul) else (expr,)
+    return any(isinstance(a, sympy.Pow) and a.exp.is_Integer and a.exp > 1 and a.base.free_symbols for a in parts)
+
+
+def regular_holonomic(lagrangian: Lagrangian) -> tuple[Lagrangian, list[str]]:
+    """The Lagrangian with each holonomic constraint ``chi = f^k`` (``k > 1``) replaced by ``f``.
+
+    In ``L_ext = L - lambda chi`` (the paper's (1)) the constraint force is ``lambda dchi``;
+    for ``chi = f^2`` it vanishes on the surface, so the multiplier cannot hold the motion
+    there (the chain ends in a contradiction). Constraints written as such a power are
+    decomposed here (an expanded one is found irregular by the chain, which refuses it
+    and names its square-free part). The user means the surface ``f = 0``: the
+    square-free part describes it regularly (Henneaux–Teitelboim, Sect. 1.1.2). Returns the
+    new Lagrangian (the same one if nothing changed) and one note per replacement.
+    """
+    notes: list[str] = []
+    new: list[sympy.Expr] = []
+    for k, chi in enumerate(lagrangian.constraints, start=1):
+        part = square_free_part(chi, lagrangian.coordinates) if _written_power(chi) else None
+        if part is None:
+            new.append(chi)
+            continue
+        if part.could_extract_minus_sign():
+            part = -part
+        new.append(part)
+        notes.append(
+            f"constraint {k} ({chi} = 0) is irregular: its gradient vanishes where it holds, so its multiplier "
+            f"could not enforce it; it was replaced by its square-free part {part} = 0, the same surface "
+            "described regularly"
+        )
+    if not notes:
+        return lagrangian, []
+    return dataclasses.replace(lagrangian, constraints=tuple(new)), notes

@@ -1,0 +1,137 @@
+"""Constraints that are unions of branches: crossings refused, disjoint branches followed one by one.
+
+Each test states the hand derivation it checks (canonical bracket ``{q, p} = 1``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy
+from cli_output import one_error_line
+
+import dirac
+import dirac.analysis.chain.constraint_chain as constraint_chain
+from dirac.errors import AnalysisError, DiracError
+
+GRAVITY = "(x_dot**2 + y_dot**2)/2 - y"
+
+
+def test_two_crossing_lines_are_refused_naming_both_branches(run_cli, tmp_path):
+    """``x^2 - y^2 = 0`` is the union of the lines ``x - y = 0`` and ``x + y = 0``, which cross at
+    the origin, where the gradient ``(2x, -2y)`` vanishes. On either line alone the motion is
+    a bead on a straight wire under gravity (``p_lambda``, the line, the velocity along its
+    normal, the equation fixing ``lambda``: 4 second class, ``(6 - 4)/2 = 1`` degree of
+    freedom), but at the crossing the multiplier is free; the union has no single regular
+    surface, so the analysis is refused, naming both branches (written expanded: found by
+    factorisation, not from the written form)."""
+    L = dirac.Lagrangian.from_strings("cross", ["x", "y"], GRAVITY, ["x**2 - y**2"])
+    with pytest.raises(AnalysisError, match=r"constraint 1 \(x\*\*2 - y\*\*2 = 0\) is irregular") as caught:
+        dirac.analyze(L)
+    assert isinstance(caught.value, DiracError)
+    assert "x - y = 0" in str(caught.value) and "x + y = 0" in str(caught.value)
+    path = tmp_path / "cross.toml"
+    path.write_text('[system]\nname = "cross"\ncoordinates = ["x", "y"]\n'
+                    f'lagrangian = "{GRAVITY}"\nconstraints = ["x**2 - y**2"]\n')
+    status, out, err = run_cli("analyze", str(path))
+    line = one_error_line(status, err)
+    assert "x - y = 0" in line and "x + y = 0" in line and out == ""
+
+
+def test_either_line_alone_is_a_bead_on_a_wire():
+    """The branch ``x - y = 0`` by itself: the hand count of the test above (4 second class, 1)."""
+    a = dirac.analyze(dirac.Lagrangian.from_strings("line", ["x", "y"], GRAVITY, ["x - y"]))
+    assert [len(s) for s in a.stages] == [1, 1, 1, 1]
+    assert len(a.second_class) == 4 and a.first_class == [] and a.physical_degrees_of_freedom == 1
+
+
+def test_sample_points_stay_off_the_crossing_when_the_product_is_not_factored(monkeypatch):
+    """With factorisation switched off the chain meets ``x^2 - y^2`` as one constraint. Its
+    surface (with ``x p_x - y p_y`` and the ``lambda`` equation) contains the whole crossing
+    ``x = y = 0, p_x = +-p_y`` where the gradient of ``x^2 - y^2`` vanishes; Gauss-Newton
+    converges next to it (gradient ~1e-6, row-normalised it looks regular). Such points are
+    singular and dropped: every sample point has ``|x| = |y|`` well away from 0, and on the
+    lines the structure is the bead's (4 second class, 1 degree of freedom)."""
+    monkeypatch.setattr(constraint_chain, "FACTOR_TERMS", 0)
+    monkeypatch.setattr(constraint_chain, "MAX_FACTOR_TERMS", 0)
+    a = dirac.analyze(dirac.Lagrangian.from_strings("cross", ["x", "y"], GRAVITY, ["x**2 - y**2"]))
+    x, y = (a.phase_space.index(a.symbols[n]) for n in ("x", "y"))
+    for z in a._points:
+        assert abs(abs(z[x]) - abs(z[y])) < 1e-8 and abs(z[x]) > 1e-3
+    assert len(a.second_class) == 4 and a.physical_degrees_of_freedom == 1
+
+
+def test_expanded_product_of_two_crossing_planes_is_refused():
+    """``(w + x - 2z + 2)(2w + x + 2y + z - 4)`` written expanded (13 terms): two hyperplanes of
+    ``(w, x, y, z)`` with independent normals, which meet in a plane where the gradient of the
+    product vanishes; refused, naming both factors."""
+    w, x, y, z = sympy.symbols("w x y z")
+    chi = str(sympy.expand((w + x - 2 * z + 2) * (2 * w + x + 2 * y + z - 4)))
+    L = dirac.Lagrangian.from_strings(
+        "planes", ["w", "x", "y", "z"], "(w_dot**2 + x_dot**2 + y_dot**2 + z_dot**2)/2 - y", [chi]
+    )
+    with pytest.raises(AnalysisError, match=r"branches .*w \+ x - 2\*z \+ 2 = 0.* and .*2\*w \+ x \+ 2\*y \+ z - 4 = 0"):
+        dirac.analyze(L)
+
+
+FIRST_ORDER = "-3*x**2*x_dot - x*z**2/2 + x_dot*z - y**2*y_dot - 2*y*y_dot - y*z**2 + y*z*z_dot"
+
+
+def test_spurious_branch_without_motion_is_dropped():
+    """``L = a(q).q_dot - V`` with ``a = (z - 3x^2, -y^2 - 2y, y z)``, ``V = x z^2/2 + y z^2``.
+
+    Primary ``phi = p - a``; ``{phi_i, phi_j} = F_ij = d_i a_j - d_j a_i``: ``F_xy = 0``,
+    ``F_xz = -1``, ``F_yz = z``; ``{phi_i, H_c} = -d_i V = (-z^2/2, -z^2, -(x + 2y) z)``.
+    Consistency: the x row gives ``u_3 = -z^2/2``, the z row ``u_1 = z u_2 + (x + 2y) z``,
+    the y row ``-z^2 + z u_3 = -z^2 (1 + z/2) = 0``: ``z = 0`` or ``z = -2``. On ``z = -2``
+    the constraint's own consistency ``z_dot = u_3 = 0`` contradicts ``u_3 = -z^2/2 = -2``
+    (the Euler-Lagrange equation ``z_dot = -z^2/2``): no motion, the branch is dropped.
+    On ``z = 0``: ``u_3 = 0``, ``u_1 = 0``, ``u_2`` free, and the chain ends. Brackets of
+    ``(phi_1, phi_2, phi_3, z)`` on ``z = 0``: ``{phi_1, phi_3} = -1``, ``{phi_3, z} = -1``,
+    the rest 0: rank 2, so 2 second class, 2 first class (``phi_2`` and
+    ``phi_1 + z = p_x + 3x^2``), ``(6 - 2*2 - 2)/2 = 0`` degrees of freedom.
+    """
+    L = dirac.Lagrangian.from_strings("spur", ["x", "y", "z"], FIRST_ORDER)
+    a = dirac.analyze(L)
+    s = a.symbols
+    x, y, z, px, py, pz = (s[n] for n in ("x", "y", "z", "p_x", "p_y", "p_z"))
+    assert [len(stage) for stage in a.stages] == [3, 1]
+    assert a.stages[1] == [z]
+    expected = [px + 3 * x**2 - z, py + y**2 + 2 * y, pz - y * z]
+    assert all(any(sympy.expand(c - e) == 0 for c in a.stages[0]) for e in expected)
+    assert len(a.first_class) == 2 and len(a.second_class) == 2
+    assert a.bracket_matrix_rank == 2
+    assert a.physical_degrees_of_freedom == 0
+    assert [u.name for u in a.undetermined_multipliers] == ["u_2"]
+    assert sympy.expand(a.multipliers["u_1"].subs(z, 0)) == 0 and sympy.expand(a.multipliers["u_3"].subs(z, 0)) == 0
+    assert any("z + 2 = 0" in n and "dropped" in n for n in a.notes)
+    for seed in range(6):
+        assert abs(a.surface_point(seed=seed)["z"]) < 1e-8
+    iz = a.phase_space.index(z)
+    assert all(abs(p[iz]) < 1e-8 for p in a._points)
+
+
+def test_disjoint_branches_of_different_structure_are_refused():
+    """``L = x_dot z_dot + y z (z - 1) + x^2 z/2``: ``p_y = 0`` primary,
+    ``H_c = p_x p_z - y z (z - 1) - x^2 z/2``; ``{p_y, H_c} = z (z - 1)``, branches ``z = 0``
+    and ``z = 1``. Both have ``{z, H_T} = p_x``: ``p_x = 0``; then ``{p_x, H_T} = x z``: on
+    ``z = 0`` the chain ends (``p_y, z, p_x``, all first class, ``u`` free); on ``z = 1`` it
+    goes on with ``x``, ``p_z`` (``{x, H_T} = p_z``), ``y`` (``{p_z, H_T} = y (2z - 1) + x^2/2``),
+    ``y`` fixing ``u``: six second class. Two different systems: refused, naming both."""
+    L = dirac.Lagrangian.from_strings("two", ["x", "y", "z"], "x_dot*z_dot + y*z*(z - 1) + x**2*z/2")
+    with pytest.raises(AnalysisError, match=r"branches .*z - 1 = 0.*z = 0.*different structure") as caught:
+        dirac.analyze(L)
+    message = str(caught.value)
+    assert "stages of sizes 1, 1, 1, 1, 1, 1" in message and "stages of sizes 1, 1, 1," in message
+
+
+def test_disjoint_branches_of_the_same_structure_keep_the_union():
+    """``x^2 - 1 = 0`` written expanded: the walls ``x = 1`` and ``x = -1`` never meet, and on
+    each the motion is the bead's (4 second class, 1 degree of freedom): the union is one
+    regular surface, analysed as such, and sample points lie on it."""
+    a = dirac.analyze(dirac.Lagrangian.from_strings("walls", ["x", "y"], GRAVITY, ["x**2 - 1"]))
+    assert [len(st) for st in a.stages] == [1, 1, 1, 1]
+    assert len(a.second_class) == 4 and a.physical_degrees_of_freedom == 1
+    ix = a.phase_space.index(a.symbols["x"])
+    assert np.allclose(np.abs([p[ix] for p in a._points]), 1.0)
+    assert any("same structure" in n for n in a.notes)

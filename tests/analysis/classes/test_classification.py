@@ -1,0 +1,47 @@
+"""First-class combinations when C_ab is singular but no single constraint is first class."""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy
+
+from dirac.analysis.classes.classification import classify
+from dirac.analysis.core.numeric import Numerics
+from dirac.analysis.core.phase_space import PhaseSpace
+
+
+def test_first_class_combination_is_found():
+    q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2", real=True)
+    space = PhaseSpace((q1, q2), (p1, p2))
+    numerics = Numerics(space, {})
+    # {q1, p1} = 1, {q1, p1 + q2} = 1, {p1, p1 + q2} = 0: rank 2, and
+    # (p1 + q2) - p1 = q2 commutes with all three (hand).
+    constraints = [q1, p1, p1 + q2]
+    points = numerics.surface_points(constraints, 3)
+    result = classify(space, numerics, constraints, points)
+    assert result.rank == 2
+    assert len(result.second_class) == 2 and len(result.first_class) == 1
+    (combo,) = result.first_class
+    for c in constraints:
+        assert sympy.simplify(space.poisson_bracket(combo, c)) == 0
+    # the combination is q2 up to the second-class constraints and a factor
+    assert sympy.simplify(combo.subs({q1: 0, p1: 0})).free_symbols == {q2}
+
+
+def test_poisson_bracket_convention():
+    q, p = sympy.symbols("q p", real=True)
+    space = PhaseSpace((q,), (p,))
+    assert space.poisson_bracket(q, p) == 1
+    assert space.poisson_bracket(p, q) == -1
+    assert sympy.expand(space.poisson_bracket(q**2, p**2) - 4 * q * p) == 0
+
+
+def test_surface_points_lie_on_the_surface():
+    x, y, px, py = sympy.symbols("x y p_x p_y", real=True)
+    space = PhaseSpace((x, y), (px, py))
+    numerics = Numerics(space, {})
+    points = numerics.surface_points([x**2 + y**2 - 1, x * px + y * py], 4)
+    for z in points:
+        assert abs(z[0] ** 2 + z[1] ** 2 - 1) < 1e-12
+        assert abs(z[0] * z[2] + z[1] * z[3]) < 1e-12
+    assert len({tuple(np.round(z, 6)) for z in points}) == 4
