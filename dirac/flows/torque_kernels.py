@@ -28,16 +28,13 @@ source, so a torque compiles once per machine. The free kernels are untouched.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from types import ModuleType
-from typing import TYPE_CHECKING
 
 import sympy
 
 from dirac.codegen.kernel_source import emit_function
 from dirac.codegen.numba_backend import import_source
-
-if TYPE_CHECKING:
-    from dirac.flows.torques import Torque
 
 __all__ = ["torque_module", "torque_module_source"]
 
@@ -170,27 +167,33 @@ def split_advance(M, R, a, w, gammas, axes, rates, fractions, casimir_rate, with
 '''
 
 
-def torque_module_source(torque: Torque) -> str:
-    """The numba source of the kick and the two step loops of ``torque``.
+def torque_module_source(
+    expressions: Sequence[sympy.Expr],
+    momentum: Sequence[sympy.Symbol],
+    rates: Sequence[sympy.Symbol],
+    attitude: Sequence[sympy.Symbol],
+    time: sympy.Symbol,
+) -> str:
+    """The numba source of the kick and the two step loops of the torque ``expressions``
+    (``N_1, N_2, N_3`` in the symbols ``momentum`` ``M_i``, ``rates`` ``Omega_i``,
+    ``attitude`` ``R_ij`` row by row, and ``time``).
 
     ``torque(M, R, a, t, c, out)`` evaluates ``N`` with ``Omega_i = a_i M_i``
-    (``a = 1/I``); for a torque that depends on ``M`` or ``Omega``,
+    (``a = 1/I``); for a torque that depends on ``M`` or ``Omega`` (midpoint kick),
     ``jacobian(M, R, a, t, c, out)`` fills ``dN/dM`` (``Omega`` differentiated through
     ``a``).
     """
-    from dirac.flows.torques import TORQUE_SYMBOLS
-    from dirac.model.expressions import TIME
-
-    momentum = [TORQUE_SYMBOLS[f"M_{i}"] for i in (1, 2, 3)]
+    momentum = list(momentum)
     inverse = [sympy.Symbol(f"a_{i}", real=True) for i in (1, 2, 3)]
-    attitude = sympy.Matrix(3, 3, [TORQUE_SYMBOLS[f"R_{i}{j}"] for i in (1, 2, 3) for j in (1, 2, 3)])
-    rates = {TORQUE_SYMBOLS[f"Omega_{i}"]: inverse[i - 1] * momentum[i - 1] for i in (1, 2, 3)}
-    values = [expression.subs(rates) for expression in torque.expressions]
-    arrays = [("M", momentum), ("R", attitude), ("a", inverse)]
-    scalars = [("t", TIME)]
+    matrix = sympy.Matrix(3, 3, list(attitude))
+    values = [sympy.sympify(e).subs({rates[i]: inverse[i] * momentum[i] for i in range(3)}) for e in expressions]
+    used: set[sympy.Basic] = set().union(*(sympy.sympify(e).free_symbols for e in expressions))
+    depends_on_momentum = bool(used & {*momentum, *rates})
+    arrays = [("M", momentum), ("R", matrix), ("a", inverse)]
+    scalars = [("t", time)]
     parts = [_HEADER, "EMPTY = np.zeros(0)\n\n"]
     parts.append(emit_function("torque", "the torque N (body frame)", arrays, scalars, values, (3,)))
-    if torque.depends_on_momentum:
+    if depends_on_momentum:
         jacobian = sympy.Matrix(3, 3, lambda i, j: sympy.diff(values[i], momentum[j]))
         parts.append(emit_function("jacobian", "dN/dM (Omega = a M)", arrays, scalars, jacobian, (3, 3)))
         parts.append(_KICK_MIDPOINT)
@@ -200,6 +203,6 @@ def torque_module_source(torque: Torque) -> str:
     return "\n".join(parts)
 
 
-def torque_module(torque: Torque) -> ModuleType:
-    """Write, import and return the compiled module of :func:`torque_module_source`."""
-    return import_source(torque_module_source(torque))
+def torque_module(source: str) -> ModuleType:
+    """Write, import and return the compiled module of a :func:`torque_module_source`."""
+    return import_source(source)

@@ -30,6 +30,7 @@ import numpy as np
 import sympy
 
 from dirac.errors import InputError
+from dirac.flows.torque_kernels import torque_module, torque_module_source
 from dirac.model.expressions import ALLOWED_CONSTANTS, TIME, parse_expression
 from dirac.validate import unknown_name_error, validate_array, validate_finite
 
@@ -135,9 +136,7 @@ class Torque:
     @cached_property
     def kernels(self) -> ModuleType:
         """The compiled kick and step loops of this torque (:mod:`dirac.flows.torque_kernels`)."""
-        from dirac.flows.torque_kernels import torque_module
-
-        return torque_module(self)
+        return torque_module(torque_module_source(self.expressions, _MOMENTUM, _RATE, _ATTITUDE, TIME))
 
     @cached_property
     def _scalar(self):

@@ -254,8 +254,9 @@ def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None)
     run = _run_options(run_table, source)
     name = system.get("name")
     if name in SCENE_SYSTEMS:
-        problem: SceneProblem = _rigid_problem(str(name), system, initial, source)
-        _drive(problem, data, run["t_end"], source)
+        rigid = _rigid_problem(str(name), system, initial, source)
+        _drive(rigid, data, run["t_end"], source)
+        problem: SceneProblem = rigid
     else:
         for key in ("forces", "impulses"):
             if key in data:
