@@ -234,3 +234,34 @@ def test_bad_torques_are_refused(torque, match):
 def test_an_impulse_before_the_start_is_refused():
     with pytest.raises(InputError, match="before the start"):
         RigidBodyProblem(INERTIA, M0, impulses=[(-0.1, [1.0, 0.0, 0.0])])
+
+
+def test_a_midpoint_kick_that_does_not_converge_stops_the_run_with_a_message():
+    from dirac.errors import IntegrationError
+
+    with pytest.raises(IntegrationError, match="implicit midpoint kick of the torque did not converge in 1 Newton") as info:
+        integrate(_problem(DAMPED), "lie-poisson-2", t_end=1.0, dt=0.1, max_newton_iterations=1)
+    assert info.value.partial is not None and not info.value.partial.complete
+
+
+def test_impulses_on_a_torqued_body_agree_with_scipy_restarted_at_the_impulse():
+    """Impulse at t = 1.234 (off the grid of dt = 0.05) on the damped body: the kick
+    compositions against the independent DOP853 integration stopped there and restarted."""
+    jump = np.array([0.3, 0.0, -0.2])
+    problem = _problem(DAMPED, impulses=[(1.234, jump)])
+    M_a, R_a, W_a = _reference(_damped, 1.234)
+
+    def rhs(t, y):
+        M, R = y[:3], y[3:12].reshape(3, 3)
+        omega = M / INERTIA
+        N = _damped(M, R, t)
+        return np.concatenate([np.cross(M, omega) + N, (R @ _hat(omega)).ravel(), [N @ omega]])
+
+    energy = lambda M: 0.5 * np.sum(M * M / INERTIA)  # noqa: E731
+    y0 = np.concatenate([M_a + jump, R_a.ravel(), [W_a + energy(M_a + jump) - energy(M_a)]])
+    y = solve_ivp(rhs, (1.234, 3.0), y0, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
+    for method in ("exact-kick-6", "lie-poisson-6"):
+        solution = integrate(problem, method, t_end=3.0, dt=0.05, samples=2, outputs=["M", "R", "work"])
+        assert np.max(np.abs(solution.outputs["M"][-1] - y[:3])) < 1e-9, method
+        assert np.max(np.abs(solution.outputs["R"][-1] - y[3:12].reshape(3, 3))) < 1e-9, method
+        assert abs(solution.outputs["work"][-1] - y[12]) < 1e-9, method
