@@ -41,8 +41,19 @@ def _hat(w):
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
-def _reference(torque, t_end, inertia=INERTIA, M=M0, weight=None):
-    """Euler's equations with the torque, DOP853 at rtol = atol = 1e-13: M(t_end), R(t_end), W(t_end)."""
+_REFERENCES: dict = {}
+
+
+def _reference(torque, t_end, weight=None):
+    """Euler's equations with the torque, DOP853 at rtol = atol = 1e-13: M(t_end), R(t_end),
+    W(t_end) (computed once per torque, time and weight)."""
+    key = (torque.__name__, t_end, None if weight is None else tuple(weight))
+    if key not in _REFERENCES:
+        _REFERENCES[key] = _tight(torque, t_end, INERTIA, M0, weight)
+    return _REFERENCES[key]
+
+
+def _tight(torque, t_end, inertia, M, weight):
 
     def rhs(t, y):
         M, R = y[:3], y[3:12].reshape(3, 3)

@@ -17,8 +17,8 @@ Two families of ``F``:
     *exact* free flow of a Lagrange top ``I_1 = I_2``).
 With an external torque or angular impulses both families use the torque kicks of
 :mod:`dirac.flows.methods.torqued` (gravity and torque in one kick); ``exact-kick-*`` also
-integrates a torqued rigid body that way (a free body is refused: its exact flow is
-``exact``).
+integrates a torqued rigid body that way (on a free body the kicks are zero and the steps
+are those of the exact flow).
 
 ``exact-kick-*`` (numba, one kernel)
     ``F`` is the exact free flow (Jacobi elliptic functions and an elliptic integral of
@@ -38,7 +38,6 @@ from typing import cast
 import numpy as np
 
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
-from dirac.errors import InputError
 from dirac.flows.methods.base import Method, Stepper, StepperFactory
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
 from dirac.flows.methods.torqued import TorquedStepper
@@ -100,13 +99,7 @@ def _splitting_factory(method: Method, problem, outputs, options) -> Stepper:
 
 
 def _exact_kick_factory(method: Method, problem, outputs, options) -> Stepper:
-    if problem.kind == "rigid_body" and not problem.driven:
-        raise InputError(
-            f"method {method.name!r} cannot integrate a free body (a problem of kind 'rigid_body' without torque or "
-            "impulses); it accepts: heavy_top, and rigid_body under a torque or angular impulses; the free body's "
-            "exact flow is method 'exact'"
-        )
-    if problem.driven:  # torque kicks (with gravity for a heavy top)
+    if problem.driven or problem.kind == "rigid_body":  # torque kicks (zero for a free body; gravity for a top)
         return TorquedStepper(problem, outputs, cast(tuple[float, ...], method.data), "exact", options)
     return ExactKickStepper(method, problem, outputs)
 
