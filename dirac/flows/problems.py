@@ -28,8 +28,9 @@ from dirac.errors import InputError
 from dirac.validate import validate_array, validate_non_negative
 
 if TYPE_CHECKING:
+    from dirac.flows.impulses import AngularImpulse
     from dirac.flows.mechanics import MechanicalSystem
-    from dirac.flows.torques import AngularImpulse, Torque
+    from dirac.flows.torques import Torque
     from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
@@ -115,11 +116,14 @@ class RigidBodyProblem:
     outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "casimir", "lab_momentum", "work")
 
     def __post_init__(self) -> None:
-        from dirac.flows.torques import Torque, validate_impulses
+        from dirac.flows.impulses import validate_impulses
         from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
 
-        if self.torque is not None and not isinstance(self.torque, Torque):
-            self.torque = Torque(self.torque)
+        if self.torque is not None:
+            from dirac.flows.torques import Torque  # the expression parser: only for a torque
+
+            if not isinstance(self.torque, Torque):
+                self.torque = Torque(self.torque)
         self.impulses = validate_impulses(self.impulses)
 
         self.inertia = validate_inertia(self.inertia)

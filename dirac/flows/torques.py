@@ -14,15 +14,14 @@ The work done by the torque, ``W(t) = ∫ N·Omega dt``, makes ``E - W`` a const
 exact motion: ``dE/dt = Omega·dM/dt (+ dV/dt) = Omega·N`` since ``Omega·(M x Omega) = 0``
 and the gravity part is conservative. An angular impulse ``J`` (body frame) at time ``t_J``
 makes ``M`` jump by ``J``; its work is the jump of the kinetic energy,
-``E(M + J) - E(M)`` (the limit of ``∫ N·Omega dt`` over a short, strong torque).
+``E(M + J) - E(M)`` (the limit of ``∫ N·Omega dt`` over a short, strong torque); the
+impulses are in :mod:`dirac.flows.impulses` (no sympy: a free body never imports it).
 """
 
 from __future__ import annotations
 
 import ast
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import cached_property
 from types import ModuleType
 
@@ -32,9 +31,9 @@ import sympy
 from dirac.errors import InputError
 from dirac.flows.torque_kernels import torque_module, torque_module_source
 from dirac.model.expressions import ALLOWED_CONSTANTS, TIME, parse_expression
-from dirac.validate import unknown_name_error, validate_array, validate_finite
+from dirac.validate import unknown_name_error
 
-__all__ = ["Torque", "AngularImpulse", "TORQUE_SYMBOLS", "torque_symbols", "validate_impulses"]
+__all__ = ["Torque", "TORQUE_SYMBOLS", "torque_symbols"]
 
 
 def torque_symbols() -> dict[str, sympy.Symbol]:
@@ -151,50 +150,3 @@ class Torque:
         omega = M / np.asarray(inertia, dtype=float)
         values = self._scalar(*M, *omega, *np.asarray(R, dtype=float).ravel(), float(t))
         return np.asarray(values, dtype=float).reshape(3)
-
-
-@dataclass(frozen=True)
-class AngularImpulse:
-    """An angular impulse ``J`` (body frame) at time ``t``: ``M`` jumps by ``J``.
-
-    Raises
-    ------
-    InputError
-        ``t`` negative or not finite, ``J`` not three finite numbers.
-    """
-
-    t: float
-    vector: np.ndarray
-
-    def __post_init__(self) -> None:
-        t = validate_finite(self.t, "impulse time t")
-        if t < 0:
-            raise InputError(f"an impulse at t = {t:g} is before the start of the run (t = 0); give t >= 0")
-        object.__setattr__(self, "t", t)
-        object.__setattr__(self, "vector", validate_array(self.vector, "angular_impulse", (3,)))
-
-
-def validate_impulses(impulses: Sequence[object]) -> tuple[AngularImpulse, ...]:
-    """The impulses as :class:`AngularImpulse`, sorted by time (``(t, [a, b, c])`` pairs or
-    :class:`AngularImpulse`); two at the same time are added."""
-    result: list[AngularImpulse] = []
-    for item in impulses:
-        if isinstance(item, AngularImpulse):
-            result.append(item)
-            continue
-        if isinstance(item, dict) and set(item) == {"t", "angular_impulse"}:
-            result.append(AngularImpulse(item["t"], item["angular_impulse"]))  # type: ignore[arg-type]
-            continue
-        if isinstance(item, (tuple, list)) and len(item) == 2:
-            result.append(AngularImpulse(item[0], item[1]))  # type: ignore[arg-type]
-            continue
-        raise InputError(f"an angular impulse is a pair (t, [a, b, c]) or an AngularImpulse, got {item!r}")
-    result.sort(key=lambda impulse: impulse.t)
-    merged: list[AngularImpulse] = []
-    for impulse in result:
-        if merged and math.isclose(merged[-1].t, impulse.t, rel_tol=0.0, abs_tol=0.0):
-            merged[-1] = AngularImpulse(impulse.t, merged[-1].vector + impulse.vector)
-        else:
-            merged.append(impulse)
-    return tuple(merged)
-

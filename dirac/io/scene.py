@@ -341,7 +341,7 @@ def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> 
     set on ``problem`` (validated there: :class:`dirac.flows.torques.Torque`,
     :class:`dirac.flows.torques.AngularImpulse`)."""
     from dirac.errors import warn
-    from dirac.flows.torques import AngularImpulse, Torque, validate_impulses
+    from dirac.flows.impulses import AngularImpulse, validate_impulses
 
     forces = scene_table(data, "forces", source, required=False)
     reject_unknown_keys(forces, _RIGID_FORCE_KEYS, "[forces]", source)
@@ -349,6 +349,8 @@ def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> 
         torque = forces["torque"]
         if not isinstance(torque, list):
             raise InputError(f'{source}: [forces] torque must be a list of three expressions, e.g. ["0", "0", "-0.1*Omega_3"]')
+        from dirac.flows.torques import Torque
+
         problem.torque = Torque(torque, source)
     tables = data.get("impulses", [])
     if not isinstance(tables, list) or not all(isinstance(table, dict) for table in tables):

@@ -276,3 +276,17 @@ def test_impulses_on_a_torqued_body_agree_with_scipy_restarted_at_the_impulse():
         assert np.max(np.abs(solution.outputs["M"][-1] - y[:3])) < 1e-9, method
         assert np.max(np.abs(solution.outputs["R"][-1] - y[3:12].reshape(3, 3))) < 1e-9, method
         assert abs(solution.outputs["work"][-1] - y[12]) < 1e-9, method
+
+
+def test_a_free_body_run_does_not_import_the_expression_parser():
+    """The torque parser (sympy) is imported only for a torque: the free body's start-up
+    is unchanged."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from dirac import RigidBodyProblem, integrate; "
+            "integrate(RigidBodyProblem([1.0, 2.0, 3.0], [1.0, 0.0, 0.1]), 'lie-poisson-4', t_end=1.0, dt=0.1); "
+            "integrate(RigidBodyProblem([1.0, 2.0, 3.0], [1.0, 0.0, 0.1]), 'scipy-DOP853', t_end=1.0); "
+            "print('sympy' in sys.modules)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.strip() == "False"

@@ -17,15 +17,18 @@ state).
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from dirac.errors import InputError
 from dirac.flows.methods.base import StepFailure
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper, rigid_body_outputs
-from dirac.flows.torques import Torque
 from dirac.rigidbody.exact_step import FreeFlowWork
 from dirac.rigidbody.splitting import build_sequence
+
+if TYPE_CHECKING:
+    from dirac.flows.torques import Torque
 
 __all__ = ["TorquedStepper", "DRIVEN_METHOD_PREFIXES", "refuse_undriven"]
 
@@ -68,6 +71,8 @@ class TorquedStepper(RigidBodyStepper):
     def __init__(self, problem, outputs: tuple[str, ...], gammas: tuple[float, ...], free: str,
                  options: dict) -> None:
         super().__init__(problem, outputs)
+        from dirac.flows.torques import Torque  # the parser and code generator: only for driven bodies
+
         self.torque: Torque = problem.torque if problem.torque is not None else Torque(_ZERO)
         self.with_R = self.with_R or self.torque.depends_on_attitude or free == "exact"
         self.kernels = self.torque.kernels
