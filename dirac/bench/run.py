@@ -69,6 +69,10 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
 
             for top in heavy_top_cases(quick):
                 rows += run_heavy_top_case(top, repeats, say)
+            from dirac.bench.torqued import run_torqued_case, torqued_cases
+
+            for torqued in torqued_cases(quick):
+                rows += run_torqued_case(torqued, repeats, say)
     measured: list[Target] = []
     notes: list[str] = []
     field_rows: list[dict] = []

@@ -402,6 +402,24 @@ def heavy_top_equal_cpu_target(rows: list[dict], problem: str = "heavy top (fast
                   f"its error is {row['error']:.2g}; {row.get('description', '')}")
 
 
+def torqued_target(rows: list[dict], threshold: float = 1e-8) -> Target:
+    """The torqued body (:mod:`dirac.bench.torqued`): CPU of the fastest DOP853 run over that
+    of the fastest package run, both with error ``<= threshold``."""
+    name = f"torqued body: DOP853 CPU / fastest kick composition (error <= {threshold:g})"
+    subset = [r for r in rows if r.get("problem") == "torqued body" and "failed" not in r
+              and r.get("error", math.inf) <= threshold]
+    ours = [r for r in subset if not r["method"].startswith("scipy-")]
+    dop = [r for r in subset if r["method"] == "scipy-DOP853"]
+    if not ours or not dop:
+        return Target(name, None, "x", 1.0, ">=", "DOP853 or the package did not reach the error in this run")
+    best = min(ours, key=lambda r: r["cpu_s"])
+    best_dop = min(dop, key=lambda r: r["cpu_s"])
+    return Target(name, best_dop["cpu_s"] / best["cpu_s"], "x", 1.0, ">=",
+                  f"{best['method']} dt = {best['value']:g}: {best['cpu_s'] * 1e3:.2f} ms, error {best['error']:.2g}; "
+                  f"DOP853 tol {best_dop['value']:g}: {best_dop['cpu_s'] * 1e3:.2f} ms, error {best_dop['error']:.2g}, "
+                  f"{best_dop['evaluations']} RHS calls (lean float RHS)")
+
+
 # --------------------------------------------------------------------------- start-up
 def _dirac_command() -> list[str]:
     return [sys.executable, "-m", "dirac"]
@@ -502,5 +520,6 @@ def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], Non
     attempt("heavy top: exact-kick-4 and lie-poisson-4 per step, hand-written anchor",
             lambda: heavy_top_step_targets(repeats, 20_000 if quick else 100_000))
     targets.append(heavy_top_equal_cpu_target(rows))
+    targets.append(torqued_target(rows))
     attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
     return targets, notes

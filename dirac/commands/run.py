@@ -56,7 +56,7 @@ METHOD_HELP: tuple[tuple[str, str], ...] = (
     ("lie-poisson-8-s15", "order 8, Suzuki-Umeno / McLachlan 15-stage composition"),
     ("lie-poisson-sym-4-suzuki", "symmetric-top split, Suzuki's order-4 composition"),
     ("lie-poisson-sym-8-s15", "symmetric-top split, 15-stage order-8 composition"),
-    ("exact-kick-2/4/6/8", "heavy top: exact free flow + gravity kick (Celledoni et al. 2008)"),
+    ("exact-kick-2/4/6/8", "heavy top, torqued body: exact free flow + gravity/torque kick (Celledoni et al. 2008)"),
     ("rattle-2/4/6/8", "constrained systems: RATTLE and its symmetric compositions"),
     ("midpoint", "implicit midpoint (rigid body; Dirac vector field of general systems)"),
     ("scipy-RK45", "baseline: scipy RK45, rtol = atol = tolerance"),

@@ -28,7 +28,8 @@ import numpy as np
 
 from dirac.errors import InputError, IntegrationError
 from dirac.flows.methods.base import Method, StepFailure, Stepper
-from dirac.flows.methods.registry import METHODS, get_method, method_names
+from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
+from dirac.flows.methods.torqued import refuse_undriven
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 from dirac.validate import is_real_number, unknown_name_error, validate_integer, validate_positive
@@ -237,6 +238,7 @@ def integrate(
         raise InputError(
             f"method {method_object.name!r} cannot integrate a {kind.replace('_', ' ')} problem; use one of: {', '.join(usable)}"
         )
+    refuse_undriven(checked, method_object.name, driven_method_names(kind))
     if method_object.kind == "fixed" and dt is None:
         raise InputError(f"method {method_object.name!r} takes fixed steps: give dt (the step size)")
     if dt is not None and method_object.kind == "fixed" and not t_end / dt <= MAX_STEPS:

@@ -28,7 +28,9 @@ from dirac.errors import InputError
 from dirac.validate import validate_array, validate_non_negative
 
 if TYPE_CHECKING:
+    from dirac.flows.impulses import AngularImpulse
     from dirac.flows.mechanics import MechanicalSystem
+    from dirac.flows.torques import Torque
     from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
@@ -91,6 +93,11 @@ class RigidBodyProblem:
         Initial body angular momentum.
     R0 : array_like, shape (3, 3) or (B, 3, 3), optional
         Initial attitude (body to lab), default the identity (43).
+    torque : dirac.flows.torques.Torque or sequence of 3 str, optional (keyword)
+        External torque ``N`` in the body frame: ``dM/dt = M x Omega + N`` (Euler's
+        equations with a torque), expressions in ``M_i``, ``Omega_i``, ``R_ij`` and ``t``.
+    impulses : sequence of (t, [a, b, c]) or AngularImpulse, optional (keyword)
+        Angular impulses (body frame): ``M`` jumps by ``[a, b, c]`` at time ``t >= 0``.
 
     Examples
     --------
@@ -100,14 +107,24 @@ class RigidBodyProblem:
     inertia: np.ndarray
     M0: np.ndarray
     R0: np.ndarray | None = None
+    torque: Torque | None = field(default=None, kw_only=True)
+    impulses: tuple[AngularImpulse, ...] = field(default=(), kw_only=True)
     batched: bool = field(init=False, default=False)
 
     kind: ClassVar[str] = "rigid_body"
     system: ClassVar[str] = "rigid_body"
-    outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "casimir", "lab_momentum")
+    outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "casimir", "lab_momentum", "work")
 
     def __post_init__(self) -> None:
+        from dirac.flows.impulses import validate_impulses
         from dirac.rigidbody.inertia import validate_inertia, validate_momentum, validate_rotation
+
+        if self.torque is not None:
+            from dirac.flows.torques import Torque  # the expression parser: only for a torque
+
+            if not isinstance(self.torque, Torque):
+                self.torque = Torque(self.torque)
+        self.impulses = validate_impulses(self.impulses)
 
         self.inertia = validate_inertia(self.inertia)
         moments = validate_array(self.M0, "M0", finite=False)  # finiteness: validate_momentum, per body
@@ -131,9 +148,23 @@ class RigidBodyProblem:
         """Number of initial states."""
         return int(self.M0.shape[0])
 
+    @property
+    def driven(self) -> bool:
+        """Whether an external torque or an angular impulse acts (not a free flow)."""
+        return self.torque is not None or bool(self.impulses)
+
     def parameters(self) -> dict[str, object]:
         """Numerical parameters for the result file's ``meta``."""
-        return {"inertia": self.inertia.tolist()}
+        return {"inertia": self.inertia.tolist(), **self._driving()}
+
+    def _driving(self) -> dict[str, object]:
+        """The torque and impulses for ``meta`` (nothing when there are none)."""
+        driving: dict[str, object] = {}
+        if self.torque is not None:
+            driving["torque"] = list(self.torque.texts)
+        if self.impulses:
+            driving["impulses"] = [{"t": i.t, "angular_impulse": i.vector.tolist()} for i in self.impulses]
+        return driving
 
 
 @dataclass
@@ -161,7 +192,7 @@ class HeavyTopProblem(RigidBodyProblem):
 
     kind: ClassVar[str] = "heavy_top"
     system: ClassVar[str] = "heavy_top"
-    outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "lab_momentum_z")
+    outputs: ClassVar[tuple[str, ...]] = ("M", "R", "energy", "lab_momentum_z", "work")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -178,6 +209,7 @@ class HeavyTopProblem(RigidBodyProblem):
             "inertia": self.inertia.tolist(),
             "mass_gravity": self.mass_gravity,
             "center_of_mass": self.center_of_mass.tolist(),
+            **self._driving(),
         }
 
 

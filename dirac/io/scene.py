@@ -33,6 +33,10 @@ scipy baselines; the multipliers are completed on the constraint surface, output
 overridden under ``[system] parameters``. Optional ``[run]`` keys: ``drift_limit``,
 ``newton_tolerance``, ``max_newton_iterations``. Unknown keys are errors that suggest the closest known key.
 
+A rigid body or heavy top may be driven: ``[forces] torque = ["N1", "N2", "N3"]`` (the
+external torque in the body frame, expressions in ``M_i``, ``Omega_i``, ``R_ij``, ``t``)
+and ``[[impulses]]`` tables with ``t`` and ``angular_impulse = [a, b, c]`` (``M`` jumps).
+
 This module is the one scene reader: reading the file (:func:`read_scene_file`), its
 tables (:func:`scene_table`), numbers, vectors and the rigid body's inertia
 (:func:`scene_number`, :func:`scene_integer`, :func:`scene_vector`,
@@ -94,7 +98,7 @@ FLAGSHIP_SCENE: dict[str, object] = {
     },
 }
 
-_TOP_KEYS = {"system", "initial", "run", "description"}
+_TOP_KEYS = {"system", "initial", "run", "description", "forces", "impulses"}
 _RUN_KEYS = {"t_end", "method", "dt", "tolerance", "samples", "outputs", "drift_limit", "newton_tolerance",
              "max_newton_iterations"}
 _RIGID_KEYS = {"name", "inertia", "description"}
@@ -250,8 +254,14 @@ def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None)
     run = _run_options(run_table, source)
     name = system.get("name")
     if name in SCENE_SYSTEMS:
-        problem: SceneProblem = _rigid_problem(str(name), system, initial, source)
+        rigid = _rigid_problem(str(name), system, initial, source)
+        _drive(rigid, data, run["t_end"], source)
+        problem: SceneProblem = rigid
     else:
+        for key in ("forces", "impulses"):
+            if key in data:
+                raise InputError(f"{source}: [{key}] (torques, angular impulses) applies to rigid_body and heavy_top "
+                                 "scenes; give the forces of a Lagrangian system in its system file")
         problem = _general_problem(system, initial, source, base or Path("."))
     available: tuple[str, ...] = problem.outputs
     for output in run.get("outputs", []):
@@ -320,6 +330,48 @@ def _rigid_problem(name: str, system: dict, initial: dict, source: str) -> Rigid
         chi = scene_vector(system.get("center_of_mass", [0.0, 0.0, 1.0]), "[system] center_of_mass", source, (3,))
         return HeavyTopProblem(inertia, M, R, mass_gravity=weight, center_of_mass=chi)
     return RigidBodyProblem(inertia, M, R)
+
+
+_RIGID_FORCE_KEYS = {"torque"}
+_RIGID_IMPULSE_KEYS = {"t", "angular_impulse"}
+
+
+def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> None:
+    """``[forces] torque = [...]`` and ``[[impulses]]`` of a rigid-body or heavy-top scene,
+    set on ``problem`` (validated there: :class:`dirac.flows.torques.Torque`,
+    :class:`dirac.flows.torques.AngularImpulse`)."""
+    from dirac.errors import warn
+    from dirac.flows.impulses import AngularImpulse, validate_impulses
+
+    forces = scene_table(data, "forces", source, required=False)
+    reject_unknown_keys(forces, _RIGID_FORCE_KEYS, "[forces]", source)
+    if "torque" in forces:
+        torque = forces["torque"]
+        if not isinstance(torque, list):
+            raise InputError(f'{source}: [forces] torque must be a list of three expressions, e.g. ["0", "0", "-0.1*Omega_3"]')
+        from dirac.flows.torques import Torque
+
+        problem.torque = Torque(torque, source)
+    tables = data.get("impulses", [])
+    if not isinstance(tables, list) or not all(isinstance(table, dict) for table in tables):
+        raise InputError(f"{source}: impulses must be [[impulses]] tables, each with t and angular_impulse = [a, b, c]")
+    impulses = []
+    for k, table in enumerate(tables, start=1):
+        where = f"[[impulses]] {k}"
+        reject_unknown_keys(table, _RIGID_IMPULSE_KEYS, where, source)
+        for key in ("t", "angular_impulse"):
+            if key not in table:
+                raise InputError(f"{source}: {where} lacks {key} (give t = time and angular_impulse = [a, b, c], "
+                                 "body frame)")
+        t = scene_number(table["t"], f"{where} t", source)
+        if t < 0:
+            raise InputError(f"{source}: {where} t = {t:g} is before the start of the run; give t >= 0")
+        if t > t_end:
+            warn(f"{source}: {where} at t = {t:g} is after [run] t_end = {t_end:g}: it never acts")
+        impulses.append(AngularImpulse(t, scene_vector(table["angular_impulse"], f"{where} angular_impulse", source,
+                                                       (3,))))
+    if impulses:
+        problem.impulses = validate_impulses(impulses)
 
 
 def _general_problem(system: dict, initial: dict, source: str, base: Path) -> ConstrainedProblem | AnalysedProblem:

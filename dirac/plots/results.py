@@ -122,6 +122,22 @@ def _kind(result: Any, meta: Mapping[str, Any]) -> str:
                      "add \"M\" or \"q\" to outputs in the scene's [run] table to draw it")
 
 
+def _driven(result: Any, meta: Mapping[str, Any], kind: str, t: np.ndarray, M: np.ndarray, R: np.ndarray | None,
+            inertia: Any, parameters: Mapping[str, Any]) -> Any:
+    """The picture of a rigid body or heavy top driven by a torque or impulses."""
+    from dirac.plots.rigid_body import driven_figure
+
+    if _has(result, "energy"):
+        energy = _first_body(_get(result, "energy"), 1)
+    elif kind == "rigid_body":
+        energy = 0.5 * np.sum(M * M / np.asarray(inertia, dtype=float), axis=1)
+    else:
+        raise InputError("a heavy top's picture under a torque needs the output 'energy'; add it to [run] outputs")
+    work = _first_body(_get(result, "work"), 1) if _has(result, "work") else None
+    heading = "heavy top" if kind == "heavy_top" else "rigid body"
+    return driven_figure(t, M, R, inertia, energy, work, title=_title(meta, f"{heading} under a torque"))
+
+
 def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem: Any | None = None) -> Any:
     """The picture of one run, chosen by the kind of system; returns a matplotlib Figure.
 
@@ -164,6 +180,8 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem
             raise InputError("the result's meta has no parameters.inertia: cannot draw the energy ellipsoid")
         M = _first_body(_get(result, "M"), 2)
         R = _first_body(_get(result, "R"), 3) if _has(result, "R") else None
+        if "torque" in parameters or "impulses" in parameters:
+            return _driven(result, meta, kind, t, M, R, inertia, parameters)
         if kind == "rigid_body":
             return rigid_body_figure(t, M, R, inertia, title=_title(meta, "rigid body"))
         weight = None

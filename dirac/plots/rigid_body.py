@@ -11,6 +11,10 @@ What a reader of the paper wants to see (Sects. VII, IX–XI):
 * the **conserved quantities** -- relative errors of the energy ``H_0`` (247), of the
   Casimir ``|M|^2``, of ``m = R M`` and of ``R^T R = 1`` over time.
 
+A body driven by an external torque or angular impulses conserves none of these: its
+picture (:func:`driven_figure`) shows the energy ``E(t)`` and the work ``W(t)`` of the
+torque, and the error of ``E - W``, the one quantity the exact motion keeps.
+
 Units: ``dirac`` works in any consistent units; the axes are labelled in SI (moments of
 inertia in kg m^2, angular momentum in kg m^2/s, time in s).
 """
@@ -41,6 +45,8 @@ __all__ = [
     "rigid_body_figure",
     "heavy_top_errors",
     "heavy_top_figure",
+    "draw_energy_and_work",
+    "driven_figure",
 ]
 
 #: colours of the three principal axes (x, y, z convention: red, green, blue)
@@ -428,4 +434,69 @@ def heavy_top_figure(
     M_text = ", ".join(f"{v + 0.0:.4g}" for v in M[0])
     w_text = "" if weight is None else ",  $mg\\chi = (" + ", ".join(f"{v:.4g}" for v in np.asarray(weight)) + ")$"
     fig.suptitle(f"{heading}\n$I = ({I_text})${w_text},  $M(0) = ({M_text})$,  {t.size} samples", fontsize=12)
+    return fig
+
+
+def draw_energy_and_work(ax: Any, t: Any, energy: Any, work: Any | None) -> None:
+    """Draw the energy ``E(t)`` (not conserved under a torque), the work ``W(t)`` done by the
+    torque and impulses, and ``E - W`` (constant along the exact motion) against time."""
+    t = np.asarray(t, dtype=float)
+    energy = np.asarray(energy, dtype=float)
+    ax.plot(t, energy, color="C0", linewidth=1.4, label="energy $E(t)$ (not conserved: external torque)")
+    if work is not None:
+        work = np.asarray(work, dtype=float)
+        ax.plot(t, work, color="C1", linewidth=1.2, linestyle="--", label=r"work $W(t)=\int N\cdot\Omega\,dt$")
+        ax.plot(t, energy - work, color="C2", linewidth=1.2, linestyle="-.", label="$E - W$ (conserved)")
+    ax.set_xlabel("time $t$ [s]")
+    ax.set_ylabel("energy [J]")
+    ax.set_title("Energy and the work of the torque", fontsize=11)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, framealpha=0.8)
+
+
+def driven_figure(
+    t: Any,
+    M: Any,
+    R: Any | None,
+    inertia: Any,
+    energy: Any,
+    work: Any | None,
+    *,
+    title: str | None = None,
+    heading: str = "Rigid body under a torque",
+) -> Any:
+    """The picture of a run driven by an external torque or angular impulses.
+
+    Panels: the body axes (:func:`draw_body_axes`, when ``R`` is known), ``M_i(t)``
+    (:func:`draw_momentum`), the energy and the work (:func:`draw_energy_and_work`), and
+    the relative error of ``E - W`` (``E_0 - (E - W)`` over ``E_0``; ``dE/dt = N·Omega``
+    along the exact motion). No polhode: under a torque ``M`` leaves the free body's
+    sphere and ellipsoid. Without ``work`` only the energy is drawn.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    t, M, R, inertia = _validate(t, M, R, inertia)
+    energy = np.asarray(energy, dtype=float).reshape(-1)
+    fig = new_figure(13.0, 11.0)
+    grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=0.12, top=0.91, wspace=0.22, hspace=0.45)
+    if R is not None:
+        draw_body_axes(fig.add_subplot(grid[0, 0], projection="3d"), R)
+        draw_momentum(fig.add_subplot(grid[0, 1]), t, M)
+    else:
+        draw_momentum(fig.add_subplot(grid[0, :]), t, M)
+    draw_energy_and_work(fig.add_subplot(grid[1, 0]), t, energy, work)
+    errors_ax = fig.add_subplot(grid[1, 1])
+    if work is not None:
+        balance = energy - np.asarray(work, dtype=float).reshape(-1)
+        draw_conservation(errors_ax, t, {r"$|(E-W)-E_0|/|E_0|$": _relative(balance, abs(float(energy[0])))})
+    else:
+        errors_ax.text(0.5, 0.5, "output 'work' not stored:\nthe balance E - W cannot be drawn",
+                       ha="center", va="center", transform=errors_ax.transAxes)
+        errors_ax.set_axis_off()
+    I_text = ", ".join(f"{v:.4g}" for v in inertia)
+    M_text = ", ".join(f"{v + 0.0:.4g}" for v in M[0])
+    fig.suptitle(f"{title or heading}\n$I = ({I_text})$ kg m$^2$,  $M(0) = ({M_text})$ {_MOMENTUM_UNIT},  "
+                 f"{t.size} samples", fontsize=12)
     return fig

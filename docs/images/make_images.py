@@ -52,6 +52,10 @@ def make_all() -> None:
             str(work / "racket.npz"), "--plot", str(IMAGES / "tennis_racket.png"))
         run("run", str(DOCS / "scenes" / "heavy_top.toml"), "--no-progress", "--out", str(work / "top.npz"),
             "--plot", str(IMAGES / "heavy_top.png"))
+        run("run", str(DOCS / "scenes" / "satellite_despin.toml"), "--no-progress", "--out",
+            str(work / "satellite.npz"), "--plot", str(IMAGES / "satellite_despin.png"))
+        run("run", str(DOCS / "scenes" / "top_friction.toml"), "--no-progress", "--out", str(work / "friction.npz"),
+            "--plot", str(IMAGES / "top_friction.png"))
         for name, text in page_files(DOCS / "tutorial.md").items():  # bead.toml, bead_scene.toml
             (work / name).write_text(text, encoding="utf-8")
         run("run", str(work / "bead_scene.toml"), "--no-progress", "--out", str(work / "bead.npz"),

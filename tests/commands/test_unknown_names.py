@@ -23,7 +23,7 @@ def _scene(tmp_path: Path, text: str) -> Path:
     [
         (RIGID + "sample = 5\n", "[run] has an unknown key 'sample' (did you mean 'samples'?); known keys: drift_limit, dt, "),
         (RIGID.replace("[initial]", "[intial]"),
-         "the scene has an unknown section 'intial' (did you mean 'initial'?); known sections: description, initial, run, system"),
+         "the scene has an unknown section 'intial' (did you mean 'initial'?); known sections: description, forces, impulses, initial, run, system"),
         (RIGID + 'method = "rattle2"\n', "[run] method: unknown method 'rattle2' (did you mean 'rattle-2'"),
         (RIGID + 'outputs = ["M", "enrgy"]\n',
          "[run] outputs: unknown output 'enrgy' (did you mean 'energy'?); known outputs: M, R, casimir, energy, lab_momentum"),

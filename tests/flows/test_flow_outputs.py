@@ -94,7 +94,7 @@ def test_counters_and_cpu_time_are_recorded():
         ({"t_end": 1.0}, "give dt"),
         ({"t_end": 1.0, "dt": 0.1, "samples": 0}, "samples"),
         ({"t_end": 1.0, "dt": 0.1, "outputs": ["q"]}, r"^unknown output 'q'; known outputs: M, R, casimir, energy, "
-                                                    r"lab_momentum; these are the outputs of a rigid body problem$"),
+                                                    r"lab_momentum, work; these are the outputs of a rigid body problem$"),
         ({"t_end": 1.0, "dt": 0.1, "outputs": ["enrgy"]}, r"unknown output 'enrgy' \(did you mean 'energy'\?\)"),
         ({"t_end": 1.0, "dt": 0.1, "tolerance": 2.0}, "tolerance"),
     ],

@@ -55,7 +55,7 @@ def test_angular_velocity_and_lab_momentum_are_accepted():
          "s.toml: [initial] has an unknown key 'RR' (did you mean 'R'?); known keys: M, R, m, omega"),
         (_with(RIGID) | {"intial": {}},
          "s.toml: the scene has an unknown section 'intial' (did you mean 'initial'?); known sections: description, "
-         "initial, run, system"),
+         "forces, impulses, initial, run, system"),
         (_with(RIGID, run={"colour": "red"}),  # nothing close: no suggestion
          "s.toml: [run] has an unknown key 'colour'; known keys: drift_limit, dt, max_newton_iterations, method, "
          "newton_tolerance, outputs, samples, t_end, tolerance"),

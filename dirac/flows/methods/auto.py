@@ -19,6 +19,9 @@
   ``exact-kick-*`` costs more per stage but its error is proportional to the gravity
   torque, so it wins for a fast top (gravity a perturbation of the free motion) and
   ``lie-poisson-*`` for a slow one.
+* A rigid body or heavy top driven by an external torque or angular impulses: the same
+  candidates and the same Richardson logic, with torque kicks
+  (:mod:`dirac.flows.methods.torqued`).
 * General and analysed systems: each candidate of order ``p`` (``rattle-2/4``, resp.
   ``midpoint``) is run over a pilot span with steps ``h`` and ``h/2``; Richardson's
   estimate with linear growth in time gives the step for ``tolerance``; the cheaper
@@ -122,6 +125,8 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
                   outputs: tuple[str, ...]) -> AutoChoice:
     """Choose method and step for ``problem`` (see the module docstring)."""
     options = {"t_end": t_end, "tolerance": tolerance, "newton_tolerance": 1e-12, "max_newton_iterations": 50}
+    if kind in ("rigid_body", "heavy_top") and problem.driven:
+        return _heavy_top(problem, t_end, tolerance, dt, outputs, options)
     if kind == "rigid_body":
         return _rigid_body(problem, t_end, samples, tolerance, outputs, options)
     candidates: tuple[str, ...]
@@ -219,11 +224,20 @@ def _richardson_step(name: str, problem, outputs, dt_start: float, t_end: float,
 
 
 def _heavy_top(problem, t_end: float, tolerance: float, dt: float | None, outputs, options) -> AutoChoice:
-    """The heavy top: the cheapest of :data:`HEAVY_TOP_CANDIDATES` in microseconds."""
+    """The heavy top, and a rigid body driven by a torque or impulses: the cheapest of
+    :data:`HEAVY_TOP_CANDIDATES` in microseconds (the time scale of the pilot also takes
+    the torque's rate ``|N| / |M|`` at the start into account)."""
     scale = 1.0 / _frequency(problem)
-    weight = float(np.linalg.norm(problem.weight_vector))
-    if weight > 0:
-        scale = min(scale, 1.0 / math.sqrt(weight / float(np.min(problem.inertia))))
+    if problem.kind == "heavy_top":
+        weight = float(np.linalg.norm(problem.weight_vector))
+        if weight > 0:
+            scale = min(scale, 1.0 / math.sqrt(weight / float(np.min(problem.inertia))))
+    if problem.torque is not None:
+        M0, R0 = problem.M0[0], problem.R0[0]
+        rate = float(np.linalg.norm(problem.torque.evaluate(M0, R0, 0.0, problem.inertia)))
+        size = float(np.linalg.norm(M0))
+        if rate > 0 and math.isfinite(rate):
+            scale = min(scale, size / rate if size > 0 else 1.0 / math.sqrt(rate / float(np.min(problem.inertia))))
     dt_start = dt if dt is not None else 0.05 * scale
     batch = problem.M0.shape[0]
     best: AutoChoice | None = None

@@ -15,6 +15,11 @@ Two families of ``F``:
     ``F`` is the Strang step of the Lie–Poisson splitting of ``H_0`` (exact rotations
     about the body axes; for ``lie-poisson-sym-*`` the symmetric-top split, which is the
     *exact* free flow of a Lagrange top ``I_1 = I_2``).
+With an external torque or angular impulses both families use the torque kicks of
+:mod:`dirac.flows.methods.torqued` (gravity and torque in one kick); ``exact-kick-*`` also
+integrates a torqued rigid body that way (on a free body the kicks are zero and the steps
+are those of the exact flow).
+
 ``exact-kick-*`` (numba, one kernel)
     ``F`` is the exact free flow (Jacobi elliptic functions and an elliptic integral of
     the third kind), as in Celledoni et al. (2008): :func:`dirac.rigidbody.exact_step.free_flow_step`
@@ -35,6 +40,7 @@ import numpy as np
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
 from dirac.flows.methods.base import Method, Stepper, StepperFactory
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
+from dirac.flows.methods.torqued import TorquedStepper
 from dirac.rigidbody.exact_step import FreeFlowWork, exact_kick_advance
 from dirac.rigidbody.heavy_top import heavy_top_advance
 from dirac.rigidbody.splitting import CompositionScheme, build_sequence
@@ -86,10 +92,15 @@ class ExactKickStepper(RigidBodyStepper):
 
 def _splitting_factory(method: Method, problem, outputs, options) -> Stepper:
     """Stepper of a ``lie-poisson-*`` method on a :class:`HeavyTopProblem`."""
+    if problem.driven:  # external torque or impulses: gravity and torque in one kick
+        scheme = cast(CompositionScheme, method.data)
+        return TorquedStepper(problem, outputs, tuple(scheme.coefficients), scheme.splitting, options)
     return HeavyTopSplittingStepper(method, problem, outputs)
 
 
 def _exact_kick_factory(method: Method, problem, outputs, options) -> Stepper:
+    if problem.driven or problem.kind == "rigid_body":  # torque kicks (zero for a free body; gravity for a top)
+        return TorquedStepper(problem, outputs, cast(tuple[float, ...], method.data), "exact", options)
     return ExactKickStepper(method, problem, outputs)
 
 
@@ -104,9 +115,10 @@ METHODS: tuple[Method, ...] = tuple(
         kind="fixed",
         symplectic=True,
         preserves_casimirs=True,
-        description=f"heavy top: exact free flow + gravity kick (Celledoni et al. 2008), order {composition.order}",
+        description=f"heavy top, torqued body: exact free flow + gravity/torque kick (Celledoni et al. 2008), "
+        f"order {composition.order}",
         reference=f"Celledoni, Fasso, Safstrom & Zanna, SIAM J. Sci. Comput. 30 (2008); {composition.reference}",
-        factories={"heavy_top": _exact_kick_factory},
+        factories={"heavy_top": _exact_kick_factory, "rigid_body": _exact_kick_factory},
         data=composition.coefficients,
     )
     for composition in COMPOSITIONS

@@ -5,7 +5,8 @@ symmetric compositions with coefficient tables as data) lives in
 :mod:`dirac.rigidbody.splitting`; this module binds it to :class:`RigidBodyProblem`:
 one :class:`Method` per composition scheme (``lie-poisson-2/4/6/8`` and the extras).
 On a heavy top the same methods compose the free step with gravity kicks
-(:mod:`dirac.flows.methods.heavy_top`; the registry joins the two).
+(:mod:`dirac.flows.methods.heavy_top`; the registry joins the two); with an external
+torque or angular impulses, with torque kicks (:mod:`dirac.flows.methods.torqued`).
 
 Only what is asked for is advanced: when no output needs ``R`` the kernel never touches
 it (``with_R = False``).
@@ -17,6 +18,7 @@ from typing import cast
 
 from dirac.flows.methods.base import Method, Stepper
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
+from dirac.flows.methods.torqued import TorquedStepper
 from dirac.rigidbody import splitting
 from dirac.rigidbody.batch import advance_batch
 
@@ -64,6 +66,9 @@ class LiePoissonStepper(RigidBodyStepper):
 
 
 def _factory(method: Method, problem, outputs, options) -> Stepper:
+    if problem.driven:  # torques or impulses: kicks composed with the Strang step
+        scheme = cast(splitting.CompositionScheme, method.data)
+        return TorquedStepper(problem, outputs, tuple(scheme.coefficients), scheme.splitting, options)
     return LiePoissonStepper(method, problem, outputs)
 
 

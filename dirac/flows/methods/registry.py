@@ -16,7 +16,7 @@ from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle,
 from dirac.flows.methods.base import Method
 from dirac.validate import unknown_name_error
 
-__all__ = ["METHODS", "CONTRACT_NAMES", "get_method", "method_names"]
+__all__ = ["METHODS", "CONTRACT_NAMES", "get_method", "method_names", "driven_method_names"]
 
 #: The names every user sees first, ``auto`` included; the others are extras.
 CONTRACT_NAMES: tuple[str, ...] = (
@@ -52,6 +52,16 @@ def method_names() -> list[str]:
     """Every method name: :data:`CONTRACT_NAMES` first (``auto`` leading), then the extras sorted."""
     extras = sorted(name for name in METHODS if name not in CONTRACT_NAMES)
     return [*CONTRACT_NAMES, *extras]
+
+
+def driven_method_names(kind: str) -> list[str]:
+    """The methods that integrate external torques and angular impulses on a problem of
+    ``kind`` (``auto`` first): the kick compositions of :mod:`~dirac.flows.methods.torqued`
+    and the scipy baselines."""
+    from dirac.flows.methods.torqued import DRIVEN_METHOD_PREFIXES
+
+    return ["auto"] + [name for name in method_names()
+                       if name in METHODS and METHODS[name].accepts(kind) and name.startswith(DRIVEN_METHOD_PREFIXES)]
 
 
 def get_method(name: str | Method) -> Method:

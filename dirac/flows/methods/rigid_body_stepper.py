@@ -74,14 +74,16 @@ def _attitude(R: np.ndarray | None) -> np.ndarray:
 
 def rigid_body_outputs(
     outputs: tuple[str, ...], M: np.ndarray, R: np.ndarray | None, inertia: np.ndarray,
-    weight: np.ndarray | None = None,
+    weight: np.ndarray | None = None, work: np.ndarray | None = None,
 ) -> dict[str, np.ndarray]:
     """Compute the requested outputs from batched ``M`` (B, 3) and ``R`` (B, 3, 3).
 
     ``energy`` is ``H_0`` (247) for the free body and ``H_0 + m g <chi, R^T e_z>`` for
     the heavy top (``weight = m g chi``, :func:`gravity_weight`); ``casimir`` is
     ``|M|^2``; ``lab_momentum`` is ``m = R M``; ``lab_momentum_z`` its vertical
-    component (conserved by the heavy top).
+    component (conserved by the heavy top); ``work`` the work ``∫ N·Omega dt`` of the
+    external torques and impulses since ``t = 0`` (zero when ``work`` is not given: no
+    external torque acts).
     """
     result: dict[str, np.ndarray] = {}
     for name in outputs:
@@ -100,6 +102,8 @@ def rigid_body_outputs(
             result[name] = np.einsum("bij,bj->bi", _attitude(R), M)
         elif name == "lab_momentum_z":
             result[name] = np.einsum("bj,bj->b", _attitude(R)[:, 2, :], M)
+        elif name == "work":
+            result[name] = np.zeros(M.shape[0]) if work is None else np.array(work, dtype=float)
         else:  # pragma: no cover - outputs are validated before
             raise KeyError(name)
     return result

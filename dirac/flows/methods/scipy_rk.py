@@ -51,10 +51,19 @@ class ScipyStepper(Stepper):
         self.t_end = float(options["t_end"])
         self.t = 0.0
         kind = problem.kind
+        self.driven = False
         if kind in ("rigid_body", "heavy_top"):
-            self.with_R = needs_attitude(outputs) or kind == "heavy_top"
+            torque = problem.torque
+            self.driven = problem.driven
+            self.with_R = (needs_attitude(outputs) or kind == "heavy_top"
+                           or (torque is not None and torque.depends_on_attitude))
             self._fun, self._args = _rigid_body_rhs(problem, self.with_R)
             states = [np.concatenate([M, R.ravel()]) if self.with_R else M.copy() for M, R in zip(problem.M0, problem.R0)]
+            if self.driven:  # the work W is the last component: dW/dt = N.Omega
+                self._fun = _driven_rhs(self._fun, problem, self.with_R)
+                states = [np.concatenate([y, [0.0]]) for y in states]
+            self.impulses = tuple(problem.impulses)
+            self._next = 0
         elif kind == "analysed":
             self.analysed = problem.analysed
             self._fun, self._args = (lambda t, y: self.analysed.field(y, t)), ()
@@ -65,6 +74,17 @@ class ScipyStepper(Stepper):
             states = [np.concatenate([q, p]) for q, p in zip(problem.q0, problem.p0)]
         self.y = np.array(states)
         self._solvers: list[_OdeSolver] | None = None
+        if self.driven:
+            self._apply_impulses_at(0.0)
+
+    def _apply_impulses_at(self, t: float) -> None:
+        """Angular impulses at time ``t``: ``M`` jumps, the work by the jump of the energy."""
+        inverse = 1.0 / np.asarray(self.problem.inertia, dtype=float)
+        while self._next < len(self.impulses) and self.impulses[self._next].t <= t:
+            before = 0.5 * np.sum(self.y[:, :3] ** 2 * inverse, axis=-1)
+            self.y[:, :3] += self.impulses[self._next].vector
+            self.y[:, -1] += 0.5 * np.sum(self.y[:, :3] ** 2 * inverse, axis=-1) - before
+            self._next += 1
 
     def _make_solvers(self) -> list[_OdeSolver]:
         from scipy import integrate
@@ -75,6 +95,7 @@ class ScipyStepper(Stepper):
         def fun(t, y):
             return self._fun(t, y, *args)
 
+        self._counted = 0
         return [
             solver_class(fun, self.t, y.copy(), self.t_end, rtol=self.tolerance, atol=self.tolerance)
             for y in self.y
@@ -85,6 +106,17 @@ class ScipyStepper(Stepper):
         self._solvers = self._make_solvers()  # imports scipy and picks the first step outside the timing
 
     def advance_to(self, t: float) -> None:
+        if self.driven:  # stop at each impulse, jump, restart the solvers there
+            while self._next < len(self.impulses) and self.impulses[self._next].t <= t:
+                t_impulse = self.impulses[self._next].t
+                if t_impulse > self.t:
+                    self._advance_solvers(t_impulse)
+                self._apply_impulses_at(t_impulse)
+                self._solvers = self._make_solvers() if t_impulse < self.t_end else None
+        if t > self.t:
+            self._advance_solvers(t)
+
+    def _advance_solvers(self, t: float) -> None:
         if self._solvers is None:
             self._solvers = self._make_solvers()
         for b, solver in enumerate(self._solvers):
@@ -97,7 +129,8 @@ class ScipyStepper(Stepper):
                 self.y[b] = solver.y
             else:
                 self.y[b] = solver.dense_output()(t)
-        self.evaluations = sum(s.nfev for s in self._solvers)
+        self.evaluations += sum(s.nfev for s in self._solvers) - self._counted
+        self._counted = sum(s.nfev for s in self._solvers)
         self.t = t
 
     def finite(self) -> bool:
@@ -113,8 +146,10 @@ class ScipyStepper(Stepper):
             return self.field.outputs(self.outputs, self.y[:, :n], self.y[:, n:], self.t)
 
         M = self.y[:, :3]
-        R = self.y[:, 3:].reshape(-1, 3, 3) if self.with_R else None
-        return rigid_body_outputs(self.outputs, M, R, np.asarray(self.problem.inertia), gravity_weight(self.problem))
+        R = self.y[:, 3:12].reshape(-1, 3, 3) if self.with_R else None
+        work = self.y[:, -1] if self.driven else None
+        return rigid_body_outputs(self.outputs, M, R, np.asarray(self.problem.inertia), gravity_weight(self.problem),
+                                  work)
 
     def drift(self) -> float:
         if hasattr(self, "analysed"):
@@ -140,6 +175,28 @@ def _rigid_body_rhs(problem, with_R: bool):
 
         return heavy, (i1, i2, i3)
     return (lean_rhs_full if with_R else lean_rhs_M), (i1, i2, i3)
+
+
+def _driven_rhs(free, problem, with_R: bool):
+    """The right-hand side ``free`` plus the external torque ``N`` (body frame, on ``dM/dt``)
+    and the rate of work ``dW/dt = N·Omega`` (the last component of ``y``)."""
+    inertia = np.asarray(problem.inertia, dtype=float)
+    torque = problem.torque
+    identity = np.eye(3)
+
+    def driven(t, y, *args):
+        dy = np.empty_like(y)
+        dy[:-1] = free(t, y[:-1], *args)
+        if torque is None:
+            dy[-1] = 0.0
+            return dy
+        R = y[3:12].reshape(3, 3) if with_R else identity
+        N = torque.evaluate(y[:3], R, t, inertia)
+        dy[:3] += N
+        dy[-1] = float(N @ (y[:3] / inertia))
+        return dy
+
+    return driven
 
 
 def _factory(method: Method, problem, outputs, options) -> Stepper:
