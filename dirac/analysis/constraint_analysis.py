@@ -117,7 +117,7 @@ class ConstraintAnalysis:
         self._generic = _generic_parameter_values(lagrangian, rng)
         legendre = legendre_transform(lagrangian, rng, self._generic)
         self._legendre = legendre
-        done(f"Legendre transform: Hessian rank {legendre.rank}, {len(legendre.primary)} primary constraint(s)")
+        done(f"Legendre transform: Hessian rank {legendre.rank}, {_count(len(legendre.primary), 'primary constraint')}")
         space = legendre.phase_space
         self._space = space
         self.coordinates = space.coordinates
@@ -140,10 +140,9 @@ class ConstraintAnalysis:
         chain.holonomic = {e: k for k, e in enumerate(expanded, start=1)}
         chain.run()
         self._chain = chain
-        done(
-            f"constraint chain: {len(chain.stages)} stage(s) of sizes "
-            f"{', '.join(str(len(stage)) for stage in chain.stages) or '-'}, {len(chain.constraints)} constraint(s)"
-        )
+        done(f"constraint chain: {_count(len(chain.stages), 'stage')} "
+             f"(sizes {', '.join(str(len(stage)) for stage in chain.stages) or '-'}), "
+             f"{_count(len(chain.constraints), 'constraint')}")
         self.primary_constraints = list(chain.primary)
         self.total_hamiltonian = chain.total_hamiltonian
         self.stages = chain.stages
@@ -503,6 +502,11 @@ class ConstraintAnalysis:
             f"<ConstraintAnalysis {self.name!r}: stages {counts}, {len(self.first_class)} first class, "
             f"{len(self.second_class)} second class, {self.physical_degrees_of_freedom} degrees of freedom>"
         )
+
+
+def _count(number: int, noun: str) -> str:
+    """``1 stage``, ``4 stages``."""
+    return f"{number} {noun}{'' if number == 1 else 's'}"
 
 
 def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:

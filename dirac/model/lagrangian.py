@@ -235,6 +235,11 @@ class Lagrangian:
             raise InputError("coordinates must be a list of names, e.g. ['x', 'y']")
         if isinstance(constraints, str):
             raise InputError("constraints must be a list of expressions, e.g. ['x**2 + y**2 - l**2']")
+        if parameters is not None and not isinstance(parameters, Mapping):
+            raise InputError(
+                f"parameters must be a mapping name -> value, e.g. {{'m': 1.0, 'g': 9.81}} (None for a parameter "
+                f"without a value), not a {type(parameters).__name__}"
+            )
         parameters = dict(parameters or {})
         labels = [str(c) for c in coordinates]
         if TIME.name in parameters and TIME.name not in labels:
@@ -251,9 +256,17 @@ class Lagrangian:
         constraints = list(constraints)
         _check_names(q, v, tuple(psyms.values()), len(constraints))
         names = {s.name: s for s in (*q, *v, *psyms.values())}
-        expr = parse_expression(lagrangian, names, what="lagrangian", time=TIME)
+        add = "if it is a parameter, add it to parameters (with its value)"
+        expr = parse_expression(lagrangian, names, what="lagrangian", time=TIME, unknown_hint=add)
+        positions = {s.name: s for s in (*q, *psyms.values())}  # a constraint chi(q, t) has no velocities
+        holonomic = {
+            s.name: "it is a velocity, and only holonomic constraints chi(q, t) = 0 are supported: write the "
+            "constraint in the coordinates, parameters and t alone"
+            for s in v
+        }
         chis = tuple(
-            parse_expression(text, names, what=f"constraint {k}", time=TIME) for k, text in enumerate(constraints, start=1)
+            parse_expression(text, positions, what=f"constraint {k}", time=TIME, refused=holonomic, unknown_hint=add)
+            for k, text in enumerate(constraints, start=1)
         )
         values = {psyms[label]: (None if value is None else value) for label, value in parameters.items()}
         for label, value in parameters.items():
