@@ -12,8 +12,8 @@ factories are joined here, so neither of those modules imports the other.
 
 from __future__ import annotations
 
-from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
 from dirac.errors import InputError
+from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
 from dirac.flows.methods.base import Method
 from dirac.validate import unknown_name_error
 
