@@ -256,7 +256,7 @@ class Lagrangian:
         constraints = list(constraints)
         _check_names(q, v, tuple(psyms.values()), len(constraints))
         names = {s.name: s for s in (*q, *v, *psyms.values())}
-        add = "if it is a parameter, add it to parameters (with its value)"
+        add = "if it is a parameter, add it to parameters (with its value); if a coordinate, to coordinates"
         expr = parse_expression(lagrangian, names, what="lagrangian", time=TIME, unknown_hint=add)
         positions = {s.name: s for s in (*q, *psyms.values())}  # a constraint chi(q, t) has no velocities
         holonomic = {

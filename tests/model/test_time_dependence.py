@@ -73,7 +73,8 @@ def test_t_as_a_parameter_is_refused_from_symbols_too():
 
 def test_unknown_name_message_lists_the_declared_names_only():
     with pytest.raises(InputError, match=r"unknown name 's'; if it is a parameter, add it to parameters \(with its "
-                                         r"value\); the names allowed here are: x, x_dot$"):
+                                         r"value\); if a coordinate, to coordinates; the names allowed here are: "
+                                         r"x, x_dot$"):
         Lagrangian.from_strings("bad", ["x"], "x_dot**2/2 - s*x")
 
 
