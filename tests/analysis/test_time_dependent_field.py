@@ -142,3 +142,15 @@ def test_velocities_and_momenta_are_refused_with_a_reason(hoop, suspension):
         analysis.momenta({"u": 0.0}, {"u_dot": 1.0}, t=0.0)
     with pytest.raises(InputError, match="not both"):
         analysis.surface_point({"u": 0.0, "y": -0.8, "u_dot": 1.0, "p_u": 1.0})
+
+
+def test_velocities_of_a_singular_lagrangian_are_refused_not_guessed():
+    """The gauge system's L = ((x_dot - y z)^2 + (y_dot + x z)^2)/2 - k r^2/2 has no z_dot:
+    the momenta do not fix z_dot (a gauge freedom), so velocities() refuses."""
+    analysis = dirac.analyze(dirac.load_system("gauge_system"))
+    point = {"x": 1.0, "y": 0.0, "z": 0.0, "p_x": 0.0, "p_y": 0.5, "p_z": 0.0}
+    with pytest.raises(InputError, match="singular.*do not determine every velocity"):
+        analysis.velocities(point)
+    # the momenta themselves are defined: p_x = x_dot - y z, p_y = y_dot + x z, p_z = 0
+    assert analysis.momenta({"x": 1.0, "y": 2.0, "z": 0.5}, {"x_dot": 0.3, "y_dot": -0.1, "z_dot": 7.0}) == \
+        pytest.approx({"p_x": 0.3 - 2.0 * 0.5, "p_y": -0.1 + 1.0 * 0.5, "p_z": 0.0})
