@@ -166,7 +166,7 @@ def constrained_figure(
         panel = fig.add_subplot(grid[1, :])
         draw_conservation(panel, t, errors, ylabel="error (see legend)", time_label=_TIME)
         if not energy_conserved:
-            panel.set_title("Constraint residuals and conserved quantities over time "
-                            "(the energy changes: the system depends on time)", fontsize=11)
+            drawn = "Constraint residuals and conserved quantities" if conserved else "Constraint residuals"
+            panel.set_title(f"{drawn} over time (the energy changes: the system depends on time)", fontsize=11)
     fig.suptitle(title or "Constrained system", fontsize=12)
     return fig
