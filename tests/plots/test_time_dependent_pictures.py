@@ -130,3 +130,17 @@ def test_a_two_coordinate_system_keeps_a_plane_path_and_conserved_energy():
     assert path.name == "rectilinear"
     (panel,) = [ax for ax in fig.axes if ax.get_title() == "Conserved quantities: error over time"]
     assert not [line for line in panel.get_lines() if "not conserved" in line.get_label()]
+
+
+def test_without_a_conserved_combination_the_panel_claims_none():
+    """A driven system without a Jacobi integral (say a moving suspension): the energy is
+    labelled not conserved, and the panel's title names only the residuals."""
+    from dirac.plots.constrained import constrained_figure
+
+    t = np.linspace(0.0, 1.0, 11)
+    q = np.column_stack([np.sin(t), -np.cos(t)])
+    fig = constrained_figure(t, q, energy=1.0 + t, constraint_residual=1e-15 + 0 * t, energy_conserved=False)
+    (panel,) = [ax for ax in fig.axes if "over time" in ax.get_title() and "Coordinates" not in ax.get_title()]
+    assert panel.get_title() == "Constraint residuals over time (the energy changes: the system depends on time)"
+    (energy,) = [k for k in _curves(panel) if k.startswith("energy")]
+    assert energy.endswith("(not conserved: the system depends on time)")
