@@ -53,22 +53,25 @@ def _name_of(coordinate: sympy.Basic) -> str:
     return coordinate.name if isinstance(coordinate, sympy.Symbol) else type(coordinate).__name__
 
 
-def _engine_time(exprs: Sequence[sympy.Basic], coordinates: Sequence[sympy.Basic]) -> dict[sympy.Symbol, sympy.Symbol]:
-    """Every time symbol of ``exprs`` and ``coordinates`` -> :data:`TIME`, for ``xreplace``.
+def _engine_time(coordinates: Sequence[sympy.Basic]) -> Callable[[sympy.Basic], sympy.Basic]:
+    """The function that writes every time symbol of an expression as :data:`TIME`.
 
     The time symbols are the argument of the coordinates ``q(t)`` (``dynamicsymbols._t``,
     a ``t`` without ``real=True``, or any other name) and every symbol named ``t`` (with
-    whatever assumptions), unless a coordinate is called ``t``. Replacing them inside the
-    coordinates as well keeps ``q(t)`` and ``d q(t)/dt`` recognisable when the user
-    substituted a real ``t`` for sympy's (``x(t)`` then reads ``x(T)``).
+    whatever assumptions), unless a coordinate is called ``t`` (then nothing changes).
+    Applied to the coordinates as well, it keeps ``q(t)`` and ``d q(t)/dt`` recognisable
+    when the user substituted a real ``t`` for sympy's (``x(t)`` then reads ``x(T)``).
     """
     if any(_name_of(c) == TIME.name for c in coordinates):
-        return {}
-    found: set[sympy.Symbol] = set()
-    for e in (*exprs, *coordinates):
-        found |= {s for s in sympy.sympify(e).free_symbols if isinstance(s, sympy.Symbol)}
+        return lambda e: e
     times = {_time_of(c) for c in coordinates} - {None}
-    return {s: TIME for s in found if s.name == TIME.name or s in times}
+
+    def timed(e: sympy.Basic) -> sympy.Basic:
+        e = sympy.sympify(e)
+        return e.xreplace({s: TIME for s in e.free_symbols
+                           if isinstance(s, sympy.Symbol) and (s.name == TIME.name or s in times)})
+
+    return timed
 
 
 def plain_parts(
@@ -114,10 +117,8 @@ def plain_parts(
     time_names = {t.name for t in (_time_of(c) for c in coordinates) if t is not None}
     if len(time_names) > 1:
         raise InputError(f"the coordinates depend on different time symbols {sorted(time_names)}: use one")
-    to_time = _engine_time((expr, *chis), coordinates)
-    if to_time:
-        expr, chis = expr.xreplace(to_time), [c.xreplace(to_time) for c in chis]
-        coordinates = [c.xreplace(to_time) for c in coordinates]
+    timed = _engine_time(coordinates)
+    coordinates = [timed(c) for c in coordinates]
     times = {_time_of(c) for c in coordinates} - {None}
     labels = [_name_of(c) for c in coordinates]
     duplicates = sorted({label for label in labels if labels.count(label) > 1})
@@ -131,6 +132,8 @@ def plain_parts(
     functions = {c: q[label] for c, label in zip(coordinates, labels) if _time_of(c) is not None}
 
     def plain(e: sympy.Expr) -> sympy.Expr:
+        """``e`` in the engine's symbols: its time is :data:`TIME`, ``q(t)`` is ``q``, ``q(t).diff(t)`` is ``q_dot``."""
+        e = timed(e)
         return e.subs(derivatives).subs(functions) if derivatives else e
 
     expr = plain(expr)
