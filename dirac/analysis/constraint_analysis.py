@@ -23,9 +23,9 @@ from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsol
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
 from dirac.analysis.legendre.regularity import regular_holonomic
 from dirac.analysis.legendre.transform import legendre_transform
-from dirac.analysis.legendre_map import LegendreMap, MomentumSymbols
 from dirac.analysis.report import to_json, to_latex, to_text
 from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian, momentum_name, velocity_name
@@ -406,7 +406,7 @@ class ConstraintAnalysis:
         ``point`` holds the coordinates and their momenta (e.g. a :meth:`surface_point`;
         for a system whose momenta depend on the time, ``t`` is read from it unless
         given). Parameters at their defaults. Inverse of ``analysis.momenta(q, q_dot)``;
-        see :mod:`dirac.analysis.legendre_map`.
+        see :mod:`dirac.analysis.legendre.numeric_map`.
 
         Raises
         ------
