@@ -46,6 +46,7 @@ __all__ = [
     "write_results",
     "read_results",
     "plot",
+    "TIME",
 ]
 
 #: public name -> module that defines it (imported on first access)
@@ -63,6 +64,7 @@ _LAZY: dict[str, str] = {
     "write_results": "dirac.io.results",
     "read_results": "dirac.io.results",
     "plot": "dirac.plots.results",
+    "TIME": "dirac.model.expressions",
 }
 
 

@@ -214,9 +214,17 @@ def validate_array(value: object, name: str, shape: Sequence[int] | None = None,
 
 
 def did_you_mean(name: str, known: Iterable[str]) -> str:
-    """`` (did you mean 'a' or 'b'?)`` with the names of ``known`` closest to ``name``
-    (:func:`difflib.get_close_matches`), or ``""`` when none is close."""
-    close = difflib.get_close_matches(str(name), sorted(set(map(str, known))), n=3)
+    """`` (did you mean 'a' or 'b'?)`` with the names of ``known`` closest to ``name``, or
+    ``""`` when none is close.
+
+    Names equal to ``name`` but for upper and lower case come first (``L`` -> ``l``), then
+    the closest by :func:`difflib.get_close_matches`; ``name`` itself is never suggested.
+    """
+    name = str(name)
+    names = sorted(set(map(str, known)) - {name})
+    same_letters = [k for k in names if k.lower() == name.lower()]
+    close = same_letters + [k for k in difflib.get_close_matches(name, names, n=3) if k not in same_letters]
+    close = close[:3]
     if not close:
         return ""
     return f" (did you mean {' or '.join(map(repr, close))}?)"

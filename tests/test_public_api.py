@@ -11,7 +11,16 @@ def test_every_public_name_resolves_and_is_not_a_module():
     for name in dirac.__all__:
         value = getattr(dirac, name)
         assert not inspect.ismodule(value), f"dirac.{name} is a module, not the public object"
-        assert callable(value), f"dirac.{name} is not callable"
+        assert callable(value) or name == "TIME", f"dirac.{name} is not callable"
+
+
+def test_time_is_the_real_symbol_t_the_engine_uses():
+    import sympy
+
+    from dirac.model.expressions import TIME
+
+    assert dirac.TIME is TIME and dirac.TIME == sympy.Symbol("t", real=True)
+    assert dirac.TIME != sympy.Symbol("t")  # sympy's plain t (and dynamicsymbols._t) is another symbol
 
 
 def test_unknown_attribute_is_an_attribute_error():

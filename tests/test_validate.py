@@ -158,7 +158,10 @@ def pendulum_problem_parts():
 def test_did_you_mean_offers_the_closest_known_names_or_nothing():
     from dirac.validate import did_you_mean
 
-    assert did_you_mean("samples", ["dt", "samples"]) == " (did you mean 'samples'?)"
+    assert did_you_mean("sampels", ["dt", "samples"]) == " (did you mean 'samples'?)"
+    assert did_you_mean("samples", ["dt", "samples"]) == ""  # never the name itself ("'auto' (did you mean 'auto'?)")
+    assert did_you_mean("L", ["g", "l", "m"]) == " (did you mean 'l'?)"  # upper and lower case first
+    assert did_you_mean("Theta", ["theta", "phi", "Thetas"]) == " (did you mean 'theta' or 'Thetas'?)"
     assert did_you_mean("sample", ["dt", "samples", "sample_rate"]) == " (did you mean 'samples' or 'sample_rate'?)"
     assert did_you_mean("colour", ["dt", "samples"]) == ""
 

@@ -23,11 +23,12 @@ from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsol
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
 from dirac.analysis.legendre.regularity import regular_holonomic
 from dirac.analysis.legendre.transform import legendre_transform
 from dirac.analysis.report import to_json, to_latex, to_text
 from dirac.errors import AnalysisError, InputError, warn
-from dirac.model.lagrangian import Lagrangian
+from dirac.model.lagrangian import Lagrangian, momentum_name, velocity_name
 
 if TYPE_CHECKING:  # imported where used: most analyses never ask for them (start-up time of the CLI)
     from dirac.analysis.brackets.vector_field import VectorField
@@ -116,11 +117,11 @@ class ConstraintAnalysis:
         self._generic = _generic_parameter_values(lagrangian, rng)
         legendre = legendre_transform(lagrangian, rng, self._generic)
         self._legendre = legendre
-        done(f"Legendre transform: Hessian rank {legendre.rank}, {len(legendre.primary)} primary constraint(s)")
+        done(f"Legendre transform: Hessian rank {legendre.rank}, {_count(len(legendre.primary), 'primary constraint')}")
         space = legendre.phase_space
         self._space = space
         self.coordinates = space.coordinates
-        self.momenta = space.momenta
+        self.momenta = MomentumSymbols(space.momenta, lambda q, q_dot, t: self._legendre_map().momenta(q, q_dot, t))
         self.phase_space = space.variables
         self.symbols = space.symbols
         self.parameters = tuple(lagrangian.parameters)
@@ -139,10 +140,9 @@ class ConstraintAnalysis:
         chain.holonomic = {e: k for k, e in enumerate(expanded, start=1)}
         chain.run()
         self._chain = chain
-        done(
-            f"constraint chain: {len(chain.stages)} stage(s) of sizes "
-            f"{', '.join(str(len(stage)) for stage in chain.stages) or '-'}, {len(chain.constraints)} constraint(s)"
-        )
+        done(f"constraint chain: {_count(len(chain.stages), 'stage')} "
+             f"(sizes {', '.join(str(len(stage)) for stage in chain.stages) or '-'}), "
+             f"{_count(len(chain.constraints), 'constraint')}")
         self.primary_constraints = list(chain.primary)
         self.total_hamiltonian = chain.total_hamiltonian
         self.stages = chain.stages
@@ -165,6 +165,7 @@ class ConstraintAnalysis:
         C2 = C[cls.second_indices, cls.second_indices] if cls.second_indices else sympy.zeros(0, 0)
         self._bracket = DiracBracket(space, self.second_class, C2, self._numerics, self._points, lagrangian.parameters)
         self._defaults_numerics: Numerics | None = None
+        self._legendre_numeric: LegendreMap | None = None
         done("Dirac bracket set up")
         s = len(self.second_class)
         if s == 0:
@@ -393,23 +394,48 @@ class ConstraintAnalysis:
         return vector_field(self, parameters, multipliers)
 
     # ------------------------------------------------------------------ points
+    def _legendre_map(self) -> LegendreMap:
+        """``p = dL/dq_dot`` and its inverse at the default parameter values (generated once)."""
+        if self._legendre_numeric is None:
+            self._legendre_numeric = LegendreMap(self.lagrangian, tuple(self.momenta), self.time)
+        return self._legendre_numeric
+
+    def velocities(self, point: Mapping[str, float], t: float | None = None) -> dict[str, float]:
+        """The velocities ``q_dot`` (names ``x_dot``) at a phase-space point: ``p = dL/dq_dot`` solved.
+
+        ``point`` holds the coordinates and their momenta (e.g. a :meth:`surface_point`;
+        for a system whose momenta depend on the time, ``t`` is read from it unless
+        given). Parameters at their defaults. Inverse of ``analysis.momenta(q, q_dot)``;
+        see :mod:`dirac.analysis.legendre.numeric_map`.
+
+        Raises
+        ------
+        InputError
+            Missing values, or a singular ``d^2 L/dq_dot^2`` at the point (the momenta do
+            not determine every velocity).
+        """
+        return self._legendre_map().velocities(point, t)
+
     def surface_point(self, values: Mapping[str, float] | None = None, seed: int | None = None) -> dict[str, float]:
         """A numeric point on the full constraint surface, completing the given values.
 
         Parameters are at their defaults (symbolic parameters without a default make this
         fail). Variables given in ``values`` are held fixed; the others are solved for
         (Gauss–Newton from a random start), e.g. given ``q`` and ``p`` this finds the
-        multipliers ``lambda`` (the fourth stage) and ``p_lambda = 0``. For a
+        multipliers ``lambda`` (the fourth stage) and ``p_lambda = 0``. Velocities may be
+        given instead of momenta (``x_dot``: then every coordinate is needed, velocities
+        not given are 0, and ``p = dL/dq_dot`` (205), :attr:`momenta`). For a
         time-dependent system the point is on the surface at the time ``t`` (given in
         ``values``, else 0), which the returned point includes.
 
         Raises
         ------
         InputError
-            Unknown names, parameters without default, or values that no point of the
-            surface has.
+            Unknown names, parameters without default, a velocity and its momentum both
+            given, or values that no point of the surface has.
         """
         values = dict(values or {})
+        values = self._momenta_from_velocities(values)
         self._space.check_names({k: v for k, v in values.items() if self.time is None or k != self.time.name}, "surface_point")
         missing = [p.name for p, v in self.lagrangian.parameters.items() if v is None]
         if missing:
@@ -440,6 +466,20 @@ class ConstraintAnalysis:
         named = (*self.phase_space, self.time) if self.time is not None else self.phase_space
         return {s.name: float(x) for s, x in zip(named, point)}
 
+    def _momenta_from_velocities(self, values: dict[str, float]) -> dict[str, float]:
+        """``values`` with the velocities (``x_dot``) given in it replaced by the momenta ``p = dL/dq_dot``."""
+        coordinates = [q.name for q in self.lagrangian.coordinates]
+        rates = {name: values.pop(name) for name in [velocity_name(c) for c in coordinates] if name in values}
+        if not rates:
+            return values
+        twice = [momentum_name(name[:-4]) for name in rates if momentum_name(name[:-4]) in values]
+        if twice:
+            raise InputError(f"surface_point: give a velocity or its momentum, not both ({', '.join(twice)} and its velocity)")
+        t = values.get(self.time.name, 0.0) if self.time is not None else None
+        momenta = self._legendre_map().momenta({c: values[c] for c in coordinates if c in values}, rates, t,
+                                               what="surface_point with velocities")
+        return {**values, **momenta}
+
     # ------------------------------------------------------------------ reports
     def to_json(self) -> dict:
         """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys)."""
@@ -462,6 +502,11 @@ class ConstraintAnalysis:
             f"<ConstraintAnalysis {self.name!r}: stages {counts}, {len(self.first_class)} first class, "
             f"{len(self.second_class)} second class, {self.physical_degrees_of_freedom} degrees of freedom>"
         )
+
+
+def _count(number: int, noun: str) -> str:
+    """``1 stage``, ``4 stages``."""
+    return f"{number} {noun}{'' if number == 1 else 's'}"
 
 
 def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:

@@ -93,21 +93,34 @@ def format_rows(rows: list[dict]) -> str:
 
 def format_targets(targets: list) -> str:
     """The performance targets (docs/performance.md): value, target, met or missed by how much."""
-    lines = ["\n== targets (each measured in this run; ratios against baselines of this run) =="]
+    lines = [
+        "\n== targets (each measured in this run; ratios against baselines of this run) ==",
+        "A target is the speed (or memory, or accuracy per CPU time) the project aims at (docs/performance.md).",
+        "'MISSED by 3.00x' means this figure is 3 times worse than its target on this machine under its present",
+        "load: that operation is slower than planned. Results are as accurate either way; timings vary with load.",
+    ]
+    counts = {"met": 0, "missed": 0, "not measured": 0}
     for t in targets:
-        if t.value is None:
-            status, value = "not measured", "-"
+        if t.value is None or t.met is None:
+            status, value = "not measured", "-" if t.value is None else f"{t.value:.3g} {t.unit}"
+            counts["not measured"] += 1
         else:
             value = f"{t.value:.3g} {t.unit}"
             if t.met:
                 status = "met"
+                counts["met"] += 1
             elif t.sense == "<=":
-                status = f"MISSED by {t.value / t.target:.2f}x"
+                status = f"MISSED by {t.value / t.target:.2f}x (over the target: slower than planned)"
+                counts["missed"] += 1
             else:
-                status = f"MISSED by {t.target / t.value:.2f}x" if t.value > 0 else "MISSED"
+                status = (f"MISSED by {t.target / t.value:.2f}x (under the target: less gain than planned)"
+                          if t.value > 0 else "MISSED")
+                counts["missed"] += 1
         lines.append(f"- {t.name}: {value} (target {t.sense} {t.target:g} {t.unit}) -> {status}")
         if t.detail:
             lines.append(f"    {t.detail}")
+    lines.append(f"{counts['met']} of {len(targets)} targets met, {counts['missed']} missed, "
+                 f"{counts['not measured']} not measured")
     return "\n".join(lines)
 
 

@@ -27,11 +27,19 @@ scratch space at the same time.
 of its text and imports it (as :func:`dirac.codegen.numba_backend.generate_module`), so
 numba's on-disk cache keeps the machine code between runs. The module defines
 
-* ``field(t, z, params) -> ndarray``: ``z_dot`` at ``z`` (a fresh array of ``N``);
+* ``field(t, z, params) -> ndarray``: ``z_dot`` at ``z`` (a fresh array of ``N``); for a
+  field with an explicit time (``time=``) it first writes ``t`` into ``params[TIME]``;
 * ``field_into(z, params, out)``: the same into ``out``;
 * ``field_batch(Z, params, OUT)``: rows of ``Z`` (B, N) into rows of ``OUT``;
 * ``residual(z, params, out)`` and ``residual_batch(Z, params, OUT)``: the values of the
   constraints given as ``residual_expressions``.
+
+With an explicit time ``t`` (a rheonomic system: ``H`` and ``Phi`` depend on ``t``), ``t`` is
+one of the parameters, read from ``params[TIME]`` like the others, and the right side of
+the solve gets the partial time derivative of the constraints, so that the motion stays on
+the moving surface (Gitman–Tyutin; Dirac, *Lectures*):
+
+    z_dot = J g - J D^T x,    C x = D J g + d_t Phi.
 
 A singular ``C`` (off the constraint surface, or at a point where the constraints are
 not second class) gives ``inf`` or ``NaN`` entries (numba's ``error_model="numpy"``),
@@ -219,6 +227,7 @@ def vector_field_source(
     residual_expressions: Sequence[sympy.Expr] = (),
     title: str = "Dirac vector field",
     unroll_limit: int = UNROLL_LIMIT,
+    time: sympy.Symbol | None = None,
 ) -> str:
     """Python source of the compiled Dirac vector field (see the module docstring).
 
@@ -243,6 +252,10 @@ def vector_field_source(
         Largest number of source lines of the unrolled elimination; a larger one (large
         ``C`` with much fill-in, e.g. the 24 second-class constraints of a rigid body)
         is replaced by the looped solve, which compiles in a fraction of the time.
+    time
+        The explicit time ``t`` of a rheonomic system, one of ``parameters`` (its slot in
+        ``params`` is ``TIME``, which ``field(t, z, params)`` fills): the solve gets
+        ``d_t Phi`` on its right side. ``None`` (an autonomous field): ``TIME = -1``.
 
     Returns
     -------
@@ -254,6 +267,9 @@ def vector_field_source(
     scratch = len(parameters)  # where the scratch space of the looped solve starts in params
     if N % 2:
         raise ValueError(f"a canonical phase space has an even dimension, not {N}")
+    if time is not None and time not in parameters:
+        raise ValueError(f"the time {time} must be one of the parameters")
+    time_slot = -1 if time is None else list(parameters).index(time)
     n = N // 2
     k = len(second_class)
     gradient = [sympy.diff(hamiltonian, s) for s in z]
@@ -271,6 +287,12 @@ def vector_field_source(
             if d != 0:
                 wanted.append(d)
                 slots.append(("d", a, i))
+    if time is not None:  # d_t Phi_a of a rheonomic constraint
+        for a, phi in enumerate(second_class):
+            derivative = sympy.diff(phi, time)
+            if derivative != 0:
+                wanted.append(derivative)
+                slots.append(("t", a, 0))
     code = straight_line(inputs, wanted, "math", "cse", title)
     lines = _Lines()
     lines.add(f"if z.shape[0] != {N} or out.shape[0] != {N}:")
@@ -284,13 +306,16 @@ def vector_field_source(
     lines.lines.extend(code.body())
     g_name: list[str | None] = [None] * N
     d_name: list[list[str | None]] = [[None] * N for _ in range(k)]
+    t_name: list[str | None] = [None] * k
     for (kind, a, i), value in zip(slots, code.outputs):
-        name = f"g{a}_" if kind == "g" else f"d{a}_{i}_"
+        name = {"g": f"g{a}_", "d": f"d{a}_{i}_", "t": f"e{a}_"}[kind]
         lines.add(f"{name} = {value}")
         if kind == "g":
             g_name[a] = name
-        else:
+        elif kind == "d":
             d_name[a][i] = name
+        else:
+            t_name[a] = name
     # J g: (J g)_i = g_{n+i}, (J g)_{n+i} = -g_i
     correction: list[str | None] = [None] * N
     scratch_size = [0]
@@ -307,9 +332,10 @@ def vector_field_source(
                     lines.add(f"C{b}_{a}_ = -C{a}_{b}_")
                     C[a][b], C[b][a] = f"C{a}_{b}_", f"C{b}_{a}_"
         rhs: list[str | None] = []
-        for a in range(k):
+        for a in range(k):  # b_a = (D J g)_a + d_t Phi_a
             entry = _sum([term for i in range(n) for term in (
-                ("+", _product(d_name[a][i], g_name[n + i])), ("-", _product(d_name[a][n + i], g_name[i])))])
+                ("+", _product(d_name[a][i], g_name[n + i])), ("-", _product(d_name[a][n + i], g_name[i])))]
+                + [("+", t_name[a])])
             if entry is not None:
                 lines.add(f"b{a}_ = {entry}")
             rhs.append(f"b{a}_" if entry is not None else None)
@@ -351,6 +377,8 @@ def vector_field_source(
         f"K = {len(residual_expressions)}",
         f"#: entries of params: {len(parameters)} values, then {scratch_size[0]} of scratch space for the solve",
         f"PARAMS = {len(parameters) + scratch_size[0]}",
+        "#: the entry of params that holds the time t (-1: the field does not depend on t)",
+        f"TIME = {time_slot}",
         "",
         "",
         *solver_source,
@@ -362,7 +390,9 @@ def vector_field_source(
         "",
         decorated("field"),
         "def field(t, z, params):",
-        '    """z_dot at z as a new array (t is not used: the field is autonomous)."""',
+        ('    """z_dot at z as a new array (t is not used: the field is autonomous)."""' if time is None else
+         '    """z_dot at z and the time t (written into params[TIME]) as a new array."""'),
+        *([] if time is None else ["    params[TIME] = t"]),
         "    out = np.empty(N)",
         "    field_into(z, params, out)",
         "    return out",

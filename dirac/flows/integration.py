@@ -406,6 +406,8 @@ class _Loop:
                 self._check()
                 bar.update(n)
             self.t_now = float(self.times[first + index])
+            if hasattr(self.stepper, "time"):  # the state's time is the sample's, not a sum of steps that drifts
+                self.stepper.time = self.t_now
             if index == len(intervals) - 1:
                 self._check(final=True)
             self._keep(first + index, self.stepper.observe())

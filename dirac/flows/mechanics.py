@@ -67,6 +67,20 @@ def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] |
     return {k: float(v) for k, v in values.items() if v is not None}
 
 
+def _rotation(lagrangian: Lagrangian, values: Mapping[str, float]) -> tuple[int, int, float, str] | None:
+    """``(i, j, w, "H - w (...)")`` of uniformly turning constraints at these parameter values, else None."""
+    from dirac.model.rotating_frame import uniform_rotation
+
+    found = uniform_rotation(lagrangian)
+    if found is None:
+        return None
+    rate = found.rate.subs({s: values[s.name] for s in found.rate.free_symbols if s.name in values})
+    if rate.free_symbols:
+        return None
+    names = tuple(q.name for q in lagrangian.coordinates)
+    return found.first, found.second, float(rate), found.label(names, f"{float(rate):g}")
+
+
 @dataclass
 class MechanicalSystem:
     """Numerical pieces of a natural mechanical system with holonomic constraints.
@@ -91,6 +105,11 @@ class MechanicalSystem:
         The mass matrix when it depends on neither ``q`` nor ``t`` (fast RATTLE path).
     time_symbol : sympy.Symbol or None
         The time of a time-dependent system, else None.
+    rotation : tuple or None
+        ``(i, j, w, text)`` when the constraints turn uniformly at the rate ``w`` in the
+        plane of coordinates ``i, j`` (:func:`dirac.model.rotating_frame.uniform_rotation`):
+        the energy is not conserved, the Jacobi integral ``H - w (q_i p_j - q_j p_i)``
+        (``text``) is; else None.
     """
 
     name: str
@@ -103,6 +122,7 @@ class MechanicalSystem:
     module: Any = field(repr=False, default=None)
     time_symbol: sympy.Symbol | None = field(repr=False, default=None)
     symbolic: dict[str, object] = field(repr=False, default_factory=dict)
+    rotation: tuple[int, int, float, str] | None = field(repr=False, default=None)
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -206,6 +226,7 @@ class MechanicalSystem:
             time_symbol=time,
             symbolic={"mass": mass, "potential": potential, "constraints": chis, "coordinates": q,
                       "parameters": parameter_symbols},
+            rotation=_rotation(lagrangian, values),
         )
         return system
 

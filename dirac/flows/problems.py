@@ -33,7 +33,19 @@ if TYPE_CHECKING:
     from dirac.flows.torques import Torque
     from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem"]
+__all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem", "OffSurfaceError"]
+
+
+class OffSurfaceError(InputError):
+    """Initial data of a :class:`ConstrainedProblem` off the constraint surface.
+
+    ``detail`` says what is off; the message adds the advice for Python
+    (``project=True``); a scene re-raises it with its own (``project = true``).
+    """
+
+    def __init__(self, detail: str, advice: str) -> None:
+        super().__init__(f"{detail}; {advice}")
+        self.detail = detail
 
 
 @runtime_checkable
@@ -215,7 +227,7 @@ class HeavyTopProblem(RigidBodyProblem):
 
 @dataclass
 class ConstrainedProblem:
-    """A holonomically constrained mechanical system with initial positions and momenta.
+    """A holonomically constrained mechanical system with initial positions and momenta (or velocities).
 
     Parameters
     ----------
@@ -223,23 +235,33 @@ class ConstrainedProblem:
         The system: a :class:`~dirac.model.lagrangian.Lagrangian` (compiled here with its
         default parameter values) or an already compiled ``MechanicalSystem``.
     q0 : array_like, shape (n,) or (B, n)
-        Initial coordinates, on the constraint surface ``chi(q) = 0``.
+        Initial coordinates, on the constraint surface ``chi(q, 0) = 0``.
     p0 : array_like, shape (n,) or (B, n)
-        Initial momenta, tangent: ``G(q) M(q)^{-1} p = 0`` (the third-stage constraints).
+        Initial momenta, tangent: ``G(q) M(q)^{-1} p + d_t chi = 0`` (the third-stage
+        constraints). Give ``p0`` or ``qdot0``.
     surface_tolerance : float
         Largest accepted constraint residual of the initial data (absolute, scaled by
-        ``1 + |q|^2``); use :meth:`MechanicalSystem.project` to put data on the surface.
+        ``1 + |q|^2``).
+    qdot0 : array_like, shape (n,) or (B, n), optional
+        Initial velocities instead of ``p0`` (as ``q_dot`` in a scene): ``p0 = M(q0, 0) qdot0``.
+    project : bool
+        Put the initial data on the constraint surface first (as ``project = true`` in a
+        scene): the closest point in the metric ``M`` (:meth:`MechanicalSystem.project`).
 
     Raises
     ------
     InputError
-        Wrong shapes, non-finite values, or initial data off the constraint surface.
+        Wrong shapes, non-finite values, neither or both of ``p0`` and ``qdot0``, or
+        initial data off the constraint surface (:class:`OffSurfaceError`) without
+        ``project=True``.
     """
 
     mechanics: MechanicalSystem | Lagrangian  # a MechanicalSystem once constructed
     q0: np.ndarray
-    p0: np.ndarray
+    p0: np.ndarray | None = None
     surface_tolerance: float = 1e-9
+    qdot0: np.ndarray | None = None
+    project: bool = False
     batched: bool = field(init=False, default=False)
 
     kind: ClassVar[str] = "constrained"
@@ -255,33 +277,45 @@ class ConstrainedProblem:
             mechanics = MechanicalSystem.from_lagrangian(mechanics)
         self.mechanics = mechanics
         n = mechanics.dimension
+        if (self.p0 is None) == (self.qdot0 is None):
+            raise InputError("give the initial momenta p0 or the initial velocities qdot0 (one of them), e.g. "
+                             "ConstrainedProblem(system, q0=[0.6, -0.8], qdot0=[0.0, 0.0])")
         q0, self.batched = _batched(validate_array(self.q0, "initial q", finite=False), 1, "q")
-        p0, _ = _batched(validate_array(self.p0, "initial p", finite=False), 1, "p")
-        for name, value in (("q", q0), ("p", p0)):
+        given, what = (self.p0, "p") if self.p0 is not None else (self.qdot0, "qdot")
+        rates, _ = _batched(validate_array(given, f"initial {what}", finite=False), 1, what)
+        for name, value in (("q", q0), (what, rates)):
             if value.shape[1] != n:
                 raise InputError(f"initial {name} has {value.shape[1]} entries; the system has {n} coordinates")
             if not np.all(np.isfinite(value)):
                 raise InputError(f"initial {name} has non-finite entries; give finite numbers")
-        if q0.shape[0] != p0.shape[0]:
-            raise InputError(f"{q0.shape[0]} initial q but {p0.shape[0]} initial p: give one p per q")
+        if q0.shape[0] != rates.shape[0]:
+            raise InputError(f"{q0.shape[0]} initial q but {rates.shape[0]} initial {what}: give one {what} per q")
+        p0 = rates if what == "p" else np.array([mechanics.mass_matrix(a) @ v for a, v in zip(q0, rates)])
+        if self.project:
+            pairs = [mechanics.project(a, b) for a, b in zip(q0, p0)]
+            q0, p0 = np.array([a for a, _ in pairs]), np.array([b for _, b in pairs])
         names = mechanics.coordinate_names
+        advice = "or pass project=True to put the data on the surface (the closest point in the metric M)"
         for b in range(q0.shape[0]):
             position, velocity = mechanics.residuals(q0[b], p0[b])
             scale = 1.0 + float(q0[b] @ q0[b])
             if np.any(np.abs(position) > self.surface_tolerance * scale):
                 worst = int(np.argmax(np.abs(position)))
-                raise InputError(
+                raise OffSurfaceError(
                     f"initial q {dict(zip(names, q0[b].tolist()))} is off the constraint surface: constraint "
-                    f"{worst + 1} = {position[worst]:.3g}; give q with chi(q) = 0, or set project = true in [initial]"
+                    f"{worst + 1} = {position[worst]:.3g}",
+                    f"give q with chi(q, 0) = 0, {advice}",
                 )
             pscale = scale * (1.0 + float(p0[b] @ p0[b]))
             if np.any(np.abs(velocity) > self.surface_tolerance * np.sqrt(pscale)):
                 worst = int(np.argmax(np.abs(velocity)))
-                raise InputError(
+                raise OffSurfaceError(
                     f"initial velocity is not tangent to the constraint surface: d(constraint {worst + 1})/dt = "
-                    f"{velocity[worst]:.3g}; give q_dot (or p) with d chi/dt = 0, or set project = true in [initial]"
+                    f"{velocity[worst]:.3g}",
+                    f"give qdot0 (or p0) with d chi/dt = 0, {advice}",
                 )
         self.q0, self.p0 = q0, p0
+        self.qdot0 = None  # the state is (q0, p0) from here on
 
     @property
     def system(self) -> str:

@@ -376,7 +376,7 @@ def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> 
 
 def _general_problem(system: dict, initial: dict, source: str, base: Path) -> ConstrainedProblem | AnalysedProblem:
     from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
-    from dirac.flows.problems import ConstrainedProblem
+    from dirac.flows.problems import ConstrainedProblem, OffSurfaceError
     from dirac.model.system_file import lagrangian_from_table
     from dirac.model.systems import load_system
 
@@ -431,6 +431,10 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
         q, p = mechanics.project(q, p)
     try:
         return ConstrainedProblem(mechanics, q, p)
+    except OffSurfaceError as exc:
+        what = "give q" if "initial q" in exc.detail else "give q_dot (or p)"
+        raise InputError(f"{source}: {exc.detail}; {what} on the constraint surface, or set project = true "
+                         "in [initial]") from None
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
 

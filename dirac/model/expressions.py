@@ -17,6 +17,7 @@ from collections.abc import Callable, Mapping
 import sympy
 
 from dirac.errors import InputError
+from dirac.validate import did_you_mean
 
 __all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS", "TIME"]
 
@@ -57,7 +58,13 @@ _MAX_EXPONENT = 1000
 
 
 def parse_expression(
-    text: str, names: Mapping[str, sympy.Symbol], *, what: str = "expression", time: sympy.Symbol | None = None
+    text: str,
+    names: Mapping[str, sympy.Symbol],
+    *,
+    what: str = "expression",
+    time: sympy.Symbol | None = None,
+    refused: Mapping[str, str] | None = None,
+    unknown_hint: str = "",
 ) -> sympy.Expr:
     """Parse ``text`` into a sympy expression, allowing only the given ``names``.
 
@@ -74,6 +81,12 @@ def parse_expression(
         The time symbol, allowed under its own name (``t``) besides ``names`` when given
         (explicitly time-dependent Lagrangians and constraints); a name in ``names``
         takes precedence.
+    refused
+        Names that exist but are not allowed here -> why (e.g. velocities in a
+        constraint); the error says so instead of "unknown name".
+    unknown_hint
+        Added to the error of an unknown name that is close to no allowed name (e.g.
+        "if it is a parameter, add it to parameters").
 
     Returns
     -------
@@ -101,19 +114,21 @@ def parse_expression(
         tree = ast.parse(stripped, mode="eval")
     except SyntaxError as exc:
         raise InputError(f"{what} {stripped!r} is not a valid expression: {exc.msg}") from None
+    listed = list(names)
     if time is not None and time.name not in names:
         names = {**names, time.name: time}
-        listed = [name for name in names if name != time.name]
-        return _Converter(names, what, stripped, listed).visit(tree.body)
-    return _Converter(names, what, stripped).visit(tree.body)
+    return _Converter(names, what, stripped, listed, dict(refused or {}), unknown_hint).visit(tree.body)
 
 
 class _Converter:
-    def __init__(self, names: Mapping[str, sympy.Symbol], what: str, text: str, listed: list[str] | None = None) -> None:
+    def __init__(self, names: Mapping[str, sympy.Symbol], what: str, text: str, listed: list[str],
+                 refused: dict[str, str], unknown_hint: str) -> None:
         self.names = names
-        self.listed = list(names) if listed is None else listed
+        self.listed = listed
         self.what = what
         self.text = text
+        self.refused = refused
+        self.unknown_hint = unknown_hint
 
     def fail(self, message: str) -> InputError:
         return InputError(f"{self.what} {self.text!r}: {message}")
@@ -136,8 +151,12 @@ class _Converter:
                 return ALLOWED_CONSTANTS[name]
             if name in ALLOWED_FUNCTIONS:
                 raise self.fail(f"function {name!r} is used without arguments")
+            if name in self.refused:
+                raise self.fail(f"{name!r} is not allowed here: {self.refused[name]}")
             known = ", ".join(sorted(self.listed)) or "(none)"
-            raise self.fail(f"unknown name {name!r}; the names allowed here are: {known}")
+            suggestion = did_you_mean(name, [*self.listed, *ALLOWED_CONSTANTS])
+            hint = f"; {self.unknown_hint}" if self.unknown_hint and not suggestion else ""
+            raise self.fail(f"unknown name {name!r}{suggestion}{hint}; the names allowed here are: {known}")
         if isinstance(node, ast.BinOp):
             op = _BINARY.get(type(node.op))
             if op is None:

@@ -10,9 +10,13 @@ real symbol ``q_dot``. A coordinate may be
 - a function of time ``q(t)`` (``dynamicsymbols("q")``): ``L`` writes its velocity as the
   time derivative ``q(t).diff(t)``, which becomes ``q_dot``, and ``q(t)`` becomes ``q``.
 
-An explicit time dependence is written with the real symbol ``t``
-(:data:`dirac.model.expressions.TIME`, ``sympy.Symbol("t", real=True)``); a symbol named
-``t`` never becomes a parameter.
+An explicit time dependence may be written with any symbol named ``t`` (``dirac.TIME``,
+``sympy.Symbol("t")``, or ``dynamicsymbols._t``, the time of ``dynamicsymbols``) and with
+the time symbol of the coordinates ``q(t)`` whatever its name: each becomes the engine's
+time :data:`dirac.TIME` (``sympy.Symbol("t", real=True)``), so ``cos(w*t)`` with sympy's
+``t`` is the engine's time and never a parameter. When a coordinate is called ``t`` (the
+coordinate time of a relativistic particle) there is no explicit time and ``t`` stays
+that coordinate.
 """
 
 from __future__ import annotations
@@ -47,6 +51,27 @@ def _time_of(coordinate: sympy.Basic) -> sympy.Symbol | None:
 
 def _name_of(coordinate: sympy.Basic) -> str:
     return coordinate.name if isinstance(coordinate, sympy.Symbol) else type(coordinate).__name__
+
+
+def _engine_time(coordinates: Sequence[sympy.Basic]) -> Callable[[sympy.Basic], sympy.Basic]:
+    """The function that writes every time symbol of an expression as :data:`TIME`.
+
+    The time symbols are the argument of the coordinates ``q(t)`` (``dynamicsymbols._t``,
+    a ``t`` without ``real=True``, or any other name) and every symbol named ``t`` (with
+    whatever assumptions), unless a coordinate is called ``t`` (then nothing changes).
+    Applied to the coordinates as well, it keeps ``q(t)`` and ``d q(t)/dt`` recognisable
+    when the user substituted a real ``t`` for sympy's (``x(t)`` then reads ``x(T)``).
+    """
+    if any(_name_of(c) == TIME.name for c in coordinates):
+        return lambda e: e
+    times = {_time_of(c) for c in coordinates} - {None}
+
+    def timed(e: sympy.Basic) -> sympy.Basic:
+        e = sympy.sympify(e)
+        return e.xreplace({s: TIME for s in e.free_symbols
+                           if isinstance(s, sympy.Symbol) and (s.name == TIME.name or s in times)})
+
+    return timed
 
 
 def plain_parts(
@@ -89,9 +114,12 @@ def plain_parts(
         raise InputError("constraints must be a list of sympy expressions, e.g. [x**2 + y**2 - l**2]")
     expr = sympy.sympify(L)
     chis = [sympy.sympify(c) for c in constraints]
+    time_names = {t.name for t in (_time_of(c) for c in coordinates) if t is not None}
+    if len(time_names) > 1:
+        raise InputError(f"the coordinates depend on different time symbols {sorted(time_names)}: use one")
+    timed = _engine_time(coordinates)
+    coordinates = [timed(c) for c in coordinates]
     times = {_time_of(c) for c in coordinates} - {None}
-    if len(times) > 1:
-        raise InputError(f"the coordinates depend on different time symbols {sorted(map(str, times))}: use one")
     labels = [_name_of(c) for c in coordinates]
     duplicates = sorted({label for label in labels if labels.count(label) > 1})
     if duplicates:
@@ -104,6 +132,8 @@ def plain_parts(
     functions = {c: q[label] for c, label in zip(coordinates, labels) if _time_of(c) is not None}
 
     def plain(e: sympy.Expr) -> sympy.Expr:
+        """``e`` in the engine's symbols: its time is :data:`TIME`, ``q(t)`` is ``q``, ``q(t).diff(t)`` is ``q_dot``."""
+        e = timed(e)
         return e.subs(derivatives).subs(functions) if derivatives else e
 
     expr = plain(expr)

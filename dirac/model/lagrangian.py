@@ -22,12 +22,14 @@ import math
 import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import sympy
 
 from dirac.errors import InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, TIME, parse_expression
 from dirac.model.from_sympy import plain_parts
+from dirac.model.lagranges_method import is_lagranges_method, lagranges_method_parts
 from dirac.validate import is_real_number, unknown_name_error, validate_finite
 
 __all__ = ["Lagrangian", "TIME", "velocity_name", "momentum_name", "multiplier_name", "latex_name", "latex_names"]
@@ -38,7 +40,10 @@ _IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 def _time_hint(unknown: set) -> str:
     """A hint when an unknown name is a time ``t`` other than :data:`TIME` (e.g. not real)."""
     if any(s.name == TIME.name for s in unknown):
-        return " (explicit time is the real symbol t: sympy.Symbol('t', real=True), dirac.model.lagrangian.TIME)"
+        return (
+            " (the engine's time is dirac.TIME, the real symbol sympy.Symbol('t', real=True): write t as dirac.TIME, "
+            "or build the system with Lagrangian.from_sympy, which takes any t, and dynamicsymbols, as time)"
+        )
     return ""
 
 
@@ -230,6 +235,11 @@ class Lagrangian:
             raise InputError("coordinates must be a list of names, e.g. ['x', 'y']")
         if isinstance(constraints, str):
             raise InputError("constraints must be a list of expressions, e.g. ['x**2 + y**2 - l**2']")
+        if parameters is not None and not isinstance(parameters, Mapping):
+            raise InputError(
+                f"parameters must be a mapping name -> value, e.g. {{'m': 1.0, 'g': 9.81}} (None for a parameter "
+                f"without a value), not a {type(parameters).__name__}"
+            )
         parameters = dict(parameters or {})
         labels = [str(c) for c in coordinates]
         if TIME.name in parameters and TIME.name not in labels:
@@ -246,9 +256,17 @@ class Lagrangian:
         constraints = list(constraints)
         _check_names(q, v, tuple(psyms.values()), len(constraints))
         names = {s.name: s for s in (*q, *v, *psyms.values())}
-        expr = parse_expression(lagrangian, names, what="lagrangian", time=TIME)
+        add = "if it is a parameter, add it to parameters (with its value); if a coordinate, to coordinates"
+        expr = parse_expression(lagrangian, names, what="lagrangian", time=TIME, unknown_hint=add)
+        positions = {s.name: s for s in (*q, *psyms.values())}  # a constraint chi(q, t) has no velocities
+        holonomic = {
+            s.name: "it is a velocity, and only holonomic constraints chi(q, t) = 0 are supported: write the "
+            "constraint in the coordinates, parameters and t alone"
+            for s in v
+        }
         chis = tuple(
-            parse_expression(text, names, what=f"constraint {k}", time=TIME) for k, text in enumerate(constraints, start=1)
+            parse_expression(text, positions, what=f"constraint {k}", time=TIME, refused=holonomic, unknown_hint=add)
+            for k, text in enumerate(constraints, start=1)
         )
         values = {psyms[label]: (None if value is None else value) for label, value in parameters.items()}
         for label, value in parameters.items():
@@ -259,8 +277,8 @@ class Lagrangian:
     @classmethod
     def from_sympy(
         cls,
-        L: sympy.Expr,
-        coordinates: Sequence[sympy.Basic],
+        L: sympy.Expr | Any,
+        coordinates: Sequence[sympy.Basic] | None = None,
         constraints: Iterable[sympy.Expr] = (),
         parameters: Mapping[sympy.Symbol | str, float | None] | Iterable[sympy.Symbol | str] | None = None,
         name: str = "system",
@@ -271,8 +289,15 @@ class Lagrangian:
         Coordinates are symbols ``q`` (velocities written as symbols named ``q_dot``) or
         functions of time ``q(t)`` from ``sympy.physics.mechanics.dynamicsymbols``
         (velocities written as ``q(t).diff(t)``, replaced by ``q_dot``; ``q(t)`` by ``q``).
-        ``parameters=None`` makes every other symbol a parameter without a default. See
+        ``parameters=None`` makes every other symbol a parameter without a default. Any
+        symbol named ``t`` and the time of ``dynamicsymbols`` (``dynamicsymbols._t``)
+        become the engine's time :data:`dirac.TIME`. See
         :func:`dirac.model.from_sympy.plain_parts`.
+
+        ``L`` may also be a ``sympy.physics.mechanics.LagrangesMethod`` (given alone,
+        without ``coordinates`` and ``constraints``): its Lagrangian, coordinates and
+        holonomic constraints are taken (:mod:`dirac.model.lagranges_method`); a
+        non-empty ``forcelist`` or non-holonomic constraints are refused.
 
         Examples
         --------
@@ -283,6 +308,14 @@ class Lagrangian:
         >>> print(Lagrangian.from_sympy(m / 2 * x.diff(t) ** 2 - k / 2 * x**2, [x], name="oscillator"))
         oscillator: L = -k*x**2/2 + m*x_dot**2/2
         """
+        if is_lagranges_method(L):
+            if coordinates is not None or constraints != ():
+                raise InputError("give a LagrangesMethod alone: its coordinates (lm.q) and constraints (hol_coneqs) "
+                                 "are taken from it")
+            L, coordinates, constraints = lagranges_method_parts(L)
+        elif coordinates is None:
+            raise InputError("from_sympy needs the coordinates, e.g. Lagrangian.from_sympy(L, [x, y]), "
+                             "or a sympy LagrangesMethod alone")
         return cls(name, *plain_parts(L, coordinates, constraints, parameters, velocity_name), description)
 
     # ----------------------------------------------------------------- derived views

@@ -84,18 +84,20 @@ def _constraint_residuals(result: Any, problem: Any) -> dict[str, np.ndarray] | 
     """Each constraint's residual along the run, by mathtext label, when ``problem`` can tell.
 
     ``problem.mechanics`` (a compiled holonomic system, duck-typed so that this layer imports
-    no engine module) gives ``residuals(q, p) -> (chi(q), G M^{-1} p)``: the position
-    constraints ``chi_a`` and their tangency conditions ``dchi_a/dt`` (the second-stage
-    constraints of the Dirac analysis, Sect. X), one curve each; the latter only when the run
-    kept the momenta ``p``.
+    no engine module) gives ``residuals(q, p, t) -> (chi(q, t), G M^{-1} p + d_t chi)``: the
+    position constraints ``chi_a`` and their total time derivatives ``dchi_a/dt`` (the
+    second-stage constraints of the Dirac analysis, Sect. X, with the partial time derivative
+    of a moving constraint), one curve each, each sample at its own time ``t``; the latter
+    only when the run kept the momenta ``p``.
     """
     mechanics = getattr(problem, "mechanics", None)
     if mechanics is None or not hasattr(mechanics, "residuals") or not _has(result, "q"):
         return None
     q = _first_body(_get(result, "q"), 2)
+    times = np.asarray(_get(result, "t"), dtype=float).reshape(-1)
     with_momenta = _has(result, "p")  # without p only the position constraints chi_a can be formed
     p = _first_body(_get(result, "p"), 2) if with_momenta else np.zeros_like(q)
-    pairs = [mechanics.residuals(a, b) for a, b in zip(q, p)]
+    pairs = [mechanics.residuals(a, b, float(time)) for a, b, time in zip(q, p, times)]
     if not pairs or np.asarray(pairs[0][0]).size == 0:
         return None
     chi = np.array([np.asarray(c, dtype=float) for c, _ in pairs])
@@ -109,6 +111,26 @@ def _constraint_residuals(result: Any, problem: Any) -> dict[str, np.ndarray] | 
     for a in range(tangent.shape[1] if with_momenta else 0):
         residuals[f"$|\\dot\\chi_{{{a + 1}}}|$ (velocity)"] = np.abs(tangent[:, a])
     return residuals
+
+
+def _energy_curves(result: Any, problem: Any) -> tuple[dict[str, np.ndarray] | None, bool]:
+    """``(extra curves, time_dependent)``: for a time-dependent system the energy is not conserved;
+    when its constraints turn uniformly (``problem.mechanics.rotation``, duck-typed) the Jacobi
+    integral ``J = H - w (q_i p_j - q_j p_i)`` is, and its relative change is drawn."""
+    mechanics = getattr(problem, "mechanics", None)
+    time_dependent = getattr(mechanics, "time_symbol", None) is not None
+    rotation = getattr(mechanics, "rotation", None)
+    if not time_dependent or rotation is None or not all(_has(result, k) for k in ("q", "p", "energy")):
+        return None, time_dependent
+    i, j, rate, text = rotation
+    q = _first_body(_get(result, "q"), 2)
+    p = _first_body(_get(result, "p"), 2)
+    J = _first_body(_get(result, "energy"), 1) - rate * (q[:, i] * p[:, j] - q[:, j] * p[:, i])
+    scale = abs(J[0])
+    label = text.replace("*", " ")
+    if scale > 0:
+        return {f"Jacobi integral $|J-J_0|/|J_0|$, J = {label} (conserved)": np.abs(J - J[0]) / scale}, True
+    return {f"Jacobi integral $|J-J_0|$ ($J_0=0$), J = {label} (conserved)": np.abs(J - J[0])}, True
 
 
 def _kind(result: Any, meta: Mapping[str, Any]) -> str:
@@ -199,9 +221,11 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem
     names = list(coordinates) if coordinates is not None else meta.get("coordinates")
     if names is None:
         names = getattr(getattr(problem, "mechanics", None), "coordinate_names", None)
+    conserved, time_dependent = _energy_curves(result, problem)
     return constrained_figure(t, q, energy=energy, constraint_residual=residual, names=names,
                               title=_title(meta, "constrained system", time_unit=""),
-                              constraints=_constraint_residuals(result, problem))
+                              constraints=_constraint_residuals(result, problem),
+                              energy_conserved=not time_dependent, conserved=conserved)
 
 
 def plot(solution: Any, problem: Any | None = None, *, coordinates: Sequence[str] | None = None) -> Any:

@@ -96,6 +96,10 @@ def test_missed_targets_are_reported_with_the_factor():
         Target("a", 2.6, "ms", 1.0, "<="), Target("b", 25.0, "x", 50.0, ">="), Target("c", None, "s", 1.0, "<="),
     ])
     assert "MISSED by 2.60x" in text and "MISSED by 2.00x" in text and "not measured" in text
+    # what a missed target means for the user is said, once, and the lines say which way it is missed
+    assert "slower than planned" in text and "Results are as accurate either way" in text
+    assert "MISSED by 2.60x (over the target" in text and "MISSED by 2.00x (under the target" in text
+    assert text.rstrip().endswith("0 of 3 targets met, 2 missed, 1 not measured")
 
 
 @pytest.mark.parametrize("flag,module", [("--stress", "dirac.commands.bench_stress"), ("--ensemble", "dirac.commands.bench_ensemble")])

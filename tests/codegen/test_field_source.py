@@ -116,3 +116,28 @@ def test_the_module_is_cached_on_disk_by_the_hash_of_its_source(linear_module):
     source = path.read_text(encoding="utf-8")
     assert linear_module.__name__ == f"dirac_gen_{hashlib.sha256(source.encode()).hexdigest()[:20]}"
     assert compile_vector_field(source) is linear_module
+
+
+def test_explicit_time_puts_the_partial_time_derivative_into_the_solve():
+    """A particle driven along q1 = c t^2/2 (the chain's Phi = (q1 - c t^2/2, p1 - c t)),
+    free along q2, with H = (p1^2 + p2^2)/2 + k q2: by hand q1_ddot = c (the driving), which
+    only the term d_t Phi in C x = {Phi, H} + d_t Phi gives ({Phi, H} alone gives p1_dot = 0);
+    q2 moves freely, p2_dot = -k. The time is the last parameter, written by field(t, ...)."""
+    q1, q2, p1, p2, cc, kk, tt = sympy.symbols("q1 q2 p1 p2 c k t", real=True)
+    H = (p1**2 + p2**2) / 2 + kk * q2
+    phi = [q1 - cc * tt**2 / 2, p1 - cc * tt]
+    module = compile_vector_field(vector_field_source((q1, q2, p1, p2), [cc, kk, tt], H, phi, phi,
+                                                      title="driven test field", time=tt))
+    assert module.TIME == 2
+    params = np.array([0.7, 0.3, 0.0])
+    for time in (0.0, 1.3, -2.0):
+        state = np.array([0.7 * time**2 / 2, 0.4, 0.7 * time, -1.1])  # on the surface at this time
+        rate = module.field(time, state, params)
+        assert params[2] == time  # field wrote the time into its slot
+        assert rate == pytest.approx([0.7 * time, -1.1, 0.7, -0.3], abs=1e-15)
+        residual = np.empty(2)
+        module.residual(state, params, residual)
+        assert residual == pytest.approx([0.0, 0.0], abs=1e-15)
+    autonomous = compile_vector_field(vector_field_source((q1, q2, p1, p2), [cc, kk], H.subs(tt, 0), [q1, p1],
+                                                          title="autonomous test field"))
+    assert autonomous.TIME == -1

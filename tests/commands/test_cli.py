@@ -101,8 +101,8 @@ def test_analyze_reports_its_stages_only_with_verbose(run_cli):
     assert (status, out) == default[:2]
     lines = err.splitlines()
     assert len(lines) == 4 and all(line.startswith("analyze: ") and line.endswith(" s)") for line in lines)
-    assert lines[0].startswith("analyze: Legendre transform: Hessian rank 2, 1 primary constraint(s) (")
-    assert lines[1].startswith("analyze: constraint chain: 4 stage(s) of sizes 1, 1, 1, 1, 4 constraint(s) (")
+    assert lines[0].startswith("analyze: Legendre transform: Hessian rank 2, 1 primary constraint (")
+    assert lines[1].startswith("analyze: constraint chain: 4 stages (sizes 1, 1, 1, 1), 4 constraints (")
     assert lines[2].startswith("analyze: classification: 0 first-class, 4 second-class (")
     assert lines[3].startswith("analyze: Dirac bracket set up (")
 

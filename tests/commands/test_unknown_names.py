@@ -62,8 +62,47 @@ def test_method_lists_in_errors_are_sorted(tmp_path, run_cli):
         (("analyze", "pendulum", "--param", "ll=2"),
          "error: system 'pendulum': unknown parameter 'll' (did you mean 'l'?); known parameters: g, l, m"),
         (("demo", "--method", "lie-poison-4"), "error: --method: unknown method 'lie-poison-4' (did you mean 'lie-poisson-4'"),
+        (("analyze", "pendulum", "--param", "L=2"),
+         "error: system 'pendulum': unknown parameter 'L' (did you mean 'l'?); known parameters: g, l, m"),
     ],
 )
 def test_command_line_typos_suggest_the_known_name(run_cli, argv, expected):
     status, _stdout, stderr = run_cli(*argv)
     assert one_error_line(status, stderr).startswith(expected)
+
+
+SYSTEM = """[system]
+name = "pendulum"
+coordinates = ["x", "y"]
+parameters = {{ m = 1.0, g = 9.81{extra} }}
+lagrangian = "{lagrangian}"
+constraints = ["{constraint}"]
+"""
+
+
+def _system(tmp_path: Path, lagrangian: str = "m/2*(x_dot**2 + y_dot**2) - m*g*y",
+            constraint: str = "x**2 + y**2 - l**2", extra: str = ", l = 1.0") -> Path:
+    path = tmp_path / "system.toml"
+    path.write_text(SYSTEM.format(lagrangian=lagrangian, constraint=constraint, extra=extra), encoding="utf-8")
+    return path
+
+
+def test_a_typo_inside_an_expression_gets_did_you_mean(tmp_path, run_cli):
+    system = _system(tmp_path, lagrangian="m/2*(x_dot**2 + yy_dot**2) - m*g*y")
+    line = one_error_line(*run_cli("analyze", str(system))[::2])
+    assert "unknown name 'yy_dot' (did you mean 'y_dot'" in line
+    assert "add it to parameters" not in line  # a typo, not a missing parameter
+
+
+def test_a_parameter_missing_from_parameters_is_named_with_the_fix(tmp_path, run_cli):
+    system = _system(tmp_path, extra="")
+    line = one_error_line(*run_cli("analyze", str(system))[::2])
+    assert "unknown name 'l'; if it is a parameter, add it to parameters" in line
+
+
+def test_a_constraint_lists_only_the_names_allowed_in_it(tmp_path, run_cli):
+    line = one_error_line(*run_cli("analyze", str(_system(tmp_path, constraint="x**2 + y**2 - ll**2")))[::2])
+    assert "unknown name 'll' (did you mean 'l'?); the names allowed here are: g, l, m, x, y" in line
+    assert "x_dot" not in line.split("allowed here are:")[1]  # constraints refuse velocities: not offered
+    line = one_error_line(*run_cli("analyze", str(_system(tmp_path, constraint="x**2 + y**2 - l**2 + x_dot")))[::2])
+    assert "'x_dot' is not allowed here: it is a velocity, and only holonomic constraints chi(q, t) = 0" in line

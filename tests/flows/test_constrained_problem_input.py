@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import dirac
@@ -13,3 +14,36 @@ def test_constrained_problem_accepts_a_lagrangian_directly():
     assert list(problem.mechanics.coordinate_names) == ["x", "y"]
     with pytest.raises(dirac.InputError, match="off the constraint surface"):
         dirac.ConstrainedProblem(pendulum, q0=[0.6, -0.7], p0=[0.0, 0.0])
+
+
+def test_velocities_are_taken_as_in_scenes(pendulum_system):
+    # pendulum m = 1, l = 1: p = m q_dot; a tangent velocity at (0.6, -0.8) is along (0.8, 0.6)
+    problem = dirac.ConstrainedProblem(pendulum_system, q0=[0.6, -0.8], qdot0=[0.8 * 1.5, 0.6 * 1.5])
+    assert problem.p0[0] == pytest.approx([1.2, 0.9], abs=1e-15)
+    with pytest.raises(dirac.InputError, match="p0 or the initial velocities qdot0"):
+        dirac.ConstrainedProblem(pendulum_system, q0=[0.6, -0.8])
+    with pytest.raises(dirac.InputError, match="one of them"):
+        dirac.ConstrainedProblem(pendulum_system, q0=[0.6, -0.8], p0=[0.0, 0.0], qdot0=[0.0, 0.0])
+
+
+def test_off_surface_data_are_refused_with_python_advice_or_projected(pendulum_system):
+    with pytest.raises(dirac.InputError, match="pass project=True") as refused:
+        dirac.ConstrainedProblem(pendulum_system, q0=[0.6, -0.7], qdot0=[0.0, 0.0])
+    assert "[initial]" not in str(refused.value)  # scene advice only in scenes
+    with pytest.raises(dirac.InputError, match="not tangent.*pass project=True"):
+        dirac.ConstrainedProblem(pendulum_system, q0=[0.6, -0.8], qdot0=[0.6, -0.8])
+    projected = dirac.ConstrainedProblem(pendulum_system, q0=[0.6, -0.7], qdot0=[0.6, -0.8], project=True)
+    q, p = projected.q0[0], projected.p0[0]
+    assert q @ q == pytest.approx(1.0, abs=1e-13) and q @ p == pytest.approx(0.0, abs=1e-13)
+    # M = identity: the closest point of the circle lies along q0, the tangent part of p is kept
+    assert q == pytest.approx(np.array([0.6, -0.7]) / np.hypot(0.6, 0.7), abs=1e-12)
+    tangent = np.array([q[1], -q[0]])
+    assert p == pytest.approx((np.array([0.6, -0.8]) @ tangent) * tangent, abs=1e-12)
+
+
+def test_scene_off_surface_advice_names_the_scene_option(tmp_path, run_cli):
+    scene = tmp_path / "off.toml"
+    scene.write_text('[system]\nname = "pendulum"\n[initial]\nq = { x = 0.6, y = -0.7 }\n[run]\nt_end = 1.0\n',
+                     encoding="utf-8")
+    status, _, stderr = run_cli("run", str(scene), "--no-progress")
+    assert status == 2 and "set project = true in [initial]" in stderr and "project=True" not in stderr

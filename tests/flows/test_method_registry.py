@@ -101,3 +101,9 @@ def test_a_constrained_system_named_like_a_built_in_problem_is_still_constrained
 def test_problem_kind_refuses_what_is_not_a_problem():
     with pytest.raises(InputError, match="cannot integrate a dict"):
         problem_kind({"kind": "rigid_body"})
+
+
+def test_get_method_auto_says_what_auto_is():
+    with pytest.raises(InputError, match="'auto' is not one method: it chooses one for each problem") as refused:
+        get_method("auto")
+    assert "did you mean" not in str(refused.value) and "rattle-2" in str(refused.value)

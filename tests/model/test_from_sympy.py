@@ -66,7 +66,7 @@ def test_parameters_none_makes_the_other_symbols_parameters_without_default():
 
 @pytest.mark.parametrize("make, message", [
     (lambda q, t: (q.diff(t, 2) + q.diff(t) ** 2, [q]), "no accelerations"),
-    (lambda q, t: (q.diff(t) ** 2 + t * q, [q]), "unknown names: t"),
+    (lambda q, t: (q.diff(t) ** 2 + q.func(sympy.Symbol("s")), [q]), "is not a coordinate"),
     (lambda q, t: (q.diff(t) ** 2, [q, q]), "listed twice"),
     (lambda q, t: (q.diff(t) ** 2, [q**2]), "must be a sympy Symbol or a function of time"),
 ])
@@ -75,3 +75,74 @@ def test_refusals_say_what_to_do(make, message):
     L, coordinates = make(q, dynamicsymbols._t)
     with pytest.raises(InputError, match=message):
         Lagrangian.from_sympy(L, coordinates)
+
+
+def test_sympys_time_is_the_engines_time():
+    # dynamicsymbols._t is Symbol('t') without real=True: it is the explicit time, not a parameter
+    x = dynamicsymbols("x")
+    t = dynamicsymbols._t
+    w, m = sympy.symbols("w m")
+    built = Lagrangian.from_sympy(m / 2 * x.diff(t) ** 2, [x], [x - sympy.cos(w * t)], {m: 1.0, w: 2.0})
+    assert built.time == dirac.TIME and built.is_time_dependent
+    assert built.constraints[0].free_symbols == {built.coordinates[0], dirac.TIME, built.parameter_symbols["w"]}
+    plain = Lagrangian.from_sympy(sympy.Symbol("x_dot") ** 2 / 2, [sympy.Symbol("x")], [sympy.Symbol("x") - sympy.Symbol("t")])
+    assert plain.constraints[0].free_symbols == {plain.coordinates[0], dirac.TIME} and plain.parameters == {}
+
+
+def test_a_real_t_substituted_for_sympys_keeps_the_coordinates():
+    # x(t).subs(t, T) with T real gives x(T): still the coordinate x and its velocity
+    x = dynamicsymbols("x")
+    t = dynamicsymbols._t
+    L = (x.diff(t) ** 2 / 2 + t * x).subs(t, dirac.TIME)
+    built = Lagrangian.from_sympy(L, [x.subs(t, dirac.TIME)])
+    x_, v_ = built.coordinates[0], built.velocities[0]
+    assert sympy.expand(built.expression - (v_**2 / 2 + dirac.TIME * x_)) == 0
+
+
+def test_a_coordinate_named_t_is_no_time():
+    t, t_dot, x = sympy.symbols("t t_dot x")
+    built = Lagrangian.from_sympy(t_dot**2 - x**2, [t, x])
+    assert built.time is None and not built.is_time_dependent
+
+
+def test_the_constructor_hint_names_the_public_time():
+    x, v = sympy.Symbol("x", real=True), sympy.Symbol("x_dot", real=True)
+    with pytest.raises(InputError, match=r"dirac\.TIME.*from_sympy"):
+        Lagrangian("s", (x,), (v,), v**2 / 2 - sympy.Symbol("t") * x)
+
+
+def hoop_method():
+    from sympy.physics.mechanics import LagrangesMethod
+
+    x, y, z = dynamicsymbols("x y z")
+    t = dynamicsymbols._t
+    m, g, R, w = sympy.symbols("m g R w")
+    L = m / 2 * (x.diff(t) ** 2 + y.diff(t) ** 2 + z.diff(t) ** 2) - m * g * z
+    return LagrangesMethod(L, [x, y, z], hol_coneqs=[x**2 + y**2 + z**2 - R**2, -sympy.sin(w * t) * x + sympy.cos(w * t) * y])
+
+
+def test_a_lagranges_method_gives_its_lagrangian_coordinates_and_constraints():
+    built = Lagrangian.from_sympy(hoop_method(), parameters={"m": 1.0, "g": 9.81, "R": 1.0, "w": 2.0})
+    by_hand = Lagrangian.from_strings("system", ["x", "y", "z"], "m/2*(x_dot**2 + y_dot**2 + z_dot**2) - m*g*z",
+                                      ["x**2 + y**2 + z**2 - R**2", "-sin(w*t)*x + cos(w*t)*y"],
+                                      {"m": 1.0, "g": 9.81, "R": 1.0, "w": 2.0})
+    assert built == by_hand
+
+
+def test_a_lagranges_method_with_forces_or_nonholonomic_constraints_is_refused():
+    from sympy.physics.mechanics import LagrangesMethod, Point, ReferenceFrame
+
+    x = dynamicsymbols("x")
+    t = dynamicsymbols._t
+    N = ReferenceFrame("N")
+    P = Point("P")
+    P.set_vel(N, x.diff(t) * N.x)
+    forced = LagrangesMethod(x.diff(t) ** 2 / 2, [x], forcelist=[(P, -x.diff(t) * N.x)], frame=N)
+    with pytest.raises(InputError, match="forces are not supported by this path yet"):
+        Lagrangian.from_sympy(forced)
+    y = dynamicsymbols("y")
+    rolling = LagrangesMethod((x.diff(t) ** 2 + y.diff(t) ** 2) / 2, [x, y], nonhol_coneqs=[x.diff(t) - y * y.diff(t)])
+    with pytest.raises(InputError, match="non-holonomic"):
+        Lagrangian.from_sympy(rolling)
+    with pytest.raises(InputError, match="alone"):
+        Lagrangian.from_sympy(hoop_method(), [x])

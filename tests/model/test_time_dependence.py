@@ -17,7 +17,7 @@ import sympy
 from sympy.physics.mechanics import dynamicsymbols
 
 from dirac.errors import InputError
-from dirac.model.lagrangian import Lagrangian
+from dirac.model.lagrangian import TIME, Lagrangian
 from dirac.model.system_file import read_system_file
 
 T = sympy.Symbol("t", real=True)
@@ -72,7 +72,9 @@ def test_t_as_a_parameter_is_refused_from_symbols_too():
 
 
 def test_unknown_name_message_lists_the_declared_names_only():
-    with pytest.raises(InputError, match=r"unknown name 's'; the names allowed here are: x, x_dot$"):
+    with pytest.raises(InputError, match=r"unknown name 's'; if it is a parameter, add it to parameters \(with its "
+                                         r"value\); if a coordinate, to coordinates; the names allowed here are: "
+                                         r"x, x_dot$"):
         Lagrangian.from_strings("bad", ["x"], "x_dot**2/2 - s*x")
 
 
@@ -84,10 +86,11 @@ def test_from_sympy_takes_the_real_time_symbol():
     assert T in forced.expression.free_symbols
 
 
-def test_from_sympy_never_makes_t_a_parameter_and_says_how_to_write_time():
-    xs, v, t = sympy.Symbol("x"), sympy.Symbol("x_dot"), sympy.Symbol("t")
-    with pytest.raises(InputError, match=r"unknown names: t \(explicit time is the real symbol t"):
-        Lagrangian.from_sympy(v**2 / 2 - t * xs, [xs], name="plain")
+def test_from_sympy_never_makes_t_a_parameter_it_is_the_time():
+    xs, v, t = sympy.Symbol("x"), sympy.Symbol("x_dot"), sympy.Symbol("t")  # t without real=True
+    system = Lagrangian.from_sympy(v**2 / 2 - t * xs, [xs], name="plain")
+    assert system.parameters == {} and system.is_time_dependent
+    assert system.expression.free_symbols == {system.coordinates[0], system.velocities[0], TIME}
 
 
 def test_system_file_accepts_t(tmp_path):

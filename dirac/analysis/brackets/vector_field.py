@@ -47,13 +47,18 @@ class Analysis(Protocol):
     undetermined_multipliers: list[sympy.Symbol]
     second_class: list[sympy.Expr]
     constraints: list[sympy.Expr]
+    time: sympy.Symbol | None
 
 
 class VectorField:
     """The compiled Dirac vector field of an analysed system (use ``analysis.vector_field()``).
 
-    ``f(t, y)`` is ``dy/dt`` at the state ``y`` (a float array of ``len(f.names)``), usable
-    as ``scipy.integrate.solve_ivp(f, ...)``; the field does not depend on ``t``.
+    ``f(t, y)`` is ``dy/dt`` at the state ``y`` (a float array of ``len(f.names)``) and the
+    time ``t``, usable as ``scipy.integrate.solve_ivp(f, ...)``. The field depends on ``t``
+    only for a time-dependent (rheonomic) system (:attr:`time_dependent`): there ``H`` and
+    the constraints depend on ``t``, and the solve has the partial time derivative of the
+    constraints, ``C x = {Phi, H} + d_t Phi``, so the motion stays on the moving surface
+    (as :meth:`ConstraintAnalysis.equations_of_motion`).
 
     At a point of the constraint surface ``f(t, y)`` is ``{z, H}_D`` (240) with the
     multipliers solved there. Off the surface it is the same formula evaluated at ``y``
@@ -79,9 +84,12 @@ class VectorField:
         Parameter name -> the value used.
     multipliers : dict
         Free multiplier name (``u_k`` of a first-class primary constraint) -> its value.
+    time_dependent : bool
+        Whether the field depends on ``t`` (then :meth:`batch` and :meth:`residual` need it).
     """
 
-    __slots__ = ("names", "constraints", "parameters", "multipliers", "_params", "_module", "_field", "dimension")
+    __slots__ = ("names", "constraints", "parameters", "multipliers", "_params", "_module", "_field", "dimension",
+                 "time_dependent")
 
     def __init__(self, names: tuple[str, ...], constraints: tuple[str, ...], parameters: dict[str, float],
                  multipliers: dict[str, float], params: np.ndarray, module: Any) -> None:
@@ -93,9 +101,10 @@ class VectorField:
         self._params = params
         self._module = module
         self._field = module.field
+        self.time_dependent = getattr(module, "TIME", -1) >= 0
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
-        """``dy/dt`` at ``y`` (a new array); ``t`` is not used."""
+        """``dy/dt`` at ``y`` and the time ``t`` (a new array); ``t`` is used only by a time-dependent field."""
         try:
             return self._field(t, y, self._params)
         except (TypeError, ValueError):  # not a C-contiguous float64 vector of N, or t not a float
@@ -117,27 +126,42 @@ class VectorField:
                              f"not {array.shape}")
         return array
 
-    def batch(self, Y: np.ndarray) -> np.ndarray:
-        """``dy/dt`` at each row of ``Y`` (shape (B, N)) -> shape (B, N); the loop runs compiled."""
+    def _at_time(self, t: float | None, what: str) -> np.ndarray:
+        """The parameter array with the time ``t`` written into its slot (a copy), for ``what``."""
+        if not self.time_dependent:
+            return self._params
+        if t is None:
+            raise InputError(f"the system depends on the time t: give it, f.{what}(..., t=...)")
+        params = self._params.copy()
+        params[self._module.TIME] = float(t)
+        return params
+
+    def batch(self, Y: np.ndarray, t: float | None = None) -> np.ndarray:
+        """``dy/dt`` at each row of ``Y`` (shape (B, N)) -> shape (B, N); the loop runs compiled.
+
+        ``t`` is the time of every row; a time-dependent field needs it.
+        """
         states = self._states(Y)
         out = np.empty_like(states)
-        self._module.field_batch(states, self._params, out)
+        self._module.field_batch(states, self._at_time(t, "batch"), out)
         return out
 
-    def residual(self, y: np.ndarray) -> np.ndarray:
+    def residual(self, y: np.ndarray, t: float | None = None) -> np.ndarray:
         """The constraint values at ``y`` (N,) -> (K,), or at each row of ``Y`` (B, N) -> (B, K).
 
         Zero (to round-off) on the constraint surface; the order is :attr:`constraints`.
+        ``t`` is the time (of every row); constraints that depend on time need it.
         """
         array = np.asarray(y, dtype=float)
+        params = self._at_time(t, "residual")
         if array.ndim == 2:
             states = self._states(array)
             out = np.empty((states.shape[0], len(self.constraints)))
-            self._module.residual_batch(states, self._params, out)
+            self._module.residual_batch(states, params, out)
             return out
         state = self._state(array)
         values = np.empty(len(self.constraints))
-        self._module.residual(state, self._params, values)
+        self._module.residual(state, params, values)
         return values
 
     def __repr__(self) -> str:
@@ -180,9 +204,11 @@ def _module(analysis: Analysis, free: list[sympy.Symbol]) -> Any:
     H = analysis.canonical_hamiltonian + sum(
         (u * phi for u, phi in zip(analysis.primary_multipliers, analysis.primary_constraints) if u in free),
         sympy.S.Zero)
+    time = analysis.time  # a time-dependent system's t: the last parameter, written by field(t, ...)
     source = vector_field_source(
-        analysis.phase_space, [*analysis.parameters, *free], H, list(analysis.second_class),
-        list(analysis.constraints), title=f"Dirac vector field of {analysis.name}")
+        analysis.phase_space, [*analysis.parameters, *free, *([time] if time is not None else [])], H,
+        list(analysis.second_class), list(analysis.constraints), title=f"Dirac vector field of {analysis.name}",
+        time=time)
     module = compile_vector_field(source)
     _MODULES[analysis] = module
     return module

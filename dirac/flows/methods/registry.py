@@ -12,6 +12,7 @@ factories are joined here, so neither of those modules imports the other.
 
 from __future__ import annotations
 
+from dirac.errors import InputError
 from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
 from dirac.flows.methods.base import Method
 from dirac.validate import unknown_name_error
@@ -74,6 +75,12 @@ def get_method(name: str | Method) -> Method:
     """
     if isinstance(name, Method):
         return name
+    if name == "auto":
+        raise InputError(
+            "'auto' is not one method: it chooses one for each problem when a run starts "
+            "(integrate(problem, method='auto'), dirac.flows.methods.auto.choose_method); get_method needs a "
+            f"named method: {', '.join(n for n in method_names() if n != 'auto')}"
+        )
     if name not in METHODS:
         raise unknown_name_error("method", name, method_names())
     return METHODS[name]
