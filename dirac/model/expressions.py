@@ -17,6 +17,7 @@ from collections.abc import Callable, Mapping
 import sympy
 
 from dirac.errors import InputError
+from dirac.validate import did_you_mean
 
 __all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS", "TIME"]
 
@@ -137,7 +138,8 @@ class _Converter:
             if name in ALLOWED_FUNCTIONS:
                 raise self.fail(f"function {name!r} is used without arguments")
             known = ", ".join(sorted(self.listed)) or "(none)"
-            raise self.fail(f"unknown name {name!r}; the names allowed here are: {known}")
+            close = did_you_mean(name, self.listed)
+            raise self.fail(f"unknown name {name!r}{close}; the names allowed here are: {known}")
         if isinstance(node, ast.BinOp):
             op = _BINARY.get(type(node.op))
             if op is None:

@@ -180,9 +180,18 @@ def _module(analysis: Analysis, free: list[sympy.Symbol]) -> Any:
     H = analysis.canonical_hamiltonian + sum(
         (u * phi for u, phi in zip(analysis.primary_multipliers, analysis.primary_constraints) if u in free),
         sympy.S.Zero)
+    given = getattr(analysis, "forces", {})
+    time = analysis.lagrangian.time
+    if time is not None and any(time in Q.free_symbols for Q in given.values()):
+        raise InputError(
+            f"the forces of {analysis.name!r} depend on the time t, and this vector field f(t, y) is compiled without "
+            "t: integrate the forced system with its flows (dirac.flows.ForcedProblem, a scene) instead"
+        )
+    n = len(analysis.phase_space) // 2
+    forces = [given.get(s.name, sympy.S.Zero) for s in analysis.phase_space[:n]] if given else []
     source = vector_field_source(
         analysis.phase_space, [*analysis.parameters, *free], H, list(analysis.second_class),
-        list(analysis.constraints), title=f"Dirac vector field of {analysis.name}")
+        list(analysis.constraints), title=f"Dirac vector field of {analysis.name}", forces=forces)
     module = compile_vector_field(source)
     _MODULES[analysis] = module
     return module
