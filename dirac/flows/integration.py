@@ -224,7 +224,7 @@ def integrate(
     checked = _as_problem(problem)
     kind = checked.kind
     chosen_outputs = _validate_outputs(outputs, kind, checked.outputs)
-    late = [impulse.t for impulse in getattr(checked, "impulses", ()) if impulse.t > t_end]
+    late = [impulse.t for impulse in getattr(checked, "impulses", ()) if impulse.t > t_end] if kind == "forced" else []
     if late:
         from dirac.errors import warn
 
