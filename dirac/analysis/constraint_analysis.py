@@ -43,6 +43,31 @@ SMALL_SECOND_CLASS = 8
 EXACT_BRACKET_SECONDS = 60.0
 
 
+def _phase_space_forces(lagrangian: Lagrangian, velocities: Mapping[sympy.Symbol, sympy.Expr]) -> dict[str, sympy.Expr]:
+    """The generalized forces ``Q_r(q, q_dot, t)`` as functions on phase space, by coordinate name.
+
+    The velocities are replaced by their solution ``q_dot(q, p)`` of the Legendre transform.
+
+    Raises
+    ------
+    AnalysisError
+        A force depends on a velocity that the momenta do not determine (a singular
+        Hessian): then ``Q`` is no function on phase space.
+    """
+    result: dict[str, sympy.Expr] = {}
+    for q, Q in lagrangian.forces.items():
+        used = Q.free_symbols & set(lagrangian.velocities)
+        missing = sorted(v.name for v in used if v not in velocities)
+        if missing:
+            raise AnalysisError(
+                f"the force on {q.name!r} depends on {', '.join(missing)}, which the momenta do not determine (the "
+                "Hessian of L is singular): such a force is no function on phase space; write it without those "
+                "velocities"
+            )
+        result[q.name] = Q.xreplace({v: velocities[v] for v in used}) if used else Q
+    return result
+
+
 def _generic_parameter_values(lagrangian: Lagrangian, rng: np.random.Generator) -> dict:
     """Random positive values (0.7-1.9) for the parameters: decisions hold generically."""
     return {p: float(rng.uniform(0.7, 1.9)) for p in lagrangian.parameters}
@@ -130,11 +155,14 @@ class ConstraintAnalysis:
         self.canonical_hamiltonian = legendre.canonical_hamiltonian
         K = len(legendre.primary)
         self.primary_multipliers = tuple(sympy.Symbol(f"u_{k + 1}", real=True) for k in range(K))
-        self.time = lagrangian.time if lagrangian.is_time_dependent else None
+        self.forces = _phase_space_forces(lagrangian, legendre.velocity_solution)
+        forced_in_time = lagrangian.time is not None and any(lagrangian.time in e.free_symbols for e in self.forces.values())
+        self.time = lagrangian.time if (lagrangian.is_time_dependent or forced_in_time) else None
         self._numerics = Numerics(space, self._generic, seed=seed, time=self.time)
         chain = ConstraintChain(
             space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
         )
+        chain.forces = {space.symbols[momentum_name(name)]: Q for name, Q in self.forces.items()}
         expanded = [tidy(chi, space.variables, sign=True) for chi in lagrangian.constraints]
         chain.written = {e: chi for e, chi in zip(expanded, lagrangian.constraints) if isinstance(chi, sympy.Mul)}
         chain.holonomic = {e: k for k, e in enumerate(expanded, start=1)}
@@ -189,7 +217,14 @@ class ConstraintAnalysis:
             *regularised,
             *chain.regularity_notes,
         ]
-        if self.time is not None:
+        if self.forces:
+            self.notes.append(
+                "generalized forces Q act (Lagrange's equations d/dt dL/dq_dot - dL/dq = Q + constraint forces): "
+                "p_dot = -dH/dq + Q, so every consistency condition is d Phi/dt = {Phi, H_T} + sum_r dPhi/dp_r Q_r "
+                "(+ d_t Phi), and the multipliers are solved with the forces; the Dirac bracket and the classes "
+                "are those of H (forces are not Hamiltonian)"
+            )
+        if self.time is not None and lagrangian.is_time_dependent:
             self.notes.append(
                 "time-dependent (rheonomic) system: the consistency conditions are d Phi/dt = {Phi, H_T} + "
                 "d_t Phi with the partial time derivative; t is sampled at random like a variable in the "

@@ -168,7 +168,8 @@ def to_json(analysis: AnalysisResult) -> dict:
     ``gauge_generators`` (one ``{"terms": [G_0, G_1, ...]}`` per gauge parameter),
     ``gauge_transformations`` (for each, its ``parameter``, free ``multiplier`` and
     ``delta``: variable -> ``{z, G}``), ``first_class_without_gauge_transformation`` and
-    ``gauge_conditions``.
+    ``gauge_conditions``; ``forces`` (coordinate name -> the generalized force ``Q_r`` in
+    phase-space variables; ``{}`` when none).
     """
     multipliers, solution, definitions = _multiplier_texts(analysis)
     gauge = analysis.gauge_structure
@@ -206,6 +207,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         ],
         "first_class_without_gauge_transformation": [expression_text(c) for c in gauge.without_transformation],
         "gauge_conditions": list(analysis.gauge_conditions),
+        "forces": {name: expression_text(Q) for name, Q in getattr(analysis, "forces", {}).items()},
     }
     if definitions:
         out["multiplier_subexpressions"] = definitions
@@ -280,6 +282,14 @@ def to_text(analysis: AnalysisResult) -> str:
     lines.append(f"  L = {_short(a.lagrangian.expression)}")
     for k, chi in enumerate(a.lagrangian.constraints, start=1):
         lines.append(f"  constraint {k}: {chi} = 0   (multiplier lambda_{k})")
+    forces = getattr(a, "forces", {})
+    if forces:
+        lines.append("  generalized forces (not from a potential), Lagrange: d/dt dL/dq_dot - dL/dq = Q + constraint forces")
+        for name, Q in forces.items():
+            lines.append(f"    Q_{name} = {_short(Q)}")
+        lines.append("  forced equations of motion: q_dot = dH_T/dp, and for each forced coordinate")
+        for name in forces:
+            lines.append(f"    d p_{name}/dt = -dH_T/d{name} + Q_{name}")
     if a.time is not None:
         lines.append("time-dependent: t occurs explicitly; consistency is d Phi/dt = {Phi, H_T} + d_t Phi = 0")
     lines.append(

@@ -77,6 +77,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
     notes: list[str] = []
     field_rows: list[dict] = []
     general_rows: list = []
+    forced: list[dict] = []
     if targets:
         from dirac.bench.general_systems import measure_general_systems
         from dirac.bench.targets import measure_targets
@@ -90,6 +91,13 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"vector field: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
         general_rows = measure_general_systems(quick, measured, notes, say)
+        from dirac.bench.forced import forced_rows, forced_target
+
+        try:
+            forced = forced_rows(quick, repeats, say)
+            measured.append(forced_target(forced))
+        except Exception as exc:  # one failed measurement must not hide the others
+            notes.append(f"forced systems: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
     else:
         from dirac.bench.targets import work_precision_targets
 
@@ -110,6 +118,10 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         from dirac.bench.general_systems import format_general_rows
 
         print(format_general_rows(general_rows))
+    if forced:
+        from dirac.bench.forced import format_forced_rows
+
+        print(format_forced_rows(forced))
     print(format_targets(measured))
     for note in notes:
         print(f"note: {note}")
@@ -123,6 +135,7 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
         "targets": [t.as_dict() for t in measured],
         "vector_field": field_rows,
         "general_systems": [row.as_dict() for row in general_rows],
+        "forced_systems": forced,
         "notes": notes,
     }
     if json_path:

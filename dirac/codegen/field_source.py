@@ -228,6 +228,7 @@ def vector_field_source(
     title: str = "Dirac vector field",
     unroll_limit: int = UNROLL_LIMIT,
     time: sympy.Symbol | None = None,
+    forces: Sequence[sympy.Expr] = (),
 ) -> str:
     """Python source of the compiled Dirac vector field (see the module docstring).
 
@@ -248,6 +249,11 @@ def vector_field_source(
         The expressions ``residual`` evaluates (typically every constraint).
     title
         First docstring line of the module.
+    forces
+        Generalized forces ``Q_i`` on the first ``len(forces)`` coordinates (functions of
+        ``z``): the unprojected field becomes ``J grad H + (0, Q)`` (``p_dot = -dH/dq +
+        Q``) before the Dirac projection, so that on the surface it is the forced motion
+        with the multipliers solved with the forces.
     unroll_limit
         Largest number of source lines of the unrolled elimination; a larger one (large
         ``C`` with much fill-in, e.g. the 24 second-class constraints of a rigid body)
@@ -273,6 +279,8 @@ def vector_field_source(
     n = N // 2
     k = len(second_class)
     gradient = [sympy.diff(hamiltonian, s) for s in z]
+    for i, Q in enumerate(forces):  # (J g)_{n+i} = -g_i: p_dot_i = -dH/dq_i + Q_i
+        gradient[i] = gradient[i] - Q
     jacobian = [[sympy.diff(phi, s) for s in z] for phi in second_class]
     inputs = {symbol: f"a{i}_" for i, symbol in enumerate(z)}
     inputs.update({symbol: f"c{i}_" for i, symbol in enumerate(parameters)})

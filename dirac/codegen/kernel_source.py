@@ -122,6 +122,8 @@ def mechanical_kernel_source(
     constraints: Sequence[sympy.Expr],
     time: sympy.Symbol | None = None,
     title: str = "mechanical system",
+    forces: Sequence[sympy.Expr] | None = None,
+    velocities: Sequence[sympy.Symbol] = (),
 ) -> str:
     """The numba module of a natural system ``H = 1/2 p^T M(q, t)^{-1} p + V(q, t)``
     with holonomic constraints ``chi(q, t) = 0``.
@@ -144,6 +146,12 @@ def mechanical_kernel_source(
         The time symbol the expressions may contain, or None.
     title
         First line of the module docstring.
+    forces, velocities
+        Generalized forces ``Q(q, q_dot, t)`` (one per coordinate) written in the symbols
+        ``velocities`` for ``q_dot``: the generated ``force`` is then ``dH/dq - Q``, so
+        that ``p_dot = -force`` is the forced motion in the field and in RATTLE's stages
+        (the forced step loops: :mod:`dirac.codegen.forced_source`). The unrolled
+        constant-mass RATTLE stays the unforced one.
     """
     q = list(coordinates)
     n, m = len(q), len(constraints)
@@ -156,6 +164,9 @@ def mechanical_kernel_source(
     dmass = [mass.diff(s) for s in q]
     force = [grad_v[k] - sympy.Rational(1, 2) * (sympy.Matrix([v]) * dmass[k] * sympy.Matrix(v))[0, 0]
              for k in range(n)]
+    if forces is not None:
+        to_v = dict(zip(velocities, v))
+        force = [force[k] - sympy.sympify(forces[k]).xreplace(to_v) for k in range(n)]
     hidden = [sum((jacobian[a, j] * v[j] for j in range(n)), sympy.S.Zero) + chi_t[a] for a in range(m)]
     hidden_dq = [sympy.diff(h, s) for h in hidden for s in q]
     hidden_dt = [sympy.diff(h, time) if time is not None else sympy.S.Zero for h in hidden]

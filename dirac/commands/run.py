@@ -58,6 +58,8 @@ METHOD_HELP: tuple[tuple[str, str], ...] = (
     ("lie-poisson-sym-8-s15", "symmetric-top split, 15-stage order-8 composition"),
     ("exact-kick-2/4/6/8", "heavy top, torqued body: exact free flow + gravity/torque kick (Celledoni et al. 2008)"),
     ("rattle-2/4/6/8", "constrained systems: RATTLE and its symmetric compositions"),
+    ("forced-rattle-2/4", "forces Q(q, q_dot, t) and impulses: RATTLE with discrete Lagrange-d'Alembert forces"),
+    ("conformal-2/4", "linear damping Q = -gamma M q_dot: conformal-symplectic splitting (McLachlan-Perlmutter)"),
     ("midpoint", "implicit midpoint (rigid body; Dirac vector field of general systems)"),
     ("scipy-RK45", "baseline: scipy RK45, rtol = atol = tolerance"),
     ("scipy-DOP853", "baseline: scipy DOP853, rtol = atol = tolerance"),

@@ -5,7 +5,7 @@ Scene and result files are read and written by :mod:`dirac.io` (``dirac.load_sce
 
 Public names (imported on first use, so ``import dirac.flows`` stays cheap):
 :func:`integrate`, :class:`Solution`, :class:`RigidBodyProblem`, :class:`HeavyTopProblem`,
-:class:`ConstrainedProblem`, :class:`MechanicalSystem`, :class:`AnalysedSystem`,
+:class:`ConstrainedProblem`, :class:`ForcedProblem` (forces and impulses), :class:`MechanicalSystem`, :class:`AnalysedSystem`,
 :class:`AnalysedProblem`, :class:`Problem` (what they have in common), :func:`get_method`,
 :func:`method_names`, :data:`METHODS`.
 """
@@ -22,6 +22,8 @@ _LAZY = {
     "RigidBodyProblem": "dirac.flows.problems",
     "HeavyTopProblem": "dirac.flows.problems",
     "ConstrainedProblem": "dirac.flows.problems",
+    "ForcedProblem": "dirac.flows.problems",
+    "Impulse": "dirac.flows.problems",
     "MechanicalSystem": "dirac.flows.mechanics",
     "AnalysedSystem": "dirac.flows.analysed",
     "AnalysedProblem": "dirac.flows.analysed",

@@ -111,6 +111,12 @@ class AnalysedSystem:
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
             raise InputError(f"from_analysis needs the result of dirac.analyze(system), not {type(analysis).__name__}")
+        if lagrangian.is_forced:
+            raise InputError(
+                f"system {lagrangian.name!r} has generalized forces, which the flows of the full phase space do not "
+                "take: integrate it as a ForcedProblem (L = 1/2 q_dot^T M(q) q_dot - V(q)), or use "
+                "analysis.vector_field() with scipy"
+            )
         defaults = {p: float(v) for p, v in lagrangian.parameters.items() if v is not None}
         missing = [p.name for p in lagrangian.parameters if p not in defaults]
         if missing:

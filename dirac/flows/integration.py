@@ -65,6 +65,7 @@ DEFAULT_OUTPUTS = {
     "heavy_top": ("M", "R", "energy"),
     "constrained": ("q", "p", "energy", "constraint_residual"),
     "analysed": ("z", "energy", "constraint_residual"),
+    "forced": ("q", "p", "energy", "work", "constraint_residual"),
 }
 
 
@@ -89,8 +90,8 @@ def _as_problem(problem: object) -> Problem:
     if isinstance(problem, Problem) and problem.kind in DEFAULT_OUTPUTS:
         return problem
     raise InputError(
-        f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem, ConstrainedProblem "
-        "or AnalysedProblem"
+        f"cannot integrate a {type(problem).__name__}: give a RigidBodyProblem, HeavyTopProblem, ConstrainedProblem, "
+        "ForcedProblem or AnalysedProblem"
     )
 
 
@@ -223,6 +224,11 @@ def integrate(
     checked = _as_problem(problem)
     kind = checked.kind
     chosen_outputs = _validate_outputs(outputs, kind, checked.outputs)
+    late = [impulse.t for impulse in getattr(checked, "impulses", ()) if impulse.t > t_end] if kind == "forced" else []
+    if late:
+        from dirac.errors import warn
+
+        warn(f"impulses at t = {', '.join(f'{t:g}' for t in late)} come after t_end = {t_end:g}: they are not applied")
     extra: dict[str, object] = {}
     if (isinstance(method, str) and method == "auto"):
         from dirac.flows.methods.auto import choose_method
@@ -235,8 +241,10 @@ def integrate(
         method_object = get_method(method)
     if not method_object.accepts(kind):
         usable = [m for m in _names_for(kind)]
+        what = ("a system with forces or impulses (these methods take them)" if kind == "forced"
+                else f"a {kind.replace('_', ' ')} problem")
         raise InputError(
-            f"method {method_object.name!r} cannot integrate a {kind.replace('_', ' ')} problem; use one of: {', '.join(usable)}"
+            f"method {method_object.name!r} cannot integrate {what}; use one of: {', '.join(usable)}"
         )
     refuse_undriven(checked, method_object.name, driven_method_names(kind))
     if method_object.kind == "fixed" and dt is None:

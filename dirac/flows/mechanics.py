@@ -21,7 +21,7 @@ velocities, non-quadratic kinetic energy, a singular mass matrix) are refused wi
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -42,6 +42,35 @@ class NotMechanicalError(InputError):
     """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
     velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
     flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
+
+
+def _conformal_rate(forces: Sequence[sympy.Expr], velocities: Sequence[sympy.Symbol], mass: sympy.Matrix,
+                    values: Mapping[sympy.Symbol, float], coordinates: Sequence[sympy.Symbol],
+                    time: sympy.Symbol | None) -> float | None:
+    """``gamma`` if ``Q = -gamma M q_dot`` for a constant ``gamma`` at these parameter values, else None.
+
+    Then ``p_dot = -dH/dq - gamma p``: a conformal Hamiltonian system (McLachlan &
+    Perlmutter 2001). ``Q`` must be linear in the velocities, without ``q`` or ``t``, with
+    damping matrix ``D = -dQ/dq_dot`` equal to ``gamma M`` (e.g. ``Q = -c q_dot`` with
+    ``M = m 1``: ``gamma = c / m``).
+    """
+    numeric = {k: sympy.Float(v) for k, v in values.items()}
+    Q = sympy.Matrix([sympy.sympify(e).xreplace(numeric) for e in forces])
+    D = -Q.jacobian(list(velocities))
+    moving = set(coordinates) | set(velocities) | ({time} if time is not None else set())
+    if any(entry.free_symbols & moving for entry in D):
+        return None
+    if any(sympy.simplify(e) != 0 for e in Q.xreplace({s: 0 for s in velocities})):
+        return None
+    M = sympy.Matrix(mass).xreplace(numeric)
+    if any(entry.free_symbols for entry in (*D, *M)):
+        return None
+    Dn = np.array(D.tolist(), dtype=float)
+    Mn = np.array(M.tolist(), dtype=float)
+    gamma = float(np.trace(Dn) / np.trace(Mn))
+    if not np.allclose(Dn, gamma * Mn, rtol=1e-13, atol=1e-15 * max(1.0, float(np.abs(Mn).max()))):
+        return None
+    return gamma
 
 
 def resolve_parameters(lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> dict[str, float]:
@@ -110,6 +139,13 @@ class MechanicalSystem:
         plane of coordinates ``i, j`` (:func:`dirac.model.rotating_frame.uniform_rotation`):
         the energy is not conserved, the Jacobi integral ``H - w (q_i p_j - q_j p_i)``
         (``text``) is; else None.
+    forced : bool
+        Whether generalized forces ``Q(q, q_dot, t)`` act (``Lagrangian.forces``); the
+        module's ``force`` is then ``dH/dq - Q`` and it has the forced step loops of
+        :mod:`dirac.codegen.forced_source` (``forced_rattle_run``, ``conformal_run``).
+    conformal_rate : float or None
+        ``gamma`` when the forces are ``Q = -gamma M q_dot`` (``p_dot = ... - gamma p``)
+        with a constant mass: a conformal Hamiltonian system (McLachlan & Perlmutter 2001).
     """
 
     name: str
@@ -123,6 +159,8 @@ class MechanicalSystem:
     time_symbol: sympy.Symbol | None = field(repr=False, default=None)
     symbolic: dict[str, object] = field(repr=False, default_factory=dict)
     rotation: tuple[int, int, float, str] | None = field(repr=False, default=None)
+    forced: bool = False
+    conformal_rate: float | None = None
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -157,7 +195,8 @@ class MechanicalSystem:
 
     @classmethod
     def from_lagrangian(
-        cls, lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None, extra_source: str = ""
+        cls, lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None, extra_source: str = "",
+        with_forces: bool = False,
     ) -> MechanicalSystem:
         """Split ``L`` into ``1/2 q_dot^T M(q) q_dot - V(q)`` and generate its functions.
 
@@ -169,6 +208,10 @@ class MechanicalSystem:
             Overrides of parameter values, by name.
         extra_source
             Numba source appended to the generated kernel module.
+        with_forces
+            Generate the forced kernels (:mod:`dirac.codegen.forced_source`) even when the
+            Lagrangian has no forces (a system that only receives impulses). A Lagrangian
+            with forces always gets them.
 
         Raises
         ------
@@ -203,12 +246,22 @@ class MechanicalSystem:
         parameter_symbols = list(lagrangian.parameters)
         param_array = np.array([float(values[p.name]) for p in parameter_symbols], dtype=float)
         n, m = len(q), len(lagrangian.constraints)
-        time = lagrangian.time if lagrangian.is_time_dependent else None
+        forces = lagrangian.force_vector if (lagrangian.is_forced or with_forces) else None
+        forced_in_time = forces is not None and lagrangian.time is not None and any(
+            lagrangian.time in e.free_symbols for e in forces)
+        time = lagrangian.time if (lagrangian.is_time_dependent or forced_in_time) else None
         constant = all(not (entry.free_symbols & {*q, *([time] if time is not None else [])}) for entry in mass)
         from dirac.codegen import load_kernels, mechanical_kernel_source
 
         source = mechanical_kernel_source(q, parameter_symbols, mass, potential, list(chis), time,
-                                          title=f"system {lagrangian.name}")
+                                          title=f"system {lagrangian.name}", forces=forces, velocities=v)
+        rate = None
+        if forces is not None:
+            from dirac.codegen.forced_source import forced_kernel_source
+
+            source += forced_kernel_source(q, v, parameter_symbols, forces, time, m, constant)
+            if constant:
+                rate = _conformal_rate(forces, v, mass, {p: values[p.name] for p in parameter_symbols}, q, time)
         module = load_kernels(source + extra_source)
         constant_mass = None
         if constant:
@@ -225,10 +278,51 @@ class MechanicalSystem:
             module=module,
             time_symbol=time,
             symbolic={"mass": mass, "potential": potential, "constraints": chis, "coordinates": q,
-                      "parameters": parameter_symbols},
+                      "parameters": parameter_symbols, "forces": forces, "velocities": v},
             rotation=_rotation(lagrangian, values),
+            forced=forces is not None,
+            conformal_rate=rate,
         )
         return system
+
+    # ------------------------------------------------------------------ forces
+    def applied_force(self, q: np.ndarray, q_dot: np.ndarray, time: float = 0.0) -> np.ndarray:
+        """``Q(q, q_dot, t)`` (generated kernel ``applied_force``; zero for an unforced system)."""
+        if not self.forced:
+            return np.zeros(self.dimension)
+        out = np.empty(self.dimension)
+        self.module.applied_force(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_dot, dtype=float),
+                                  float(time), self.params, out)
+        return out
+
+    def apply_impulse(self, q: np.ndarray, p: np.ndarray, impulse: np.ndarray,
+                      time: float = 0.0) -> tuple[np.ndarray, float]:
+        """The momentum after a generalized impulse ``J`` (Lamb's ``Q_r'``) at the configuration ``q``.
+
+        Integrating Lagrange's equations over an impulse of vanishing duration gives
+        ``Delta p = J + G^T nu`` (the constraints' own impulse ``G^T nu``), and the
+        velocity stage ``G M^{-1} p + d chi/dt = 0`` must hold after it, so
+
+            Delta p = J - G^T (G M^{-1} G^T)^{-1} G M^{-1} J,   Delta q_dot = M^{-1} Delta p
+
+        (with the velocity stage holding before). Returns the new ``p`` and the work of
+        the impulse, ``J . (q_dot_before + q_dot_after) / 2`` (the change of the kinetic
+        energy when the constraints do not move; Lamb, *Higher Mechanics*, Sect. 27).
+        """
+        q = np.asarray(q, dtype=float)
+        p = np.asarray(p, dtype=float)
+        impulse = np.asarray(impulse, dtype=float)
+        mass = self.mass_matrix(q, time)
+        kick = impulse.copy()
+        m = self.n_constraints
+        if m:
+            G = self._evaluate("jacobian", q, time, (m, self.dimension))
+            A = np.linalg.solve(mass, G.T)
+            kick = kick - G.T @ np.linalg.solve(G @ A, G @ np.linalg.solve(mass, impulse))
+        after = p + kick
+        before_velocity = np.linalg.solve(mass, p)
+        after_velocity = np.linalg.solve(mass, after)
+        return after, float(impulse @ (before_velocity + after_velocity) / 2.0)
 
     # ------------------------------------------------------------------ numerics (numpy side)
     def _evaluate(self, name: str, q: np.ndarray, time: float, shape: tuple[int, ...]) -> np.ndarray:

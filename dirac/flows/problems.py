@@ -33,7 +33,8 @@ if TYPE_CHECKING:
     from dirac.flows.torques import Torque
     from dirac.model.lagrangian import Lagrangian
 
-__all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "Problem", "OffSurfaceError"]
+__all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "ForcedProblem", "Impulse", "Problem",
+           "OffSurfaceError"]
 
 
 class OffSurfaceError(InputError):
@@ -274,7 +275,12 @@ class ConstrainedProblem:
         if isinstance(mechanics, Lagrangian):
             from dirac.flows.mechanics import MechanicalSystem
 
-            mechanics = MechanicalSystem.from_lagrangian(mechanics)
+            mechanics = MechanicalSystem.from_lagrangian(mechanics, with_forces=self.kind == "forced")
+        if self.kind == "forced" and not getattr(mechanics, "forced", False):
+            raise InputError(
+                f"a ForcedProblem needs the forced kernels of {mechanics.name!r}: give the Lagrangian, or "
+                "MechanicalSystem.from_lagrangian(lagrangian, with_forces=True)"
+            )
         self.mechanics = mechanics
         n = mechanics.dimension
         if (self.p0 is None) == (self.qdot0 is None):
@@ -294,6 +300,11 @@ class ConstrainedProblem:
         if self.project:
             pairs = [mechanics.project(a, b) for a, b in zip(q0, p0)]
             q0, p0 = np.array([a for a, _ in pairs]), np.array([b for _, b in pairs])
+        if getattr(mechanics, "forced", False) and self.kind == "constrained":
+            raise InputError(
+                f"system {mechanics.name!r} has generalized forces: integrate it as a ForcedProblem "
+                "(dirac.flows.ForcedProblem), whose methods take the forces"
+            )
         names = mechanics.coordinate_names
         advice = "or pass project=True to put the data on the surface (the closest point in the metric M)"
         for b in range(q0.shape[0]):
@@ -331,3 +342,79 @@ class ConstrainedProblem:
         """Parameter values of the mechanical system, for the result file's ``meta``."""
         return dict(self.mechanics.parameter_values)
 
+
+
+@dataclass(frozen=True)
+class Impulse:
+    """A generalized impulse ``J`` (Lamb's ``Q_r'``, the time integral of ``Q_r`` over a
+    blow of vanishing duration) at time ``t``: ``p`` jumps by ``J`` projected so that the
+    constraints' velocity stage still holds
+    (:meth:`dirac.flows.mechanics.MechanicalSystem.apply_impulse`)."""
+
+    t: float
+    vector: np.ndarray
+
+
+@dataclass
+class ForcedProblem(ConstrainedProblem):
+    """A constrained mechanical system with generalized forces ``Q(q, q_dot, t)`` and impulses.
+
+    The forces come with the system (``Lagrangian.forces``); Lagrange's equations are
+    ``d/dt dL/dq_dot - dL/dq = Q + G^T lambda``. Parameters as for
+    :class:`ConstrainedProblem`, and
+
+    Parameters
+    ----------
+    impulses : sequence of (t, {coordinate: value}) or Impulse
+        Generalized impulses at times ``t > 0``; coordinates not named get 0. The methods
+        land a step on each impulse time.
+
+    Raises
+    ------
+    InputError
+        As for :class:`ConstrainedProblem`; an impulse at ``t <= 0``, on an unknown
+        coordinate or with a non-finite value.
+    """
+
+    impulses: tuple = ()
+
+    kind: ClassVar[str] = "forced"
+    outputs: ClassVar[tuple[str, ...]] = ("q", "p", "q_dot", "energy", "work", "constraint_residual")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.impulses = tuple(sorted((self._impulse(item) for item in self.impulses), key=lambda i: i.t))
+
+    def _impulse(self, item: object) -> Impulse:
+        from dirac.flows.mechanics import MechanicalSystem
+        from dirac.validate import did_you_mean
+
+        mechanics = self.mechanics
+        assert isinstance(mechanics, MechanicalSystem)  # converted by ConstrainedProblem.__post_init__
+
+        if isinstance(item, Impulse):
+            time, vector = item.t, item.vector
+        else:
+            if not isinstance(item, tuple) or len(item) != 2:
+                raise InputError(f"an impulse must be (t, {{coordinate: value}}), not {item!r}")
+            time, values = item
+            names = mechanics.coordinate_names
+            if not isinstance(values, dict):
+                raise InputError(f"the impulse at t = {time} must be a table {{ {names[0]} = ... }}")
+            for key in values:
+                if key not in names:
+                    raise InputError(
+                        f"the impulse at t = {time} names {key!r}, which is not a coordinate"
+                        f"{did_you_mean(str(key), names)}; coordinates: {', '.join(names)}"
+                    )
+            vector = np.array([values.get(n, 0.0) for n in names], dtype=float)
+        from dirac.validate import validate_finite
+
+        time = validate_finite(time, "impulse time")
+        if not time > 0.0:
+            raise InputError(f"an impulse at t = {time} is not after the start t = 0: give t > 0 "
+                             "(a blow at the start is an initial velocity)")
+        vector = np.asarray(vector, dtype=float)
+        if vector.shape != (mechanics.dimension,) or not np.all(np.isfinite(vector)):
+            raise InputError(f"the impulse at t = {time} must have {mechanics.dimension} finite entries")
+        return Impulse(float(time), vector)

@@ -30,7 +30,9 @@ form ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the velocities, singular
 integrated on the full phase space of its Dirac–Bergmann analysis (``midpoint`` or the
 scipy baselines; the multipliers are completed on the constraint surface, outputs ``z``,
 ``q``, ``p``, ``energy``, ``constraint_residual``). Parameters of a Lagrangian are
-overridden under ``[system] parameters``. Optional ``[run]`` keys: ``drift_limit``,
+overridden under ``[system] parameters``. A system with generalized forces (``forces``
+in its system file or inline) or a scene with ``[[impulses]]`` (``t = 0.5``,
+``Q = { x = 1.0 }``) is a :class:`~dirac.flows.problems.ForcedProblem`. Optional ``[run]`` keys: ``drift_limit``,
 ``newton_tolerance``, ``max_newton_iterations``. Unknown keys are errors that suggest the closest known key.
 
 A rigid body or heavy top may be driven: ``[forces] torque = ["N1", "N2", "N3"]`` (the
@@ -99,11 +101,12 @@ FLAGSHIP_SCENE: dict[str, object] = {
 }
 
 _TOP_KEYS = {"system", "initial", "run", "description", "forces", "impulses"}
+_IMPULSE_KEYS = {"t", "Q"}
 _RUN_KEYS = {"t_end", "method", "dt", "tolerance", "samples", "outputs", "drift_limit", "newton_tolerance",
              "max_newton_iterations"}
 _RIGID_KEYS = {"name", "inertia", "description"}
 _HEAVY_KEYS = _RIGID_KEYS | {"mass_gravity", "center_of_mass"}
-_LAGRANGIAN_KEYS = {"name", "file", "parameters", "coordinates", "lagrangian", "constraints", "description"}
+_LAGRANGIAN_KEYS = {"name", "file", "parameters", "coordinates", "lagrangian", "constraints", "description", "forces"}
 _RIGID_INITIAL = {"M", "omega", "m", "R"}
 _GENERAL_INITIAL = {"q", "q_dot", "p", "project"}
 
@@ -258,11 +261,11 @@ def scene_from_dict(data: dict, source: str = "scene", base: Path | None = None)
         _drive(rigid, data, run["t_end"], source)
         problem: SceneProblem = rigid
     else:
-        for key in ("forces", "impulses"):
-            if key in data:
-                raise InputError(f"{source}: [{key}] (torques, angular impulses) applies to rigid_body and heavy_top "
-                                 "scenes; give the forces of a Lagrangian system in its system file")
-        problem = _general_problem(system, initial, source, base or Path("."))
+        if "forces" in data:
+            raise InputError(f"{source}: [forces] (torques) applies to rigid_body and heavy_top scenes; give the "
+                             "forces of a Lagrangian system in its system file (forces = { x = \"...\" } under [system])")
+        impulses = _impulse_tables(data.get("impulses", []), source)
+        problem = _general_problem(system, initial, source, base or Path("."), impulses)
     available: tuple[str, ...] = problem.outputs
     for output in run.get("outputs", []):
         if output not in available:
@@ -374,9 +377,32 @@ def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> 
         problem.impulses = validate_impulses(impulses)
 
 
-def _general_problem(system: dict, initial: dict, source: str, base: Path) -> ConstrainedProblem | AnalysedProblem:
+def _impulse_tables(tables: object, source: str) -> list[tuple[float, dict[str, float]]]:
+    """The ``[[impulses]]`` of a scene: ``t`` (> 0) and ``Q = { x = 1.0 }``, in the order given."""
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise InputError(f"{source}: impulses must be [[impulses]] tables, each with t and Q = {{ x = 1.0 }}")
+    result = []
+    for k, table in enumerate(tables, start=1):
+        where = f"[[impulses]] {k}"
+        reject_unknown_keys(table, _IMPULSE_KEYS, where, source)
+        for key in ("t", "Q"):
+            if key not in table:
+                raise InputError(f"{source}: {where} lacks {key!r} (give t = time and Q = {{ x = 1.0 }})")
+        time = scene_number(table["t"], f"{where} t", source)
+        if not time > 0.0:
+            raise InputError(f"{source}: {where} is at t = {time:g}, not after the start t = 0: give t > 0 "
+                             "(a blow at the start is an initial velocity)")
+        values = table["Q"]
+        if not isinstance(values, dict) or not values:
+            raise InputError(f"{source}: {where} Q must be a table of coordinates, e.g. Q = {{ x = 1.0 }}")
+        result.append((time, {str(key): scene_number(v, f"{where} Q.{key}", source) for key, v in values.items()}))
+    return result
+
+
+def _general_problem(system: dict, initial: dict, source: str, base: Path,
+                     impulses: list | None = None) -> ConstrainedProblem | AnalysedProblem:
     from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
-    from dirac.flows.problems import ConstrainedProblem, OffSurfaceError
+    from dirac.flows.problems import ConstrainedProblem, ForcedProblem, OffSurfaceError
     from dirac.model.system_file import lagrangian_from_table
     from dirac.model.systems import load_system
 
@@ -412,9 +438,15 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
         if key not in lagrangian.parameter_symbols:
             raise unknown_name_error("parameter", key, lagrangian.parameter_symbols,
                                      scene_label(source, f"[system] parameters of {lagrangian.name!r}"))
+    forced = lagrangian.is_forced or bool(impulses)
     try:
-        mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides)
-    except NotMechanicalError:
+        mechanics = MechanicalSystem.from_lagrangian(lagrangian, overrides, with_forces=forced)
+    except NotMechanicalError as exc:
+        if forced:
+            raise InputError(
+                f"{source}: forces and impulses are integrated for L = 1/2 q_dot^T M(q) q_dot - V(q) only; "
+                f"{exc}".replace("; use method = \"midpoint\" on the Dirac flow instead", "")
+            ) from None
         return _analysed_problem(lagrangian, overrides, initial, source)
     names = mechanics.coordinate_names
     if "q" not in initial:
@@ -430,6 +462,8 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path) -> Co
     if validate_boolean(initial.get("project", False), scene_label(source, "[initial] project")):
         q, p = mechanics.project(q, p)
     try:
+        if forced:
+            return ForcedProblem(mechanics, q, p, impulses=tuple(impulses or ()))
         return ConstrainedProblem(mechanics, q, p)
     except OffSurfaceError as exc:
         what = "give q" if "initial q" in exc.detail else "give q_dot (or p)"

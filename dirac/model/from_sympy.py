@@ -29,7 +29,7 @@ from sympy.core.function import AppliedUndef
 from dirac.errors import InputError
 from dirac.model.expressions import TIME
 
-__all__ = ["plain_parts", "Parts"]
+__all__ = ["plain_parts", "plain_forces", "Parts"]
 
 #: (coordinates, velocities, L, constraints, parameter -> default), in the engine's symbols
 Parts = tuple[
@@ -80,6 +80,7 @@ def plain_parts(
     constraints: Iterable[sympy.Expr],
     parameters: Mapping[sympy.Symbol | str, float | None] | Iterable[sympy.Symbol | str] | None,
     velocity_name: Callable[[str], str],
+    extra: Sequence[sympy.Expr] = (),
 ) -> Parts:
     """The parts of a :class:`~dirac.model.lagrangian.Lagrangian` from sympy expressions.
 
@@ -98,6 +99,9 @@ def plain_parts(
         makes every other symbol of ``L`` and the constraints a parameter without default.
     velocity_name
         The name of the velocity of a coordinate (``x`` -> ``x_dot``).
+    extra
+        Further expressions (generalized forces) converted like ``L``: read them back with
+        :func:`plain_forces`, which calls this function.
 
     Examples
     --------
@@ -138,7 +142,8 @@ def plain_parts(
 
     expr = plain(expr)
     chis = [plain(c) for c in chis]
-    for e in (expr, *chis):
+    extras = [plain(sympy.sympify(e)) for e in extra]
+    for e in (expr, *chis, *extras):
         left = sorted(str(d) for d in e.atoms(sympy.Derivative, AppliedUndef))
         if left:
             raise InputError(
@@ -149,7 +154,7 @@ def plain_parts(
     # every symbol by name -> the engine's real symbol of that name
     own = {s.name: s for s in (*q.values(), *v.values())}
     if parameters is None:
-        found = set().union(*(e.free_symbols for e in (expr, *chis)))
+        found = set().union(*(e.free_symbols for e in (expr, *chis, *extras)))
         values: dict[str, float | None] = {
             label: None
             for label in sorted(s.name for s in found if s.name not in own and s not in times and s.name != TIME.name)
@@ -160,9 +165,10 @@ def plain_parts(
         values = {str(p): None for p in parameters}
     params = {label: sympy.Symbol(label, real=True) for label in values}
     by_name = {**own, **params}
-    renaming = {s: by_name[s.name] for e in (expr, *chis) for s in e.free_symbols if s.name in by_name}
+    renaming = {s: by_name[s.name] for e in (expr, *chis, *extras) for s in e.free_symbols if s.name in by_name}
     expr = expr.xreplace(renaming)
     chis = [c.xreplace(renaming) for c in chis]
+    _CONVERTED[:] = [e.xreplace(renaming) for e in extras]
     return (
         tuple(q.values()),
         tuple(v.values()),
@@ -170,3 +176,38 @@ def plain_parts(
         tuple(chis),
         {params[label]: value for label, value in values.items()},
     )
+
+
+#: the extra expressions of the last :func:`plain_parts` call (read by :func:`plain_forces`)
+_CONVERTED: list[sympy.Expr] = []
+
+
+def plain_forces(
+    L: sympy.Expr,
+    coordinates: Sequence[sympy.Basic],
+    constraints: Iterable[sympy.Expr],
+    parameters: Mapping[sympy.Symbol | str, float | None] | Iterable[sympy.Symbol | str] | None,
+    velocity_name: Callable[[str], str],
+    forces: Mapping[object, sympy.Expr],
+) -> tuple[Parts, dict[str, sympy.Expr]]:
+    """:func:`plain_parts` and the generalized forces ``Q_r`` in the engine's symbols.
+
+    ``forces`` maps a coordinate (the symbol, the ``dynamicsymbols`` function or its name)
+    to ``Q_r(q, q_dot, t)`` written like ``L`` (``x(t).diff(t)`` or ``x_dot`` for a
+    velocity); the result maps the coordinate's name to the converted expression. Names a
+    force uses that are not coordinates, velocities or ``t`` become parameters when
+    ``parameters`` is ``None``.
+    """
+    if not isinstance(forces, Mapping):
+        raise InputError("forces must be a mapping coordinate -> expression, e.g. {x: -c*x.diff(t)}")
+    names = []
+    for key in forces:
+        if isinstance(key, str):
+            names.append(key)
+        elif isinstance(key, sympy.Symbol) or isinstance(key, AppliedUndef):
+            names.append(_name_of(key))
+        else:
+            raise InputError(f"a force is keyed by {key!r}: key forces by a coordinate (symbol or name)")
+    parts = plain_parts(L, coordinates, constraints, parameters, velocity_name, extra=tuple(forces.values()))
+    converted = list(_CONVERTED)
+    return parts, dict(zip(names, converted))

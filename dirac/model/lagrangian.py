@@ -28,9 +28,9 @@ import sympy
 
 from dirac.errors import InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, TIME, parse_expression
-from dirac.model.from_sympy import plain_parts
+from dirac.model.from_sympy import plain_forces, plain_parts
 from dirac.model.lagranges_method import is_lagranges_method, lagranges_method_parts
-from dirac.validate import is_real_number, unknown_name_error, validate_finite
+from dirac.validate import did_you_mean, is_real_number, unknown_name_error, validate_finite
 
 __all__ = ["Lagrangian", "TIME", "velocity_name", "momentum_name", "multiplier_name", "latex_name", "latex_names"]
 
@@ -129,6 +129,11 @@ class Lagrangian:
         the system cannot take (e.g. an inertia whose mass matrix (66) is not positive).
     fixed_values
         The parameters fixed so far (name -> number); kept for ``validator``.
+    forces
+        Generalized forces not derived from a potential: coordinate symbol -> ``Q_r(q,
+        q_dot, t)``, so that Lagrange's equations read
+        ``d/dt dL/dq_dot_r - dL/dq_r = Q_r + (constraint forces)`` (Lamb, *Dynamics*;
+        Goldstein, *Classical Mechanics*, Sect. 1.4). Coordinates not listed get 0.
 
     Notes
     -----
@@ -147,6 +152,7 @@ class Lagrangian:
     description: str = ""
     validator: Callable[[Mapping[str, float]], None] | None = field(default=None, compare=False, repr=False)
     fixed_values: Mapping[str, float] = field(default_factory=dict, compare=False)
+    forces: Mapping[sympy.Symbol, sympy.Expr] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "coordinates", tuple(self.coordinates))
@@ -155,6 +161,7 @@ class Lagrangian:
         object.__setattr__(self, "expression", sympy.sympify(self.expression))
         object.__setattr__(self, "parameters", dict(self.parameters))
         object.__setattr__(self, "fixed_values", dict(self.fixed_values))
+        object.__setattr__(self, "forces", self._checked_forces(self.forces))
         self._validate()
 
     # ----------------------------------------------------------------- validation
@@ -208,6 +215,58 @@ class Lagrangian:
                     f"{label} does not depend on any coordinate: a constraint chi(q) = 0 must restrict q"
                 )
 
+    def _checked_forces(self, forces: object) -> dict[sympy.Symbol, sympy.Expr]:
+        """``forces`` keyed by coordinate symbols (names accepted), zero forces dropped.
+
+        Raises
+        ------
+        InputError
+            A key that is not a coordinate (with the closest coordinate names), an
+            expression with names other than the coordinates, velocities, parameters and
+            ``t``, or a non-finite number.
+        """
+        if not isinstance(forces, Mapping):
+            raise InputError("forces must be a mapping coordinate -> expression, e.g. {'x': '-c*x_dot'}")
+        by_name = {q.name: q for q in self.coordinates}
+        allowed = set(self.coordinates) | set(self.velocities) | set(self.parameters)
+        if self.time is not None:
+            allowed.add(self.time)
+        checked: dict[sympy.Symbol, sympy.Expr] = {}
+        for key, value in forces.items():
+            label = key.name if isinstance(key, sympy.Symbol) else str(key)
+            if label not in by_name:
+                raise InputError(
+                    f"a force is given on {label!r}, which is not a coordinate of {self.name!r}"
+                    f"{did_you_mean(label, by_name)}; coordinates: {', '.join(by_name)}"
+                )
+            try:
+                expression = sympy.sympify(value)
+            except (sympy.SympifyError, TypeError):
+                raise InputError(f"the force on {label!r} ({value!r}) is not an expression") from None
+            unknown = expression.free_symbols - allowed
+            if unknown:
+                names = sorted(s.name for s in unknown)
+                hints = "".join(did_you_mean(n, [s.name for s in allowed]) for n in names)
+                raise InputError(
+                    f"the force on {label!r} uses unknown names: {', '.join(names)}{hints}; a force may use the "
+                    "coordinates, their velocities <q>_dot, the parameters and t"
+                )
+            if expression.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
+                raise InputError(f"the force on {label!r} is not finite: {expression}")
+            if expression != 0:
+                checked[by_name[label]] = expression
+        return checked
+
+    @property
+    def is_forced(self) -> bool:
+        """Whether generalized forces not derived from a potential act (:attr:`forces`)."""
+        return bool(self.forces)
+
+    @property
+    def force_vector(self) -> tuple[sympy.Expr, ...]:
+        """``(Q_1, ..., Q_n)`` in coordinate order (0 where no force is given)."""
+        return tuple(self.forces.get(q, sympy.S.Zero) for q in self.coordinates)
+
     # ----------------------------------------------------------------- construction
     @classmethod
     def from_strings(
@@ -218,10 +277,13 @@ class Lagrangian:
         constraints: Iterable[str] = (),
         parameters: Mapping[str, float | None] | None = None,
         description: str = "",
+        forces: Mapping[str, str] | None = None,
     ) -> Lagrangian:
         """Build a Lagrangian from expressions written as text (docs/file_formats.md).
 
         The name ``t`` is the time (:attr:`time`) unless ``t`` is one of ``coordinates``.
+        ``forces`` maps coordinate names to generalized forces ``Q_r(q, q_dot, t)`` as
+        text (:attr:`forces`), e.g. ``{"x": "-c*x_dot"}``.
 
         Examples
         --------
@@ -272,7 +334,19 @@ class Lagrangian:
         for label, value in parameters.items():
             if value is not None and not is_real_number(value):
                 raise InputError(f"parameter {label!r} = {value!r} is not a number")
-        return cls(name, q, v, expr, chis, values, description)
+        if forces is None:
+            forces = {}
+        if not isinstance(forces, Mapping):
+            raise InputError("forces must be a table coordinate -> expression, e.g. { x = \"-c*x_dot\" }")
+        parsed: dict[str, sympy.Expr] = {}
+        for label, text in forces.items():
+            if label not in labels:
+                raise InputError(
+                    f"a force is given on {label!r}, which is not a coordinate of {name!r}"
+                    f"{did_you_mean(str(label), labels)}; coordinates: {', '.join(labels)}"
+                )
+            parsed[label] = parse_expression(text, names, what=f"the force on {label!r}", time=TIME)
+        return cls(name, q, v, expr, chis, values, description, forces=parsed)
 
     @classmethod
     def from_sympy(
@@ -283,6 +357,7 @@ class Lagrangian:
         parameters: Mapping[sympy.Symbol | str, float | None] | Iterable[sympy.Symbol | str] | None = None,
         name: str = "system",
         description: str = "",
+        forces: Mapping[object, sympy.Expr] | None = None,
     ) -> Lagrangian:
         """Build a Lagrangian from sympy expressions: plain symbols or ``dynamicsymbols``.
 
@@ -292,12 +367,15 @@ class Lagrangian:
         ``parameters=None`` makes every other symbol a parameter without a default. Any
         symbol named ``t`` and the time of ``dynamicsymbols`` (``dynamicsymbols._t``)
         become the engine's time :data:`dirac.TIME`. See
-        :func:`dirac.model.from_sympy.plain_parts`.
+        :func:`dirac.model.from_sympy.plain_parts`. ``forces`` maps a coordinate (symbol,
+        ``dynamicsymbols`` function or name) to its generalized force ``Q_r`` written like
+        ``L`` (:attr:`forces`).
 
         ``L`` may also be a ``sympy.physics.mechanics.LagrangesMethod`` (given alone,
         without ``coordinates`` and ``constraints``): its Lagrangian, coordinates and
         holonomic constraints are taken (:mod:`dirac.model.lagranges_method`); a
-        non-empty ``forcelist`` or non-holonomic constraints are refused.
+        ``forcelist`` becomes generalized forces ``Q_r`` (:mod:`dirac.model.lagranges_method`);
+        non-holonomic constraints are refused.
 
         Examples
         --------
@@ -312,10 +390,16 @@ class Lagrangian:
             if coordinates is not None or constraints != ():
                 raise InputError("give a LagrangesMethod alone: its coordinates (lm.q) and constraints (hol_coneqs) "
                                  "are taken from it")
-            L, coordinates, constraints = lagranges_method_parts(L)
+            L, coordinates, constraints, loads = lagranges_method_parts(L)
+            if loads and forces:
+                raise InputError("the LagrangesMethod has a forcelist and forces= is given too: give the forces once")
+            forces = forces or loads
         elif coordinates is None:
             raise InputError("from_sympy needs the coordinates, e.g. Lagrangian.from_sympy(L, [x, y]), "
                              "or a sympy LagrangesMethod alone")
+        if forces:
+            parts, converted = plain_forces(L, coordinates, constraints, parameters, velocity_name, forces)
+            return cls(name, *parts, description, forces=converted)
         return cls(name, *plain_parts(L, coordinates, constraints, parameters, velocity_name), description)
 
     # ----------------------------------------------------------------- derived views
@@ -390,6 +474,7 @@ class Lagrangian:
             self.description,
             self.validator,
             merged,
+            {q: e.subs(substitution) for q, e in self.forces.items()},
         )
 
     def with_defaults(self) -> Lagrangian:
@@ -411,6 +496,7 @@ class Lagrangian:
     def __str__(self) -> str:
         lines = [f"{self.name}: L = {self.expression}"]
         lines += [f"  constraint {k}: {c} = 0" for k, c in enumerate(self.constraints, start=1)]
+        lines += [f"  force on {q.name}: Q = {e}" for q, e in self.forces.items()]
         return "\n".join(lines)
 
 

@@ -1,7 +1,8 @@
 """System files: a :class:`~dirac.model.lagrangian.Lagrangian` read from TOML or from Python.
 
 A TOML system file has one ``[system]`` table (``name``, ``coordinates``, ``lagrangian``,
-optional ``parameters``, ``constraints``, ``description``; docs/file_formats.md; the name
+optional ``parameters``, ``constraints``, ``description``, ``forces`` (generalized
+forces by coordinate); docs/file_formats.md; the name
 ``t`` is the time unless a coordinate is called ``t``); a ``.py``
 system file defines ``system()`` returning a Lagrangian. Scene files reuse
 :func:`lagrangian_from_table` for a system written inline.
@@ -18,7 +19,7 @@ from dirac.validate import check_known_keys
 
 __all__ = ["read_system_file", "lagrangian_from_table"]
 
-_SYSTEM_KEYS = {"name", "coordinates", "parameters", "lagrangian", "constraints", "description"}
+_SYSTEM_KEYS = {"name", "coordinates", "parameters", "lagrangian", "constraints", "description", "forces"}
 
 
 def read_system_file(path: str | Path) -> Lagrangian:
@@ -67,9 +68,12 @@ def lagrangian_from_table(table: object, source: str = "system table") -> Lagran
         raise InputError(f"{source}: [system] constraints must be a list of string expressions")
     if not isinstance(parameters, dict):
         raise InputError(f"{source}: [system] parameters must be a table, e.g. {{ m = 1.0 }}")
+    forces = table.get("forces", {})
+    if not isinstance(forces, dict):
+        raise InputError(f"{source}: [system] forces must be a table, e.g. {{ x = \"-c*x_dot\" }}")
     try:
         return Lagrangian.from_strings(
-            name, coordinates, lagrangian, constraints, parameters, str(table.get("description", ""))
+            name, coordinates, lagrangian, constraints, parameters, str(table.get("description", "")), forces=forces
         )
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None

@@ -76,8 +76,14 @@ def constrained_errors(
     constraints: Mapping[str, Any] | None = None,
     energy_conserved: bool = True,
     conserved: Mapping[str, Any] | None = None,
+    work: Any | None = None,
 ) -> dict[str, np.ndarray]:
     """Energy error and constraint residuals, by legend label.
+
+    With ``work`` (the work ``W(t)`` of generalized forces, a forced run) the conserved
+    quantity is ``E - W`` (Lamb's energy balance ``dT/dt = sum_r Q_r q_dot_r``): its error
+    ``|(E - W) - E0| / |E0|`` is drawn, and the change of the energy itself, labelled as
+    not conserved.
 
     The energy error is relative, ``|E - E0| / |E0|`` (absolute, and labelled so, when
     ``E0 = 0``); with ``energy_conserved=False`` (a system that depends on time) it is
@@ -88,7 +94,14 @@ def constrained_errors(
     one curve.
     """
     errors: dict[str, np.ndarray] = {}
-    if energy is not None:
+    if energy is not None and work is not None:
+        E = np.asarray(energy, dtype=float).reshape(-1)
+        W = np.asarray(work, dtype=float).reshape(-1)
+        scale = abs(E[0]) if E[0] != 0 else 1.0
+        balance = E - W
+        errors[r"energy $-$ work $|(E-W)-(E_0-W_0)|/|E_0|$ (conserved)"] = np.abs(balance - balance[0]) / scale
+        errors[r"energy $|E-E_0|/|E_0|$ (not conserved: forces act)"] = np.abs(E - E[0]) / scale
+    elif energy is not None:
         E = np.asarray(energy, dtype=float).reshape(-1)
         scale = abs(E[0])
         note = "" if energy_conserved else " (not conserved: the system depends on time)"
@@ -118,6 +131,7 @@ def constrained_figure(
     constraints: Mapping[str, Any] | None = None,
     energy_conserved: bool = True,
     conserved: Mapping[str, Any] | None = None,
+    work: Any | None = None,
 ) -> Any:
     """The three-panel picture of a constrained-system run.
 
@@ -131,6 +145,9 @@ def constrained_figure(
     constraints : mapping of str to array_like, shape (n,), optional
         The residual of each constraint by name; one curve each, in place of
         ``constraint_residual``.
+    work : array_like, shape (n,), optional
+        The work of the generalized forces (a forced run): the error of ``energy - work``
+        is drawn, and the energy labelled as not conserved (:func:`constrained_errors`).
     names : sequence of str, optional
         Coordinate names (default ``q_1 … q_d``).
     title : str, optional
@@ -151,7 +168,7 @@ def constrained_figure(
     if q.ndim != 2 or q.shape[0] != t.size or t.size == 0:
         raise InputError(f"q must have shape ({t.size}, d) to match t; got {q.shape}")
     labels = _names(names, q.shape[1])
-    errors = constrained_errors(energy, constraint_residual, constraints, energy_conserved, conserved)
+    errors = constrained_errors(energy, constraint_residual, constraints, energy_conserved, conserved, work)
     fig = new_figure(13.0, 9.5)
     legend_rows = (len(errors) + 2) // 2  # the legend under the error panel: two columns, one more entry
     grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=max(0.12, 0.04 + 0.025 * legend_rows), top=0.93,

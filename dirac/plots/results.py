@@ -218,6 +218,7 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem
     q = _first_body(_get(result, "q"), 2)
     energy = _first_body(_get(result, "energy"), 1) if _has(result, "energy") else None
     residual = _first_body(_get(result, "constraint_residual"), 1) if _has(result, "constraint_residual") else None
+    work = _first_body(_get(result, "work"), 1) if _has(result, "work") else None
     names = list(coordinates) if coordinates is not None else meta.get("coordinates")
     if names is None:
         names = getattr(getattr(problem, "mechanics", None), "coordinate_names", None)
@@ -225,7 +226,7 @@ def result_figure(result: Any, coordinates: Sequence[str] | None = None, problem
     return constrained_figure(t, q, energy=energy, constraint_residual=residual, names=names,
                               title=_title(meta, "constrained system", time_unit=""),
                               constraints=_constraint_residuals(result, problem),
-                              energy_conserved=not time_dependent, conserved=conserved)
+                              energy_conserved=not time_dependent, conserved=conserved, work=work)
 
 
 def plot(solution: Any, problem: Any | None = None, *, coordinates: Sequence[str] | None = None) -> Any:

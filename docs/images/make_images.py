@@ -61,6 +61,41 @@ def make_all() -> None:
         run("run", str(work / "bead_scene.toml"), "--no-progress", "--out", str(work / "bead.npz"),
             "--plot", str(IMAGES / "bead.png"))
         shutil.rmtree(work, ignore_errors=True)
+    poincare_section(IMAGES / "poincare.png")
+
+
+def poincare_section(path: Path, periods: int = 20000) -> None:
+    """The Poincare section of the chaotic driven damped pendulum of forces.md: the same
+    system and method as the page's Python block, with ``periods`` drive periods."""
+    import math
+
+    import numpy as np
+
+    import dirac
+    from dirac.plots.canvas import new_figure
+
+    print(f"poincare section of the driven pendulum, {periods} periods (docs/forces.md)", flush=True)
+    driven = dirac.Lagrangian.from_strings(
+        "driven_pendulum", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",
+        constraints=["x**2 + y**2 - l**2"],
+        parameters={"m": 1.0, "g": 1.0, "l": 1.0, "c": 0.5, "A": 1.5, "w": 2 / 3},
+        forces={"x": "-c*x_dot - A*cos(w*t)*y/l**2", "y": "-c*y_dot + A*cos(w*t)*x/l**2"})
+    period = 2 * math.pi / (2 / 3)
+    problem = dirac.ForcedProblem(driven, [0.0, -1.0], [0.0, 0.0])
+    run = dirac.integrate(problem, "forced-rattle-2", t_end=periods * period, dt=period / 400,
+                          samples=periods + 1, outputs=["q", "q_dot"])
+    x, y = run.outputs["q"][100:].T
+    vx, vy = run.outputs["q_dot"][100:].T
+    theta, omega = np.arctan2(x, -y), x * vy - y * vx
+    fig = new_figure(8.0, 6.0)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.plot(theta, omega, ",", color="tab:blue", alpha=0.8)
+    ax.set_xlabel(r"angle $\theta$ (rad), once per drive period $2\pi/\omega$")
+    ax.set_ylabel(r"angular velocity $\dot\theta$ (rad per unit time)")
+    ax.set_title(r"Driven damped pendulum, $c = 0.5$, $A = 1.5$, $\omega = 2/3$: Poincaré section "
+                 f"({theta.size} points, forced-rattle-2)", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    fig.savefig(path, dpi=110)
 
 
 if __name__ == "__main__":

@@ -129,17 +129,38 @@ def test_a_lagranges_method_gives_its_lagrangian_coordinates_and_constraints():
     assert built == by_hand
 
 
-def test_a_lagranges_method_with_forces_or_nonholonomic_constraints_is_refused():
+def test_a_lagranges_method_forcelist_becomes_generalized_forces():
+    """Drag ``-c v`` on a particle at ``(x, y)`` and a torque ``tau`` on a frame turned by ``th``.
+
+    By hand, ``Q_r = sum_i (d v_i/d q_dot_r) . F_i``: the drag gives ``Q_x = -c x_dot``,
+    ``Q_y = -c y_dot``; the torque ``tau N.z`` on a frame with angular velocity ``th_dot N.z``
+    gives ``Q_th = tau``.
+    """
     from sympy.physics.mechanics import LagrangesMethod, Point, ReferenceFrame
+
+    x, y, th = dynamicsymbols("x y th")
+    t = dynamicsymbols._t
+    c, tau = sympy.symbols("c tau")
+    N = ReferenceFrame("N")
+    B = N.orientnew("B", "Axis", [th, N.z])
+    P = Point("P")
+    P.set_vel(N, x.diff(t) * N.x + y.diff(t) * N.y)
+    L = (x.diff(t) ** 2 + y.diff(t) ** 2 + th.diff(t) ** 2) / 2
+    loads = [(P, -c * (x.diff(t) * N.x + y.diff(t) * N.y)), (B, tau * N.z)]
+    forced = LagrangesMethod(L, [x, y, th], forcelist=loads, frame=N)
+    built = Lagrangian.from_sympy(forced, parameters={"c": 0.5, "tau": 2.0})
+    x_dot, y_dot = sympy.Symbol("x_dot", real=True), sympy.Symbol("y_dot", real=True)
+    c_, tau_ = sympy.Symbol("c", real=True), sympy.Symbol("tau", real=True)
+    assert {str(k): sympy.simplify(v) for k, v in built.forces.items()} == {"x": -c_ * x_dot, "y": -c_ * y_dot, "th": tau_}
+    with pytest.raises(InputError, match="give the forces once"):
+        Lagrangian.from_sympy(forced, forces={x: -c * x.diff(t)}, parameters={"c": 0.5, "tau": 2.0})
+
+
+def test_a_lagranges_method_with_nonholonomic_constraints_is_refused():
+    from sympy.physics.mechanics import LagrangesMethod
 
     x = dynamicsymbols("x")
     t = dynamicsymbols._t
-    N = ReferenceFrame("N")
-    P = Point("P")
-    P.set_vel(N, x.diff(t) * N.x)
-    forced = LagrangesMethod(x.diff(t) ** 2 / 2, [x], forcelist=[(P, -x.diff(t) * N.x)], frame=N)
-    with pytest.raises(InputError, match="forces are not supported by this path yet"):
-        Lagrangian.from_sympy(forced)
     y = dynamicsymbols("y")
     rolling = LagrangesMethod((x.diff(t) ** 2 + y.diff(t) ** 2) / 2, [x, y], nonhol_coneqs=[x.diff(t) - y * y.diff(t)])
     with pytest.raises(InputError, match="non-holonomic"):

@@ -110,7 +110,7 @@ def test_toml_unknown_keys_are_errors_naming_the_file_and_the_closest_keys(tmp_p
         read_system_file(path)
     assert str(error.value) == (
         f"{path}: [system] has unknown keys 'colour', 'constraint' (did you mean 'constraints'?); "
-        "known keys: constraints, coordinates, description, lagrangian, name, parameters"
+        "known keys: constraints, coordinates, description, forces, lagrangian, name, parameters"
     )
 
 

@@ -204,11 +204,14 @@ def _module(analysis: Analysis, free: list[sympy.Symbol]) -> Any:
     H = analysis.canonical_hamiltonian + sum(
         (u * phi for u, phi in zip(analysis.primary_multipliers, analysis.primary_constraints) if u in free),
         sympy.S.Zero)
-    time = analysis.time  # a time-dependent system's t: the last parameter, written by field(t, ...)
+    given = getattr(analysis, "forces", {})
+    n = len(analysis.phase_space) // 2
+    forces = [given.get(s.name, sympy.S.Zero) for s in analysis.phase_space[:n]] if given else []
+    time = analysis.time  # a time-dependent system's t (of L, the constraints or the forces): the last parameter
     source = vector_field_source(
         analysis.phase_space, [*analysis.parameters, *free, *([time] if time is not None else [])], H,
         list(analysis.second_class), list(analysis.constraints), title=f"Dirac vector field of {analysis.name}",
-        time=time)
+        time=time, forces=forces)
     module = compile_vector_field(source)
     _MODULES[analysis] = module
     return module

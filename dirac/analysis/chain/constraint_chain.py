@@ -120,7 +120,10 @@ class ConstraintChain:
     to its number (an irregular one cannot be regularised inside the chain: its
     multiplier term in ``H_c`` would stay irregular). ``choices`` maps a constraint that is
     the union of disjoint branches to the branch this chain follows (or to itself when the
-    union is analysed whole, its branches having the same structure).
+    union is analysed whole, its branches having the same structure). ``forces`` maps the
+    momentum ``p_r`` of a coordinate to the generalized force ``Q_r`` in phase-space
+    variables: Lagrange's equations with forces give ``p_dot = -dH/dq + Q``, so every
+    consistency condition gains ``sum_r dPhi/dp_r Q_r`` and the multipliers are solved with it.
     """
 
     phase_space: PhaseSpace
@@ -140,6 +143,7 @@ class ConstraintChain:
     written: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
     holonomic: dict[sympy.Expr, int] = field(default_factory=dict)
     choices: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
+    forces: dict[sympy.Symbol, sympy.Expr] = field(default_factory=dict)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -159,6 +163,8 @@ class ConstraintChain:
             b = pb(constraint, self.canonical_hamiltonian)
             if self.time is not None:  # d Phi/dt = {Phi, H_T} + d_t Phi for a rheonomic system
                 b = b + sympy.diff(constraint, self.time)
+            for momentum, force in self.forces.items():  # p_dot = -dH/dq + Q: + sum_r dPhi/dp_r Q_r
+                b = b + sympy.diff(constraint, momentum) * force
             cached = (b, [pb(constraint, phi) for phi in self.primary])
             self._row_cache[constraint] = cached
         return cached
@@ -355,6 +361,7 @@ class ConstraintChain:
         return ConstraintChain(
             self.phase_space, self.numerics, self.canonical_hamiltonian, list(self.primary), self.multipliers,
             time=self.time, written=dict(self.written), holonomic=dict(self.holonomic), choices=choices,
+            forces=dict(self.forces),
         )
 
     def _structure(self) -> tuple[tuple[int, ...], int, tuple[str, ...], int]:

@@ -22,6 +22,9 @@
 * A rigid body or heavy top driven by an external torque or angular impulses: the same
   candidates and the same Richardson logic, with torque kicks
   (:mod:`dirac.flows.methods.torqued`).
+* Forced systems: ``forced-rattle-2/4`` (and ``conformal-2/4`` for linear damping of a
+  constant-mass system) by the same Richardson estimate, costed by the evaluations per
+  step of a short pilot.
 * General and analysed systems: each candidate of order ``p`` (``rattle-2/4``, resp.
   ``midpoint``) is run over a pilot span with steps ``h`` and ``h/2``; Richardson's
   estimate with linear growth in time gives the step for ``tolerance``; the cheaper
@@ -135,6 +138,8 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
     if kind == "analysed":
         candidates = ("midpoint",)
         dt0 = dt if dt is not None else t_end / 1000.0
+    elif kind == "forced":
+        return _forced(problem, t_end, tolerance, dt, outputs, options)
     else:
         candidates = ("rattle-2", "rattle-4")
         dt0 = dt if dt is not None else t_end / 1000.0
@@ -250,5 +255,28 @@ def _heavy_top(problem, t_end: float, tolerance: float, dt: float | None, output
             best_cost = cost
             best = AutoChoice(name, step, f"pilot Richardson estimate: {name} with dt = {step:.3g} is the cheapest "
                               f"candidate for tolerance {tolerance:g} (~{cost * 1e-6:.2g} s)", predicted)
+    assert best is not None
+    return best
+
+
+def _forced(problem, t_end: float, tolerance: float, dt: float | None, outputs, options) -> AutoChoice:
+    """A forced system: the cheapest of ``forced-rattle-2/4`` (and ``conformal-2/4`` for
+    linear damping of a constant-mass system), each judged by Richardson's estimate as the
+    other general systems, its cost the evaluations per step its pilot measured."""
+    candidates = ["forced-rattle-2", "forced-rattle-4"]
+    if problem.mechanics.conformal_rate is not None:
+        candidates = ["conformal-2", "conformal-4", *candidates]
+    dt_start = dt if dt is not None else t_end / 1000.0
+    best: AutoChoice | None = None
+    best_cost = math.inf
+    for name in candidates:
+        step, predicted = _richardson_step(name, problem, outputs, dt_start, t_end, tolerance, options)
+        stepper = get_method(name).start(problem, outputs, options)
+        stepper.step(4, step)
+        cost = math.ceil(t_end / step) * max(1.0, stepper.evaluations / 4.0)
+        if cost < best_cost:
+            best_cost = cost
+            best = AutoChoice(name, step, f"pilot Richardson estimate: {name} with dt = {step:.3g} is the cheapest "
+                              f"forced method for tolerance {tolerance:g}", predicted)
     assert best is not None
     return best

@@ -13,7 +13,7 @@ factories are joined here, so neither of those modules imports the other.
 from __future__ import annotations
 
 from dirac.errors import InputError
-from dirac.flows.methods import exact, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
+from dirac.flows.methods import exact, forced, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
 from dirac.flows.methods.base import Method
 from dirac.validate import unknown_name_error
 
@@ -46,6 +46,7 @@ METHODS: dict[str, Method] = _collect(
     midpoint.METHODS,
     rattle.METHODS,
     scipy_rk.METHODS,
+    forced.METHODS,
 )
 
 
