@@ -74,6 +74,7 @@ def constrained_errors(
     energy: Any | None,
     constraint_residual: Any | None,
     constraints: Mapping[str, Any] | None = None,
+    *,
     energy_conserved: bool = True,
     conserved: Mapping[str, Any] | None = None,
     work: Any | None = None,
@@ -168,7 +169,8 @@ def constrained_figure(
     if q.ndim != 2 or q.shape[0] != t.size or t.size == 0:
         raise InputError(f"q must have shape ({t.size}, d) to match t; got {q.shape}")
     labels = _names(names, q.shape[1])
-    errors = constrained_errors(energy, constraint_residual, constraints, energy_conserved, conserved, work)
+    errors = constrained_errors(energy, constraint_residual, constraints, energy_conserved=energy_conserved,
+                                conserved=conserved, work=work)
     fig = new_figure(13.0, 9.5)
     legend_rows = (len(errors) + 2) // 2  # the legend under the error panel: two columns, one more entry
     grid = fig.add_gridspec(2, 2, left=0.07, right=0.98, bottom=max(0.12, 0.04 + 0.025 * legend_rows), top=0.93,
