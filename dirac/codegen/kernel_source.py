@@ -54,7 +54,7 @@ import numba
 
 #: the decorator of the expression functions and small helpers: compiled into their callers
 #: (numba inlines them at its own IR level, so the step loop holds straight-line code)
-INLINED = '@numba.njit(cache=True, inline="always")'
+INLINED = '@numba.njit(cache=True)'
 
 
 def _index(position: int, shape: tuple[int, ...]) -> str:

@@ -72,7 +72,9 @@ class MechanicalSystem:
     """Numerical pieces of a natural mechanical system with holonomic constraints.
 
     Build it with :meth:`from_lagrangian`. :attr:`module` is the generated kernel module
-    of :func:`dirac.codegen.kernel_source.mechanical_kernel_source` (functions
+    of :func:`dirac.codegen.kernel_source.mechanical_kernel_source`, interpreted or
+    compiled as pays (:class:`dirac.codegen.tiers.TieredModule`; ``module.name`` is the
+    compiled function, ``module.function(name)`` the tiered one) (functions
     ``f(q, t, c, out)`` of the coordinates in :attr:`coordinate_names` order, the time and
     the parameter values :attr:`params`; step loops ``rattle_constant_mass``,
     ``rattle_general``, ``midpoint_run``; ``field``, ``energy``, ``residuals``).
@@ -185,15 +187,16 @@ class MechanicalSystem:
         n, m = len(q), len(lagrangian.constraints)
         time = lagrangian.time if lagrangian.is_time_dependent else None
         constant = all(not (entry.free_symbols & {*q, *([time] if time is not None else [])}) for entry in mass)
-        from dirac.codegen import load_kernels, mechanical_kernel_source
+        from dirac.codegen import mechanical_kernel_source
+        from dirac.codegen.tiers import tiered_module
 
         source = mechanical_kernel_source(q, parameter_symbols, mass, potential, list(chis), time,
                                           title=f"system {lagrangian.name}")
-        module = load_kernels(source + extra_source)
+        module = tiered_module(source + extra_source, f"system {lagrangian.name!r}")
         constant_mass = None
         if constant:
             constant_mass = np.empty((n, n))
-            module.mass(np.zeros(n), 0.0, param_array, constant_mass)
+            module.function("mass")(np.zeros(n), 0.0, param_array, constant_mass)
         system = cls(
             name=lagrangian.name,
             coordinate_names=tuple(s.name for s in q),
@@ -213,7 +216,7 @@ class MechanicalSystem:
     def _evaluate(self, name: str, q: np.ndarray, time: float, shape: tuple[int, ...]) -> np.ndarray:
         """The generated function ``name(q, t, c, out)`` of the kernel module at one point."""
         out = np.empty(shape)
-        getattr(self.module, name)(np.ascontiguousarray(q, dtype=float), float(time), self.params, out)
+        self.module.function(name)(np.ascontiguousarray(q, dtype=float), float(time), self.params, out)
         return out
 
     def mass_matrix(self, q: np.ndarray, time: float = 0.0) -> np.ndarray:
@@ -234,7 +237,7 @@ class MechanicalSystem:
         """``H = 1/2 p^T M(q, t)^{-1} p + V(q, t)`` (generated kernel ``energy``)."""
         self.mass_matrix(q, time)  # refuses a singular mass matrix
         q = np.ascontiguousarray(q, dtype=float)
-        return float(self.module.energy(q, np.ascontiguousarray(p, dtype=float), float(time), self.params))
+        return float(self.module.function("energy")(q, np.ascontiguousarray(p, dtype=float), float(time), self.params))
 
     def residuals(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Position residuals ``chi(q, t)`` and velocity residuals ``G(q, t) M(q, t)^{-1} p + d chi/dt``
@@ -244,8 +247,8 @@ class MechanicalSystem:
             return np.zeros(0), np.zeros(0)
         self.mass_matrix(q, time)  # refuses a singular mass matrix
         out = np.empty(2 * m)
-        self.module.residuals(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(p, dtype=float),
-                              float(time), self.params, out)
+        self.module.function("residuals")(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(p, dtype=float),
+                                          float(time), self.params, out)
         return out[:m], out[m:]
 
     def constraint_residual(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> float:
