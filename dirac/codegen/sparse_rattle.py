@@ -148,7 +148,7 @@ def sparse_rattle_source(
     # ------------------------------------------------------------ families of constraints
     families = group_families(list(constraints), q)
     width = max([len(f.placeholders) for f in families] + [1])
-    columns = [(0,)] * m
+    columns: list[tuple[int, ...]] = [(0,)] * m
     for f in families:
         for member, cols in zip(f.members, f.columns):
             columns[member] = cols

@@ -14,6 +14,9 @@ like a tiered JIT, when to switch:
   times the steps still planned), exceeds :data:`COMPILE_SECONDS`, the function is
   compiled and the compiled form takes over.
 
+``DIRAC_KERNELS=compiled`` in the environment (or :func:`set_policy` ``("compiled")``,
+which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
+
 Both forms execute the same source with the same floating-point operations in the same
 order: a run gives the same method and the same accuracy on either tier, only the speed
 differs. The first compilation in a process writes one line to stderr
@@ -33,7 +36,7 @@ import numpy as np
 
 from dirac.codegen.numba_backend import cache_directory, import_source, interpret_source
 
-__all__ = ["COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -41,6 +44,24 @@ __all__ = ["COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compil
 COMPILE_SECONDS = 1.0
 
 _announced = False
+
+_POLICIES = ("auto", "compiled")
+_policy = os.environ.get("DIRAC_KERNELS", "auto")
+if _policy not in _POLICIES:
+    from dirac.errors import warn
+
+    warn(f"DIRAC_KERNELS={_policy!r} is not one of {', '.join(_POLICIES)}; using 'auto'")
+    _policy = "auto"
+
+
+def set_policy(policy: str) -> str:
+    """``"auto"`` (interpreted until compiling pays) or ``"compiled"`` (always compiled);
+    returns the previous policy. The default is ``$DIRAC_KERNELS`` or ``"auto"``."""
+    global _policy
+    if policy not in _POLICIES:
+        raise ValueError(f"policy {policy!r}: use one of {', '.join(_POLICIES)}")
+    previous, _policy = _policy, policy
+    return previous
 
 
 def announce_compilation(what: str, why: str) -> None:
@@ -149,6 +170,8 @@ class TieredFunction:
     def __call__(self, *args: Any) -> Any:
         """Call with the budget of single evaluations: interpreted until the interpreted
         time reaches :data:`COMPILE_SECONDS`, compiled afterwards."""
+        if self.tier == "interpreted" and _policy == "compiled":
+            self.compile("DIRAC_KERNELS=compiled")
         if self.tier == "interpreted" and self.interpreted_seconds > COMPILE_SECONDS:
             self.compile(f"{self.interpreted_calls} interpreted calls took {self.interpreted_seconds:.1f} s")
         if self._compiled is not None:
@@ -164,7 +187,9 @@ class TieredFunction:
         """
         if self.tier == "interpreted":
             per_step = self.seconds_per_step()
-            if planned is None:
+            if _policy == "compiled":
+                self.compile("DIRAC_KERNELS=compiled")
+            elif planned is None:
                 self.compile("a run of unknown length")
             elif per_step is not None and per_step * planned > COMPILE_SECONDS:
                 self.compile(f"about {planned} steps to go, {per_step * planned:.1f} s interpreted")
@@ -179,7 +204,7 @@ class TieredFunction:
         """A one-step call on scratch arguments before a run of ``planned`` steps: measures
         the interpreted time per step and, when the run would take longer than
         :data:`COMPILE_SECONDS` interpreted, compiles now (before the run's clock starts)."""
-        if self.tier == "interpreted" and planned is not None and self.seconds_per_step() is None:
+        if self.tier == "interpreted" and _policy == "auto" and planned is not None and self.seconds_per_step() is None:
             self._interpreted_call(1, args)
         self.run_steps(1, planned, *args)
 

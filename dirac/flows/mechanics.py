@@ -244,6 +244,25 @@ class MechanicalSystem:
         )
         return system
 
+    def require_field(self, what: str) -> None:
+        """Refuse ``what`` (a method needing the Dirac vector field) on a system whose
+        generated module holds RATTLE only (:mod:`dirac.codegen.sparse_rattle`: a constant
+        diagonal mass and many constraints).
+
+        Raises
+        ------
+        InputError
+            When the module has no vector field.
+        """
+        from dirac.codegen.sparse_rattle import RATTLE_ONLY
+
+        if RATTLE_ONLY in getattr(self.module, "source", ""):
+            raise InputError(
+                f"{what} needs the Dirac vector field of {self.name!r}, which is not generated for a system of "
+                f"{self.n_constraints} constraints with a constant diagonal mass (its kernel module holds the looped "
+                "RATTLE only, so that it compiles in seconds); use rattle-2 (or rattle-4/6/8)"
+            )
+
     # ------------------------------------------------------------------ numerics (numpy side)
     def _evaluate(self, name: str, q: np.ndarray, time: float, shape: tuple[int, ...]) -> np.ndarray:
         """The generated function ``name(q, t, c, out)`` of the kernel module at one point."""

@@ -72,6 +72,7 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
 
     def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__(problem, outputs, options)
+        self.mechanics.require_field("midpoint")
         for q in self.q:
             self.mechanics.mass_matrix(q)
         self.z = np.ascontiguousarray(np.concatenate([self.q, self.p], axis=1))
