@@ -24,6 +24,7 @@ import os
 import subprocess
 import sys
 import tempfile
+from typing import Any
 
 import numpy as np
 
@@ -62,13 +63,13 @@ def _chain_child(N: int, steps: int) -> dict:
     angles = 0.3
     q0 = np.array([v for k in range(N) for v in ((k + 1) * math.sin(angles), -(k + 1) * math.cos(angles))])
     problem = ConstrainedProblem(chain_lagrangian(N), q0, np.zeros(2 * N))
-    stepper = get_method("rattle-2").start(problem, ("q",), {})
+    stepper: Any = get_method("rattle-2").start(problem, ("q",), {})
     stepper.step(1, 1e-3)
     first = time.process_time() - start
     begin = time.process_time()
     stepper.step(steps, 1e-3)
     per_step = (time.process_time() - begin) / steps
-    r = np.asarray(getattr(stepper, "q"))[0].reshape(N, 2)
+    r = np.asarray(stepper.q)[0].reshape(N, 2)
     rods = np.linalg.norm(np.diff(np.vstack([[0.0, 0.0], r]), axis=0), axis=1)
     return {"N": N, "first_call_s": first, "ns_per_step_link": per_step / N * 1e9,
             "rod_error": float(np.abs(rods - 1.0).max())}
