@@ -61,7 +61,7 @@ SPARSE_MIN_CONSTRAINTS = 4
 
 #: the decorator of the expression functions and small helpers: compiled into their callers
 #: (numba inlines them at its own IR level, so the step loop holds straight-line code)
-INLINED = '@numba.njit(cache=True)'
+INLINED = '@numba.njit(cache=True, inline="always")'
 
 
 def _index(position: int, shape: tuple[int, ...]) -> str:

@@ -18,7 +18,7 @@ __all__ = ["mechanical_templates", "analysed_templates"]
 
 _COMMON = '''
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def max_abs(x):
     """max |x_i| (inf if any entry is NaN)."""
     r = 0.0
@@ -29,7 +29,7 @@ def max_abs(x):
     return r
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def scale(x, count):
     """1 + sum of x_i^2 over the first count entries: the scale of Newton tolerances."""
     s = 1.0
@@ -38,7 +38,7 @@ def scale(x, count):
     return s
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def report(info, steps_done, failed, evals, residual):
     """info = [steps_done, failed (0/1), evaluations, last_residual]."""
     info[0] = steps_done
@@ -144,7 +144,7 @@ def field(z, t, c, out):
 
 _VELOCITY_BY_ELIMINATION = '''
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def velocity(q, p, t, c, v, work, piv):
     """v = M(q, t)^{-1} p; work (n, n) keeps the LU factors of M, piv their row exchanges."""
     mass(q, t, c, work)
@@ -156,7 +156,7 @@ def velocity(q, p, t, c, v, work, piv):
 
 _STAGE_RESIDUAL = '''
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv):
     """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau)."""
     for i in range(__N__):
@@ -181,7 +181,7 @@ def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, wo
 _MECHANICAL = '''
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def project_momentum(G, W, u, chi_t, p, h, S, rhs, mu, piv):
     """RATTLE's closing projection onto the hidden constraints G M^{-1} p + d chi/dt = 0:
     with G at the new position, W = M^{-1} G^T and u = M^{-1} p, solve
@@ -327,7 +327,9 @@ def field_work():
 
 @numba.njit(cache=True)
 def field_into(z, t, c, out, work):
-    """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on z = (q, p),
+    """Called, not inlined, at the three places of midpoint_run (one compiled copy).
+
+    z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on z = (q, p),
     C = grad Phi J grad Phi^T, over the second-class constraints
     Phi = (chi(q, t), G(q, t) M^{-1} p + d chi/dt) (the second and third stages; Dirac
     bracket (240)); C is evaluated and solved at z."""
@@ -434,7 +436,7 @@ def project_work():
             np.empty(__K__, dtype=np.int64))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def project(z, t, c, tol, work):
     """Orthogonal projection of z onto Phi = 0 (Gauss-Newton, at most 5 iterations):
     z <- z - D^T (D D^T)^{-1} Phi(z) (Hairer, Lubich & Wanner IV.4)."""

@@ -22,13 +22,13 @@ __all__ = ["solve_source", "lu_source"]
 
 _CLOSED_FORMS = {
     1: '''
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def solve_1(A, b, x, piv):
     """x = A^{-1} b for a 1 x 1 matrix."""
     x[0] = b[0] / A[0, 0]
 ''',
     2: '''
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def solve_2(A, b, x, piv):
     """x = A^{-1} b for a 2 x 2 matrix (Cramer's rule)."""
     det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
@@ -41,7 +41,7 @@ def solve_2(A, b, x, piv):
 }
 
 _LU = '''
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def lu_factor(A, piv):
     """A <- its LU factors with partial pivoting (row exchanges in piv), in place."""
     k = A.shape[0]
@@ -67,7 +67,7 @@ def lu_factor(A, piv):
                     A[r, j] -= f * A[c, j]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def lu_solve(A, piv, b):
     """b <- A^{-1} b with the factors of lu_factor, in place (the row exchanges and the
     eliminations applied to b in the order lu_factor made them)."""
@@ -88,7 +88,7 @@ def lu_solve(A, piv, b):
 '''
 
 _BY_ELIMINATION = '''
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def solve_{k}(A, b, x, piv):
     """x = A^{{-1}} b for a {k} x {k} matrix by elimination with partial pivoting; A is overwritten."""
     lu_factor(A, piv)
@@ -113,7 +113,7 @@ def solve_source(size: int) -> str:
     """
     if size == 0:
         return '''
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def solve_0(A, b, x, piv):
     """Nothing to solve (no constraints)."""
     return
