@@ -54,11 +54,9 @@ def _chain_child(N: int, steps: int) -> dict:
     """In a fresh process: first compiled rattle-2 call, then ns per step and link."""
     import time
 
-    from dirac.codegen.tiers import set_policy
     from dirac.flows.methods.registry import get_method
     from dirac.flows.problems import ConstrainedProblem
 
-    set_policy("compiled")
     start = time.process_time()
     angles = 0.3
     q0 = np.array([v for k in range(N) for v in ((k + 1) * math.sin(angles), -(k + 1) * math.cos(angles))])
@@ -98,12 +96,11 @@ def _first_result_child(system: str, method: str) -> dict:
     return {"system": system, "method": method, "cpu_s": time.process_time()}
 
 
-def _child(command: str) -> dict:
+def _child(command: str, kernels: str = "auto") -> dict:
     """Run ``command`` (Python source calling a child function) in a fresh process with an
-    empty cache of generated code; its JSON result."""
+    empty cache of generated code and ``DIRAC_KERNELS=kernels``; its JSON result."""
     with tempfile.TemporaryDirectory(prefix="dirac-codegen-scale-") as scratch:
-        env = dict(os.environ, DIRAC_CACHE_DIR=scratch)
-        env.pop("DIRAC_KERNELS", None)
+        env = dict(os.environ, DIRAC_CACHE_DIR=scratch, DIRAC_KERNELS=kernels)
         result = subprocess.run([sys.executable, "-c", f"import json; from dirac.bench.codegen_scale import *; "
                                  f"from dirac.bench.codegen_scale import _chain_child, _first_result_child; "
                                  f"print(json.dumps({command}))"],
@@ -117,7 +114,7 @@ def codegen_scale_targets(quick: bool) -> tuple[list[Target], str]:
     """The chain rows (N = 8, 16, 32; up to 128 unless ``quick``) and the first-result rows,
     their targets, and the table as a note."""
     sizes = (8, 16, 32) if quick else (8, 16, 32, 64, 128)
-    chain = [_child(f"_chain_child({N}, {max(2000, 200_000 // N)})") for N in sizes]
+    chain = [_child(f"_chain_child({N}, {max(2000, 200_000 // N)})", "compiled") for N in sizes]
     first = [_child(f"_first_result_child({system!r}, {method!r})")
              for system in _FIRST_RESULT_SYSTEMS for method in _FIRST_RESULT_METHODS]
     slope = float(np.polyfit(np.log([r["N"] for r in chain]), np.log([r["first_call_s"] for r in chain]), 1)[0])

@@ -522,11 +522,4 @@ def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], Non
     targets.append(heavy_top_equal_cpu_target(rows))
     targets.append(torqued_target(rows))
     attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
-
-    def codegen_scale() -> tuple[list[Target], str]:
-        from dirac.bench.codegen_scale import codegen_scale_targets
-
-        return codegen_scale_targets(quick)
-
-    attempt("codegen scale: chain first call and per-step cost against N, cold first results", codegen_scale)
     return targets, notes

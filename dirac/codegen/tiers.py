@@ -36,7 +36,7 @@ import numpy as np
 
 from dirac.codegen.numba_backend import cache_directory, import_source, interpret_source
 
-__all__ = ["set_policy", "COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -46,22 +46,34 @@ COMPILE_SECONDS = 1.0
 _announced = False
 
 _POLICIES = ("auto", "compiled")
-_policy = os.environ.get("DIRAC_KERNELS", "auto")
-if _policy not in _POLICIES:
-    from dirac.errors import warn
-
-    warn(f"DIRAC_KERNELS={_policy!r} is not one of {', '.join(_POLICIES)}; using 'auto'")
-    _policy = "auto"
+_policy: str | None = None  # set_policy's choice; None: $DIRAC_KERNELS or "auto"
+_warned: set[str] = set()
 
 
-def set_policy(policy: str) -> str:
-    """``"auto"`` (interpreted until compiling pays) or ``"compiled"`` (always compiled);
-    returns the previous policy. The default is ``$DIRAC_KERNELS`` or ``"auto"``."""
+def set_policy(policy: str | None) -> str | None:
+    """``"auto"`` (interpreted until compiling pays), ``"compiled"`` (always compiled) or
+    None (``$DIRAC_KERNELS``, read at each decision, default ``"auto"``); returns the
+    previous setting."""
     global _policy
-    if policy not in _POLICIES:
+    if policy is not None and policy not in _POLICIES:
         raise ValueError(f"policy {policy!r}: use one of {', '.join(_POLICIES)}")
     previous, _policy = _policy, policy
     return previous
+
+
+def current_policy() -> str:
+    """The policy in force: :func:`set_policy`'s, else ``$DIRAC_KERNELS``, else ``"auto"``."""
+    if _policy is not None:
+        return _policy
+    value = os.environ.get("DIRAC_KERNELS", "auto")
+    if value not in _POLICIES:
+        if value not in _warned:
+            from dirac.errors import warn
+
+            _warned.add(value)
+            warn(f"DIRAC_KERNELS={value!r} is not one of {', '.join(_POLICIES)}; using 'auto'")
+        return "auto"
+    return value
 
 
 def announce_compilation(what: str, why: str) -> None:
@@ -170,7 +182,7 @@ class TieredFunction:
     def __call__(self, *args: Any) -> Any:
         """Call with the budget of single evaluations: interpreted until the interpreted
         time reaches :data:`COMPILE_SECONDS`, compiled afterwards."""
-        if self.tier == "interpreted" and _policy == "compiled":
+        if self.tier == "interpreted" and current_policy() == "compiled":
             self.compile("DIRAC_KERNELS=compiled")
         if self.tier == "interpreted" and self.interpreted_seconds > COMPILE_SECONDS:
             self.compile(f"{self.interpreted_calls} interpreted calls took {self.interpreted_seconds:.1f} s")
@@ -187,7 +199,7 @@ class TieredFunction:
         """
         if self.tier == "interpreted":
             per_step = self.seconds_per_step()
-            if _policy == "compiled":
+            if current_policy() == "compiled":
                 self.compile("DIRAC_KERNELS=compiled")
             elif planned is None:
                 self.compile("a run of unknown length")
@@ -204,7 +216,7 @@ class TieredFunction:
         """A one-step call on scratch arguments before a run of ``planned`` steps: measures
         the interpreted time per step and, when the run would take longer than
         :data:`COMPILE_SECONDS` interpreted, compiles now (before the run's clock starts)."""
-        if self.tier == "interpreted" and _policy == "auto" and planned is not None and self.seconds_per_step() is None:
+        if self.tier == "interpreted" and current_policy() == "auto" and planned is not None and self.seconds_per_step() is None:
             self._interpreted_call(1, args)
         self.run_steps(1, planned, *args)
 

@@ -83,15 +83,19 @@ def test_a_short_run_is_interpreted_and_gives_the_compiled_numbers(method: str, 
     before = function.interpreted_calls
     interpreted = integrate(short, method, t_end=0.05, dt=0.01, samples=6)
     assert function.interpreted_calls > before or function.tier == "compiled"  # interpreted unless compiled already
-    monkeypatch.setattr(tiers, "_policy", "compiled")
+    monkeypatch.setenv("DIRAC_KERNELS", "compiled")
     compiled = integrate(ConstrainedProblem(_pendulum(), q0, p0), method, t_end=0.05, dt=0.01, samples=6)
     assert function.tier == "compiled"
     np.testing.assert_array_equal(interpreted.outputs["q"], compiled.outputs["q"])
     np.testing.assert_array_equal(interpreted.outputs["p"], compiled.outputs["p"])
 
 
-def test_policy_names_are_checked() -> None:
+def test_policy_names_are_checked(monkeypatch) -> None:
     with pytest.raises(ValueError, match="auto, compiled"):
         tiers.set_policy("fast")
     previous = tiers.set_policy("compiled")
+    assert tiers.current_policy() == "compiled"
     assert tiers.set_policy(previous) == "compiled"
+    monkeypatch.setenv("DIRAC_KERNELS", "fastest")
+    with pytest.warns(UserWarning, match="DIRAC_KERNELS='fastest'"):
+        assert tiers.current_policy() == "auto"
