@@ -38,7 +38,7 @@ _FIRST_RESULT_METHODS = ("rattle-2", "midpoint")
 
 def chain_lagrangian(N: int):
     """The planar chain of ``N`` links (unit masses and lengths, gravity 9.81) as a Lagrangian."""
-    from dirac import Lagrangian
+    from dirac.model.lagrangian import Lagrangian
 
     x = [f"x{k}" for k in range(1, N + 1)]
     y = [f"y{k}" for k in range(1, N + 1)]
@@ -77,9 +77,9 @@ def _first_result_child(system: str, method: str) -> dict:
     """In a fresh process: import, build, run 10 steps; CPU seconds of the process so far."""
     import time
 
-    from dirac import Lagrangian
     from dirac.flows.integration import integrate
     from dirac.flows.problems import ConstrainedProblem
+    from dirac.model.lagrangian import Lagrangian
 
     if system == "pendulum":
         lagrangian = Lagrangian.from_strings("pendulum", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",

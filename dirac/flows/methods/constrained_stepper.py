@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 
-from dirac.codegen.tiers import TieredFunction, tiered
 from dirac.flows.dirac_field import constrained_outputs
 from dirac.flows.methods.base import StepFailure, Stepper
 
@@ -83,6 +82,8 @@ def call_tiered(kernel: Any, planned_steps: int | None, steps_done: int, steps: 
     """``kernel(*args)`` advancing ``steps`` steps of a run of ``planned_steps`` (None:
     unknown), ``steps_done`` of them done, through its tier when it is a
     :class:`~dirac.codegen.tiers.TieredFunction`."""
+    from dirac.codegen.tiers import TieredFunction  # not at import: a rigid-body run never needs codegen
+
     if not isinstance(kernel, TieredFunction):
         kernel(*args)
         return
@@ -91,3 +92,10 @@ def call_tiered(kernel: Any, planned_steps: int | None, steps_done: int, steps: 
         kernel.warm_up(planned, *args)
     else:
         kernel.run_steps(steps, planned, *args)
+
+
+def tiered(module: Any, name: str) -> Any:
+    """``name`` of a generated module: its tiered function (:func:`dirac.codegen.tiers.tiered`)."""
+    from dirac.codegen.tiers import tiered as tiered_function
+
+    return tiered_function(module, name)
