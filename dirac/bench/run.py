@@ -98,6 +98,15 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
             measured.append(forced_target(forced))
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"forced systems: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
+        say("codegen scale: chain first call and per-step cost against N, cold first results")
+        try:
+            from dirac.bench.codegen_scale import codegen_scale_targets
+
+            scale_targets, scale_table = codegen_scale_targets(quick)
+            measured.extend(scale_targets)
+            notes.append(scale_table)
+        except Exception as exc:  # one failed measurement must not hide the others
+            notes.append(f"codegen scale: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
     else:
         from dirac.bench.targets import work_precision_targets
 

@@ -41,6 +41,7 @@ from dirac.codegen.numba_backend import import_source
 from dirac.codegen.printer import flat_expressions, straight_line
 from dirac.codegen.rattle_scalar import constant_mass_rattle_source
 from dirac.codegen.small_solves import lu_source, solve_source
+from dirac.codegen.sparse_rattle import sparse_rattle_source
 
 __all__ = ["mechanical_kernel_source", "analysed_kernel_source", "load_kernels"]
 
@@ -50,6 +51,12 @@ import numpy as np
 import numba
 
 '''
+
+
+#: systems with a constant diagonal mass and at least this many constraints get the looped
+#: RATTLE of :mod:`dirac.codegen.sparse_rattle` (its source and compile time grow linearly
+#: with the system; the unrolled one's like m^2 n); fewer constraints keep the unrolled one
+SPARSE_MIN_CONSTRAINTS = 4
 
 
 #: the decorator of the expression functions and small helpers: compiled into their callers
@@ -155,6 +162,14 @@ def mechanical_kernel_source(
     """
     q = list(coordinates)
     n, m = len(q), len(constraints)
+    mass = sympy.Matrix(mass)
+    moving = {*q, *([time] if time is not None else [])}
+    if forces is None and m >= SPARSE_MIN_CONSTRAINTS and all(
+            (mass[i, j] == 0) if i != j else not (mass[i, i].free_symbols & moving) for i in range(n) for j in range(n)):
+        # constant diagonal mass and many constraints (unforced): loops over families, banded solve
+        inverse = [1 / mass[i, i] for i in range(n)]
+        return _HEADER.format(title=title) + sparse_rattle_source(q, parameters, inverse, potential, list(constraints),
+                                                                  time)
     v = [sympy.Symbol(f"_v{i}", real=True) for i in range(n)]
     chi = sympy.Matrix(list(constraints))
     jacobian = chi.jacobian(q) if m else sympy.zeros(0, n)

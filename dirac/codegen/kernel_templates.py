@@ -47,7 +47,7 @@ def report(info, steps_done, failed, evals, residual):
     info[3] = residual
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def dirac_projection(D, e, out, C, rhs, mu, piv):
     """out <- out - J D^T C^{-1} (D out + e), C = D J D^T: the Dirac correction (240) of
     the Hamiltonian field out = J grad H over __K__ second-class constraints with gradients
@@ -325,9 +325,11 @@ def field_work():
             np.empty(__N__))
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def field_into(z, t, c, out, work):
-    """z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on z = (q, p),
+    """Called, not inlined, at the three places of midpoint_run (one compiled copy).
+
+    z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on z = (q, p),
     C = grad Phi J grad Phi^T, over the second-class constraints
     Phi = (chi(q, t), G(q, t) M^{-1} p + d chi/dt) (the second and third stages; Dirac
     bracket (240)); C is evaluated and solved at z."""
@@ -401,7 +403,7 @@ def residuals(q, p, t, c, out):
 
 _ANALYSED_FIELD = '''
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def field_into(z, t, c, out, work):
     """z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on
     the phase space of the analysis (coordinates and multipliers, then their momenta),

@@ -37,7 +37,7 @@ import sympy
 
 from dirac.codegen.printer import flat_expressions, straight_line
 
-__all__ = ["GeneratedFunction", "generate_module", "import_source", "cache_directory"]
+__all__ = ["GeneratedFunction", "generate_module", "import_source", "interpret_source", "cache_directory"]
 
 
 @dataclass(frozen=True)
@@ -155,4 +155,41 @@ def import_source(source: str) -> ModuleType:
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module
     spec.loader.exec_module(module)
+    return module
+
+
+class _Interpreter:
+    """Stands in for ``numba`` in :func:`interpret_source`: its decorators return the
+    Python function unchanged, so the module runs in the interpreter."""
+
+    @staticmethod
+    def _identity(*args: object, **kwargs: object) -> object:
+        if len(args) == 1 and callable(args[0]) and not kwargs:
+            return args[0]
+        return lambda function: function
+
+    njit = _identity
+    jit = _identity
+    cfunc = _identity
+
+
+def interpret_source(source: str) -> ModuleType:
+    """The generated module ``source`` run by the Python interpreter, without compiling.
+
+    The same source as :func:`import_source` (hence the same algorithm and the same
+    floating-point operations in the same order), with ``numba``'s decorators replaced by
+    the identity: nothing is compiled, so the module is ready in milliseconds, and each
+    call costs interpreter time (microseconds per expression instead of nanoseconds).
+    Used for short runs and single evaluations before the compiled module pays for its
+    compilation (:mod:`dirac.codegen.tiers`). Once per process per source.
+    """
+    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
+    module_name = f"dirac_py_{digest}"
+    if module_name in sys.modules:
+        return sys.modules[module_name]
+    module = ModuleType(module_name)
+    module.__dict__["numba"] = _Interpreter
+    text = "\n".join("" if line.strip() == "import numba" else line for line in source.splitlines())
+    exec(compile(text, f"<dirac generated {module_name}>", "exec"), module.__dict__)
+    sys.modules[module_name] = module
     return module

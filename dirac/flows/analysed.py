@@ -106,7 +106,8 @@ class AnalysedSystem:
             ``analysis`` is not an analysis, a parameter still symbolic in it has no
             default value, or a multiplier name is not a free multiplier.
         """
-        from dirac.codegen import analysed_kernel_source, array_function, load_kernels
+        from dirac.codegen import analysed_kernel_source, array_function
+        from dirac.codegen.tiers import tiered_module
 
         lagrangian = getattr(analysis, "lagrangian", None)
         if not isinstance(lagrangian, Lagrangian) or not hasattr(analysis, "second_class"):
@@ -130,8 +131,9 @@ class AnalysedSystem:
         chosen = _free_multipliers(analysis, multipliers or {})
         H_flow = H + sum((v * phi for v, phi in chosen.values()), sympy.S.Zero)
         time = getattr(analysis, "time", None)  # a time-dependent system, or a gauge such as x0 - t
-        module = load_kernels(analysed_kernel_source(z, list(defaults), H_flow, constraints, time,
-                                                     title=f"analysed system {lagrangian.name}", energy=H))
+        module = tiered_module(analysed_kernel_source(z, list(defaults), H_flow, constraints, time,
+                                                     title=f"analysed system {lagrangian.name}", energy=H),
+                              f"analysed system {lagrangian.name!r}")
         velocities = list(lagrangian.velocities)
         expression = lagrangian.expression.subs(defaults)
         momenta = array_function([list(lagrangian.coordinates), velocities],
@@ -151,20 +153,20 @@ class AnalysedSystem:
 
     def energy(self, z: np.ndarray, time: float = 0.0) -> float:
         """``H_c(z, t)`` (generated kernel ``energy``)."""
-        return float(self.module.energy(np.ascontiguousarray(z, dtype=float), float(time), self.params))
+        return float(self.module.function("energy")(np.ascontiguousarray(z, dtype=float), float(time), self.params))
 
     def constraint_residual(self, z: np.ndarray, time: float = 0.0) -> float:
         """``max |Phi(z, t)|`` over the second-class constraints (generated kernel ``residuals``)."""
         if self.n_constraints == 0:
             return 0.0
         out = np.empty(self.n_constraints)
-        self.module.residuals(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
+        self.module.function("residuals")(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
         return float(np.max(np.abs(out)))
 
     def field(self, z: np.ndarray, time: float = 0.0) -> np.ndarray:
         """``z_dot`` at ``z`` and ``time`` (generated kernel ``field``)."""
         out = np.empty(self.dimension)
-        self.module.field(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
+        self.module.function("field")(np.ascontiguousarray(z, dtype=float), float(time), self.params, out)
         return out
 
     def initial_state(self, q: dict[str, float], q_dot: dict[str, float] | None = None,

@@ -27,6 +27,8 @@ class ConstrainedField:
 
     def __init__(self, mechanics) -> None:
         self.mechanics = mechanics
+        if hasattr(mechanics, "require_field"):
+            mechanics.require_field("the Dirac vector field (scipy methods)")
         self.n = mechanics.dimension
         self.m = mechanics.n_constraints
         self._kernel = mechanics.module.field

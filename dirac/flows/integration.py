@@ -260,6 +260,10 @@ def integrate(
         "tolerance": tolerance,
         "newton_tolerance": float(newton_tolerance),
         "max_newton_iterations": int(max_newton_iterations),
+        # steps the run will take (all members of a batch): generated kernels run
+        # interpreted for short runs and compile when that pays (dirac.codegen.tiers)
+        "planned_steps": (int(math.ceil(t_end / dt * (1.0 - 1e-12))) * int(getattr(checked, "batch", 1))
+                          if dt is not None else None),
     }
     stepper = method_object.start(checked, chosen_outputs, options)
     stepper.warm_up()

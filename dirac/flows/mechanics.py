@@ -110,12 +110,46 @@ def _rotation(lagrangian: Lagrangian, values: Mapping[str, float]) -> tuple[int,
     return found.first, found.second, float(rate), found.label(names, f"{float(rate):g}")
 
 
+def _split_by_velocities(L: sympy.Expr, v: list[sympy.Symbol]) -> tuple[sympy.Matrix, list[sympy.Expr], sympy.Expr]:
+    """``(d^2 L/dv_i dv_j, dL/dv_i, L - (terms with a velocity))`` of an expanded ``L``.
+
+    The same as ``sympy.hessian(L, v)`` and ``diff(L, v_i)``, term by term: each term of the
+    sum is differentiated only by the velocities it contains, so a system of ``n``
+    coordinates costs ``O(terms)`` derivatives of small terms instead of ``n^2``
+    derivatives of the whole ``L`` (minutes for a chain of 128 links).
+    """
+    index = {s: i for i, s in enumerate(v)}
+    n = len(v)
+    hessian: dict[tuple[int, int], list[sympy.Expr]] = {}
+    gradient: list[list[sympy.Expr]] = [[] for _ in range(n)]
+    rest: list[sympy.Expr] = []
+    for term in sympy.Add.make_args(L):
+        present = sorted(index[s] for s in term.free_symbols if s in index)
+        if not present:
+            rest.append(term)
+            continue
+        for i in present:
+            first = sympy.diff(term, v[i])
+            gradient[i].append(first)
+            for j in present:
+                if j >= i:
+                    second = sympy.diff(first, v[j])
+                    if second != 0:
+                        hessian.setdefault((i, j), []).append(second)
+    matrix = sympy.zeros(n, n)
+    for (i, j), parts in hessian.items():
+        matrix[i, j] = matrix[j, i] = sympy.Add(*parts)
+    return matrix, [sympy.Add(*parts) for parts in gradient], sympy.Add(*rest)
+
+
 @dataclass
 class MechanicalSystem:
     """Numerical pieces of a natural mechanical system with holonomic constraints.
 
     Build it with :meth:`from_lagrangian`. :attr:`module` is the generated kernel module
-    of :func:`dirac.codegen.kernel_source.mechanical_kernel_source` (functions
+    of :func:`dirac.codegen.kernel_source.mechanical_kernel_source`, interpreted or
+    compiled as pays (:class:`dirac.codegen.tiers.TieredModule`; ``module.name`` is the
+    compiled function, ``module.function(name)`` the tiered one) (functions
     ``f(q, t, c, out)`` of the coordinates in :attr:`coordinate_names` order, the time and
     the parameter values :attr:`params`; step loops ``rattle_constant_mass``,
     ``rattle_general``, ``midpoint_run``; ``field``, ``energy``, ``residuals``).
@@ -226,13 +260,13 @@ class MechanicalSystem:
         v = list(lagrangian.velocities)
         L = sympy.expand(lagrangian.expression)
         zero_velocity = {s: 0 for s in v}
-        hessian = sympy.hessian(L, v)
+        hessian, gradient_at_rest, potential_terms = _split_by_velocities(L, v)
         if any(entry.free_symbols & set(v) for entry in hessian):
             raise NotMechanicalError(
                 f"the Lagrangian of {lagrangian.name!r} is not quadratic in the velocities: RATTLE and the "
                 "flows here need L = 1/2 q_dot^T M(q) q_dot - V(q)"
             )
-        linear = [sympy.simplify(sympy.diff(L, s).subs(zero_velocity)) for s in v]
+        linear = [sympy.simplify(term.subs(zero_velocity)) if term != 0 else term for term in gradient_at_rest]
         offending = [s.name for s, term in zip(v, linear) if term != 0]
         if offending:
             raise NotMechanicalError(
@@ -240,7 +274,7 @@ class MechanicalSystem:
                 f"({', '.join(offending)}, e.g. magnetic or gyroscopic terms): RATTLE needs "
                 "L = 1/2 q_dot^T M(q) q_dot - V(q); use method = \"midpoint\" on the Dirac flow instead"
             )
-        potential = sympy.expand(-L.subs(zero_velocity))
+        potential = sympy.expand(-potential_terms)
         mass = sympy.Matrix(hessian)
         chis = sympy.Matrix(list(lagrangian.constraints))
         parameter_symbols = list(lagrangian.parameters)
@@ -251,7 +285,8 @@ class MechanicalSystem:
             lagrangian.time in e.free_symbols for e in forces)
         time = lagrangian.time if (lagrangian.is_time_dependent or forced_in_time) else None
         constant = all(not (entry.free_symbols & {*q, *([time] if time is not None else [])}) for entry in mass)
-        from dirac.codegen import load_kernels, mechanical_kernel_source
+        from dirac.codegen import mechanical_kernel_source
+        from dirac.codegen.tiers import tiered_module
 
         source = mechanical_kernel_source(q, parameter_symbols, mass, potential, list(chis), time,
                                           title=f"system {lagrangian.name}", forces=forces, velocities=v)
@@ -262,11 +297,11 @@ class MechanicalSystem:
             source += forced_kernel_source(q, v, parameter_symbols, forces, time, m, constant)
             if constant:
                 rate = _conformal_rate(forces, v, mass, {p: values[p.name] for p in parameter_symbols}, q, time)
-        module = load_kernels(source + extra_source)
+        module = tiered_module(source + extra_source, f"system {lagrangian.name!r}")
         constant_mass = None
         if constant:
             constant_mass = np.empty((n, n))
-            module.mass(np.zeros(n), 0.0, param_array, constant_mass)
+            module.function("mass")(np.zeros(n), 0.0, param_array, constant_mass)
         system = cls(
             name=lagrangian.name,
             coordinate_names=tuple(s.name for s in q),
@@ -291,7 +326,7 @@ class MechanicalSystem:
         if not self.forced:
             return np.zeros(self.dimension)
         out = np.empty(self.dimension)
-        self.module.applied_force(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_dot, dtype=float),
+        self.module.function("applied_force")(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(q_dot, dtype=float),
                                   float(time), self.params, out)
         return out
 
@@ -324,11 +359,30 @@ class MechanicalSystem:
         after_velocity = np.linalg.solve(mass, after)
         return after, float(impulse @ (before_velocity + after_velocity) / 2.0)
 
+    def require_field(self, what: str) -> None:
+        """Refuse ``what`` (a method needing the Dirac vector field) on a system whose
+        generated module holds RATTLE only (:mod:`dirac.codegen.sparse_rattle`: a constant
+        diagonal mass and many constraints).
+
+        Raises
+        ------
+        InputError
+            When the module has no vector field.
+        """
+        from dirac.codegen.sparse_rattle import RATTLE_ONLY
+
+        if RATTLE_ONLY in getattr(self.module, "source", ""):
+            raise InputError(
+                f"{what} needs the Dirac vector field of {self.name!r}, which is not generated for a system of "
+                f"{self.n_constraints} constraints with a constant diagonal mass (its kernel module holds the looped "
+                "RATTLE only, so that it compiles in seconds); use rattle-2 (or rattle-4/6/8)"
+            )
+
     # ------------------------------------------------------------------ numerics (numpy side)
     def _evaluate(self, name: str, q: np.ndarray, time: float, shape: tuple[int, ...]) -> np.ndarray:
         """The generated function ``name(q, t, c, out)`` of the kernel module at one point."""
         out = np.empty(shape)
-        getattr(self.module, name)(np.ascontiguousarray(q, dtype=float), float(time), self.params, out)
+        self.module.function(name)(np.ascontiguousarray(q, dtype=float), float(time), self.params, out)
         return out
 
     def mass_matrix(self, q: np.ndarray, time: float = 0.0) -> np.ndarray:
@@ -349,7 +403,7 @@ class MechanicalSystem:
         """``H = 1/2 p^T M(q, t)^{-1} p + V(q, t)`` (generated kernel ``energy``)."""
         self.mass_matrix(q, time)  # refuses a singular mass matrix
         q = np.ascontiguousarray(q, dtype=float)
-        return float(self.module.energy(q, np.ascontiguousarray(p, dtype=float), float(time), self.params))
+        return float(self.module.function("energy")(q, np.ascontiguousarray(p, dtype=float), float(time), self.params))
 
     def residuals(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Position residuals ``chi(q, t)`` and velocity residuals ``G(q, t) M(q, t)^{-1} p + d chi/dt``
@@ -359,8 +413,8 @@ class MechanicalSystem:
             return np.zeros(0), np.zeros(0)
         self.mass_matrix(q, time)  # refuses a singular mass matrix
         out = np.empty(2 * m)
-        self.module.residuals(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(p, dtype=float),
-                              float(time), self.params, out)
+        self.module.function("residuals")(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(p, dtype=float),
+                                          float(time), self.params, out)
         return out[:m], out[m:]
 
     def constraint_residual(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> float:

@@ -12,7 +12,6 @@ from scipy.integrate import solve_ivp
 
 import dirac
 from dirac import Lagrangian
-from dirac.errors import InputError
 
 M, G, ELL, C = 1.0, 9.81, 1.0, 0.3
 

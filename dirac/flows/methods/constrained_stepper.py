@@ -7,13 +7,14 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 import numpy as np
 
 from dirac.flows.dirac_field import constrained_outputs
 from dirac.flows.methods.base import StepFailure, Stepper
 
-__all__ = ["ConstrainedStepper", "newton_options", "singular_as_step_failure"]
+__all__ = ["ConstrainedStepper", "newton_options", "singular_as_step_failure", "tiered", "call_tiered"]
 
 
 def newton_options(options: dict) -> tuple[float, int, np.ndarray]:
@@ -34,6 +35,13 @@ class ConstrainedStepper(Stepper):
         self.p = np.ascontiguousarray(problem.p0, dtype=float).copy()
         self.tol, self.max_iter, self.info = newton_options(options)
         self.time = 0.0  # the time of the state (time-dependent systems)
+        self.planned_steps: int | None = options.get("planned_steps")
+
+    def _kernel_call(self, kernel: Any, steps: int, *args: Any, warm_up: bool = False) -> None:
+        """Call a step loop of the generated module: a tiered one (interpreted while the
+        steps still planned are few, :mod:`dirac.codegen.tiers`) or a compiled one;
+        ``warm_up``: a one-step call on scratch arguments that decides the tier."""
+        call_tiered(kernel, self.planned_steps, self.steps, steps, args, warm_up)
 
     def observe(self) -> dict[str, np.ndarray]:
         return constrained_outputs(self.mechanics, self.outputs, self.q, self.p, self.time)
@@ -67,3 +75,27 @@ def singular_as_step_failure(what: str) -> Iterator[None]:
             f"{what}: the Newton matrix G M^-1 G^T is singular (the constraints are not independent "
             "here); check the constraints and the state"
         ) from None
+
+
+def call_tiered(kernel: Any, planned_steps: int | None, steps_done: int, steps: int, args: tuple[Any, ...],
+                warm_up: bool = False) -> None:
+    """``kernel(*args)`` advancing ``steps`` steps of a run of ``planned_steps`` (None:
+    unknown), ``steps_done`` of them done, through its tier when it is a
+    :class:`~dirac.codegen.tiers.TieredFunction`."""
+    from dirac.codegen.tiers import TieredFunction  # not at import: a rigid-body run never needs codegen
+
+    if not isinstance(kernel, TieredFunction):
+        kernel(*args)
+        return
+    planned = None if planned_steps is None else max(planned_steps - steps_done, steps)
+    if warm_up:
+        kernel.warm_up(planned, *args)
+    else:
+        kernel.run_steps(steps, planned, *args)
+
+
+def tiered(module: Any, name: str) -> Any:
+    """``name`` of a generated module: its tiered function (:func:`dirac.codegen.tiers.tiered`)."""
+    from dirac.codegen.tiers import tiered as tiered_function
+
+    return tiered_function(module, name)

@@ -33,7 +33,7 @@ from dirac.compositions import COMPOSITIONS
 from dirac.errors import InputError
 from dirac.flows.dirac_field import constrained_outputs
 from dirac.flows.methods.base import Method, Stepper
-from dirac.flows.methods.constrained_stepper import ConstrainedStepper, singular_as_step_failure
+from dirac.flows.methods.constrained_stepper import ConstrainedStepper, singular_as_step_failure, tiered
 
 __all__ = ["ForcedStepper", "METHODS", "FORCED_METHOD_NAMES"]
 
@@ -63,23 +63,26 @@ class ForcedStepper(ConstrainedStepper):
         self.pending = list(problem.impulses)
 
     # ------------------------------------------------------------------ kernels
-    def _call(self, b: int, n_steps: int, dt: float, time: float) -> None:
+    def _call(self, b: int, n_steps: int, dt: float, time: float, warm_up: bool = False) -> None:
         mechanics = self.mechanics
         work = self.work[b : b + 1]
         if self.conformal:
-            mechanics.module.conformal_run(self.q[b], self.p[b], time, mechanics.params, float(mechanics.conformal_rate),
-                                           self.fractions, dt, n_steps, self.tol, self.max_iter, self.info, work)
+            kernel = tiered(mechanics.module, "conformal_run")
+            args: tuple = (self.q[b], self.p[b], time, mechanics.params, float(mechanics.conformal_rate),
+                           self.fractions, dt, n_steps, self.tol, self.max_iter, self.info, work)
         else:
-            mechanics.module.forced_rattle_run(self.q[b], self.p[b], time, mechanics.params, self.fractions, dt, n_steps,
-                                               self.tol, self.max_iter, self.info, work)
+            kernel = tiered(mechanics.module, "forced_rattle_run")
+            args = (self.q[b], self.p[b], time, mechanics.params, self.fractions, dt, n_steps,
+                    self.tol, self.max_iter, self.info, work)
+        self._kernel_call(kernel, n_steps, *args, warm_up=warm_up)
 
-    def _advance(self, n_steps: int, dt: float) -> None:
+    def _advance(self, n_steps: int, dt: float, warm_up: bool = False) -> None:
         """``n_steps`` steps of size ``dt`` from ``self.time`` for every state (no impulse inside)."""
         if n_steps <= 0 or dt <= 0.0:
             return
         for b in range(self.q.shape[0]):
             with singular_as_step_failure(self.name):
-                self._call(b, n_steps, dt, self.time)
+                self._call(b, n_steps, dt, self.time, warm_up)
             self.evaluations += int(self.info[2])
             self._raise_if_failed(self.name)
         self.steps += n_steps
@@ -87,7 +90,7 @@ class ForcedStepper(ConstrainedStepper):
 
     def warm_up(self) -> None:
         saved = (self.q.copy(), self.p.copy(), self.work.copy(), self.time, self.steps, self.evaluations)
-        self._advance(1, 1e-6)
+        self._advance(1, 1e-6, warm_up=True)
         self.q[:], self.p[:], self.work[:] = saved[0], saved[1], saved[2]
         self.time, self.steps, self.evaluations = saved[3], saved[4], saved[5]
 

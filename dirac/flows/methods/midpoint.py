@@ -27,7 +27,13 @@ from __future__ import annotations
 import numpy as np
 
 from dirac.flows.methods.base import Method, StepFailure, Stepper
-from dirac.flows.methods.constrained_stepper import ConstrainedStepper, newton_options, singular_as_step_failure
+from dirac.flows.methods.constrained_stepper import (
+    ConstrainedStepper,
+    call_tiered,
+    newton_options,
+    singular_as_step_failure,
+    tiered,
+)
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
 from dirac.rigidbody.midpoint import midpoint_rigid_body
 
@@ -66,6 +72,7 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
 
     def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__(problem, outputs, options)
+        self.mechanics.require_field("midpoint")
         for q in self.q:
             self.mechanics.mass_matrix(q)
         self.z = np.ascontiguousarray(np.concatenate([self.q, self.p], axis=1))
@@ -73,16 +80,17 @@ class ConstrainedMidpointStepper(ConstrainedStepper):
         n = self.mechanics.dimension
         self.q = self.z[:, :n]
         self.p = self.z[:, n:]
-        self._kernel = self.mechanics.module.midpoint_run
+        self._kernel = tiered(self.mechanics.module, "midpoint_run")
 
     def warm_up(self) -> None:
-        self._kernel(self.z[0].copy(), self.time, self.mechanics.params, 1e-6, 1, self.tol, self.max_iter, self.info)
+        self._kernel_call(self._kernel, 1, self.z[0].copy(), self.time, self.mechanics.params, 1e-6, 1, self.tol,
+                          self.max_iter, self.info, warm_up=True)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.z.shape[0]):
             with singular_as_step_failure("midpoint"):
-                self._kernel(self.z[b], self.time, self.mechanics.params, dt, n_steps, self.tol, self.max_iter,
-                             self.info)
+                self._kernel_call(self._kernel, n_steps, self.z[b], self.time, self.mechanics.params, dt, n_steps,
+                                  self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
             self._raise_if_failed("midpoint")
         self.steps += n_steps
@@ -99,14 +107,16 @@ class AnalysedMidpointStepper(Stepper):
         self.outputs = outputs
         self.z = np.ascontiguousarray(problem.z0, dtype=float).copy()
         self.tol, self.max_iter, self.info = newton_options(options)
-        self._kernel = self.analysed.module.midpoint_run
+        self._kernel = tiered(self.analysed.module, "midpoint_run")
         self.time = 0.0
+        self.planned_steps: int | None = options.get("planned_steps")
 
-    def _run(self, z: np.ndarray, n_steps: int, dt: float) -> None:
-        self._kernel(z, self.time, self.analysed.params, dt, n_steps, self.tol, self.max_iter, self.info)
+    def _run(self, z: np.ndarray, n_steps: int, dt: float, warm_up: bool = False) -> None:
+        args = (z, self.time, self.analysed.params, dt, n_steps, self.tol, self.max_iter, self.info)
+        call_tiered(self._kernel, self.planned_steps, self.steps, n_steps, args, warm_up)
 
     def warm_up(self) -> None:
-        self._run(self.z[0].copy(), 1, 1e-6)
+        self._run(self.z[0].copy(), 1, 1e-6, warm_up=True)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.z.shape[0]):

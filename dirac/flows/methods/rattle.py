@@ -25,7 +25,7 @@ import numpy as np
 
 from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
 from dirac.flows.methods.base import Method, Stepper
-from dirac.flows.methods.constrained_stepper import ConstrainedStepper, singular_as_step_failure
+from dirac.flows.methods.constrained_stepper import ConstrainedStepper, singular_as_step_failure, tiered
 
 __all__ = ["RattleStepper", "METHODS"]
 
@@ -41,21 +41,18 @@ class RattleStepper(ConstrainedStepper):
         self.constant = self.mechanics.constant_mass is not None
         if self.constant:
             self.mechanics.mass_matrix(self.q[0])  # checks positivity
-            self._kernel = self.mechanics.module.rattle_constant_mass
+            self._kernel = tiered(self.mechanics.module, "rattle_constant_mass")
         else:
             for q in self.q:
                 self.mechanics.mass_matrix(q)
-            self._kernel = self.mechanics.module.rattle_general
+            self._kernel = tiered(self.mechanics.module, "rattle_general")
 
-    def _call(self, q: np.ndarray, p: np.ndarray, n_steps: int, dt: float) -> None:
-        params = self.mechanics.params
-        if self.constant:
-            self._kernel(q, p, self.time, params, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
-        else:
-            self._kernel(q, p, self.time, params, self.fractions, dt, n_steps, self.tol, self.max_iter, self.info)
+    def _call(self, q: np.ndarray, p: np.ndarray, n_steps: int, dt: float, warm_up: bool = False) -> None:
+        self._kernel_call(self._kernel, n_steps, q, p, self.time, self.mechanics.params, self.fractions, dt, n_steps,
+                          self.tol, self.max_iter, self.info, warm_up=warm_up)
 
     def warm_up(self) -> None:
-        self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6)
+        self._call(self.q[0].copy(), self.p[0].copy(), 1, 1e-6, warm_up=True)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.q.shape[0]):

@@ -1,0 +1,101 @@
+"""The two tiers of a generated module: interpreted and compiled give the same numbers;
+the first compilation says so on stderr, once, and never on a warm cache."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+
+from dirac import Lagrangian
+from dirac.codegen import tiers
+from dirac.codegen.numba_backend import interpret_source
+from dirac.flows.integration import integrate
+from dirac.flows.problems import ConstrainedProblem
+
+_SOURCE = '''"""tiny -- generated for a test"""
+import math
+import numpy as np
+import numba
+
+
+@numba.njit(cache=True)
+def run(x, n_steps, out):
+    """n_steps of x <- x + sin(x) / 8 (a map whose iterates a hand loop reproduces)."""
+    for _ in range(n_steps):
+        x = x + math.sin(x) / 8.0
+    out[0] = x
+'''
+
+
+def _pendulum() -> Lagrangian:
+    return Lagrangian.from_strings("pendulum", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",
+                                   constraints=["x**2 + y**2 - l**2"], parameters={"m": 1.0, "g": 9.81, "l": 1.0})
+
+
+def test_interpreted_source_runs_without_numba_and_matches_a_hand_loop() -> None:
+    module = interpret_source(_SOURCE)
+    out = np.empty(1)
+    module.run(0.5, 20, out)
+    x = 0.5
+    for _ in range(20):
+        x += np.sin(x) / 8.0
+    assert out[0] == pytest.approx(x, rel=1e-15)
+    assert "numba" not in type(module.run).__module__  # a plain Python function
+
+
+def test_first_compilation_is_announced_once_with_the_cache_and_not_again(monkeypatch, tmp_path, capsys) -> None:
+    monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(tiers, "_announced", False)
+    source = _SOURCE.replace("for a test", f"for a test in {tmp_path.name}")  # a source of its own: a cold cache
+    module = tiers.TieredModule(source, "a test module")
+    function = module.function("run")
+    assert function.tier == "interpreted"
+    out = np.empty(1)
+    function.run_steps(3, None, 0.5, 3, out)  # unknown run length: compiles at once
+    assert function.tier == "compiled"
+    err = capsys.readouterr().err
+    assert err.count("dirac: compiling") == 1
+    assert str(tmp_path) in err and "DIRAC_CACHE_DIR" in err and "run of a test module" in err
+    # a second module of another source in the same process: no second line
+    other = tiers.TieredModule(source + "\n# another source\n", "another module")
+    other.function("run").run_steps(3, None, 0.5, 3, out)
+    assert capsys.readouterr().err == ""
+    # the same source imported afresh (a later process): numba's cache is warm, no compilation
+    monkeypatch.setattr(tiers, "_announced", False)
+    for name in [name for name in sys.modules if name.startswith("dirac_gen_")]:
+        if sys.modules[name].__file__ and str(tmp_path) in sys.modules[name].__file__:
+            del sys.modules[name]
+    again = tiers.TieredModule(source, "a test module").function("run")
+    assert again.tier == "compiled"
+    again(0.5, 3, out)
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("method", ["rattle-2", "midpoint"])
+def test_a_short_run_is_interpreted_and_gives_the_compiled_numbers(method: str, monkeypatch) -> None:
+    """Same source, same floating-point operations: the two tiers agree to the last bit."""
+    q0, p0 = [np.sin(1.0), -np.cos(1.0)], [0.3 * np.cos(1.0), 0.3 * np.sin(1.0)]
+    short = ConstrainedProblem(_pendulum(), q0, p0)
+    kernel = "midpoint_run" if method == "midpoint" else "rattle_constant_mass"
+    function = short.mechanics.module.function(kernel)
+    before = function.interpreted_calls
+    interpreted = integrate(short, method, t_end=0.05, dt=0.01, samples=6)
+    assert function.interpreted_calls > before or function.tier == "compiled"  # interpreted unless compiled already
+    monkeypatch.setenv("DIRAC_KERNELS", "compiled")
+    compiled = integrate(ConstrainedProblem(_pendulum(), q0, p0), method, t_end=0.05, dt=0.01, samples=6)
+    assert function.tier == "compiled"
+    np.testing.assert_array_equal(interpreted.outputs["q"], compiled.outputs["q"])
+    np.testing.assert_array_equal(interpreted.outputs["p"], compiled.outputs["p"])
+
+
+def test_policy_names_are_checked(monkeypatch) -> None:
+    with pytest.raises(ValueError, match="auto, compiled"):
+        tiers.set_policy("fast")
+    previous = tiers.set_policy("compiled")
+    assert tiers.current_policy() == "compiled"
+    assert tiers.set_policy(previous) == "compiled"
+    monkeypatch.setenv("DIRAC_KERNELS", "fastest")
+    with pytest.warns(UserWarning, match="DIRAC_KERNELS='fastest'"):
+        assert tiers.current_policy() == "auto"
