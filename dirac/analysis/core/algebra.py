@@ -14,11 +14,42 @@ import sympy
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["tidy"]
+__all__ = ["tidy", "prints_shorter"]
 
 
 class _NotRational(Exception):
     pass
+
+
+def prints_shorter(expr: sympy.Expr, limit: int) -> bool:
+    """``len(str(expr)) < limit``, without printing a long expression.
+
+    Every occurrence of a symbol prints its whole name, so the names summed over the
+    occurrences (a shared sub-tree counted as often as it occurs, as the printer does)
+    are a lower bound of the printed length: when that bound reaches ``limit`` the
+    answer is ``False`` at once (printing a 15 000-character condition of (228) costs
+    more than a tenth of a second); otherwise the expression is printed and measured,
+    so the answer is always that of ``len(str(expr)) < limit``.
+    """
+    names: dict[sympy.Basic, int] = {}
+
+    def walk(node: sympy.Basic) -> int:
+        hit = names.get(node)
+        if hit is None:
+            if node.is_Symbol:
+                hit = len(node.name)
+            else:
+                hit = 0
+                for a in node.args:
+                    hit += walk(a)
+                    if hit >= limit:
+                        break
+            names[node] = hit
+        return hit
+
+    if walk(expr) >= limit:
+        return False
+    return len(str(expr)) < limit
 
 
 def _evaluate(expr: sympy.Expr, gens: dict, domain, allow_division: bool):
