@@ -522,4 +522,11 @@ def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], Non
     targets.append(heavy_top_equal_cpu_target(rows))
     targets.append(torqued_target(rows))
     attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
+
+    def analysis_times() -> list[Target]:
+        from dirac.bench.analysis_times import analysis_targets
+
+        return analysis_targets(1 if quick else 3)
+
+    attempt("symbolic analysis: the paper's Lagrangians (19), (78), (228) and a square-root one", analysis_times)
     return targets, notes
