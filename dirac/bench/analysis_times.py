@@ -18,12 +18,11 @@ meet; the figure is the time to that answer).
 from __future__ import annotations
 
 import json
-import statistics
 import subprocess
 import sys
 from dataclasses import dataclass
 
-__all__ = ["ANALYSIS_CASES", "AnalysisCase", "analysis_time", "analysis_targets"]
+__all__ = ["ANALYSIS_CASES", "AnalysisCase", "analysis_time", "analysis_runs"]
 
 
 @dataclass(frozen=True)
@@ -75,28 +74,14 @@ def analysis_time(case: AnalysisCase) -> dict:
     return json.loads(completed.stdout.strip().splitlines()[-1])
 
 
-def analysis_targets(repeats: int) -> list:
-    """One target per case: median CPU time of ``dirac.analyze`` over ``repeats`` fresh processes.
+def analysis_runs(repeats: int) -> list[tuple[AnalysisCase, list[dict]]]:
+    """Each case with its ``repeats`` runs (:func:`analysis_time`), cases interleaved.
 
-    The cases are interleaved (case 1, 2, 3, 4, then again), so that a change in the load
-    of the machine touches them alike.
+    The cases are run in turn (case 1, 2, 3, 4, then again), so that a change in the
+    load of the machine touches them alike.
     """
-    from dirac.bench.targets import Target
-
     runs: dict[str, list[dict]] = {case.name: [] for case in ANALYSIS_CASES}
     for _ in range(repeats):
         for case in ANALYSIS_CASES:
             runs[case.name].append(analysis_time(case))
-    targets = []
-    for case in ANALYSIS_CASES:
-        rows = runs[case.name]
-        cpu = statistics.median(r["cpu"] for r in rows)
-        wall = statistics.median(r["wall"] for r in rows)
-        outcomes = sorted({r["outcome"] for r in rows})
-        targets.append(Target(
-            f"analysis: {case.name} (s CPU)", cpu, "s", case.target, "<=",
-            f"dirac.analyze in a fresh process (import excluded), median of {len(rows)}: CPU {cpu:.2f} s, "
-            f"wall {wall:.2f} s; outcome {', '.join(outcomes)}",
-            {"cpu_s": [r["cpu"] for r in rows], "wall_s": [r["wall"] for r in rows]},
-        ))
-    return targets
+    return [(case, runs[case.name]) for case in ANALYSIS_CASES]
