@@ -8,6 +8,7 @@ fraction field when the variables occur in denominators) is orders of magnitude 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import sympy
@@ -113,6 +114,12 @@ def _split_denominators(expr: sympy.Expr, variables: set) -> tuple[sympy.Expr, d
     return expr.xreplace(replacements), {d: 1 / b for d, b in back.items()}, list(back)
 
 
+@functools.lru_cache(maxsize=4096)
+def _combined(coeff: sympy.Expr) -> sympy.Expr:
+    """``factor_terms(together(coeff))``, once per distinct coefficient (many monomials share one)."""
+    return sympy.factor_terms(sympy.together(coeff))
+
+
 def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.Symbol], back: dict) -> sympy.Expr:
     """Ring element in ``variables + others`` -> sympy, terms grouped by variable monomial."""
     nv = len(variables)
@@ -124,7 +131,7 @@ def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.S
     for monom, coeffs in groups.items():
         coeff = sympy.Add(*coeffs).xreplace(back) if back else sympy.Add(*coeffs)
         if back and len(coeffs) > 1:
-            coeff = sympy.factor_terms(sympy.together(coeff))
+            coeff = _combined(coeff)
         terms.append(coeff * sympy.Mul(*[v**k for v, k in zip(variables, monom)]))
     return sympy.Add(*terms)
 
