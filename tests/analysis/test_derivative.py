@@ -50,3 +50,18 @@ def test_partials_and_bracket() -> None:
     # d/dq q (q + p)^2 = (q + p)^2 + 2 q (q + p); d/dp = 2 q (q + p)
     assert sympy.expand(dq[q] - (q + p) ** 2 - 2 * q * (q + p)) == 0
     assert sympy.expand(dp[q] - 2 * q * (q + p)) == 0
+
+
+def test_prints_shorter_is_len_of_str() -> None:
+    """``prints_shorter(e, n)`` answers ``len(str(e)) < n`` exactly (it only avoids printing)."""
+    from dirac.analysis.algebra import prints_shorter
+
+    shared = (x * y - z / 3) ** 2
+    expressions = [
+        x / 2, x * y**-1, sympy.sqrt(x) - 1, -x / 3, x ** sympy.Rational(-1, 2), 1 / (x + y) ** 2,
+        sympy.Float(0.5) * x, -sympy.Rational(3, 7) * x * y / (z - 1), sympy.sin(x) * shared,
+        sum((shared * (x + k)) ** k for k in range(1, 30)),
+    ]
+    for e in expressions:
+        for limit in (3, 5, 10, 40, 100, 400, 4000):
+            assert prints_shorter(e, limit) == (len(str(e)) < limit), (e, limit)

@@ -50,7 +50,49 @@ def prints_shorter(expr: sympy.Expr, limit: int) -> bool:
 
     if walk(expr) >= limit:
         return False
+    longest = _printed_at_most(expr, limit)
+    if longest is not None and longest < limit:
+        return True
     return len(str(expr)) < limit
+
+
+#: characters the str printer adds per argument (" + ", "*", "**", "/", "-") and per node
+#: (parentheses, "sqrt(", "1/"): generous bounds for sums, products and powers of atoms
+_PER_ARGUMENT, _PER_NODE = 8, 8
+
+
+def _printed_at_most(expr: sympy.Expr, limit: int) -> int | None:
+    """An upper bound of ``len(str(expr))`` for sums, products and powers of atoms, else ``None``.
+
+    Atoms count their own printed length; every sum, product or power adds at most
+    ``_PER_ARGUMENT`` characters per argument and ``_PER_NODE`` for itself. ``None`` for
+    any other node (a function, a relation) or once the bound reaches ``limit``.
+    """
+    sizes: dict[sympy.Basic, int] = {}
+
+    def walk(node: sympy.Basic) -> int | None:
+        hit = sizes.get(node)
+        if hit is not None:
+            return hit
+        if not node.args:
+            if not (node.is_Symbol or node.is_Number):
+                return None
+            hit = len(str(node))
+        elif node.is_Add or node.is_Mul or node.is_Pow:
+            hit = _PER_NODE
+            for a in node.args:
+                size = walk(a)
+                if size is None:
+                    return None
+                hit += size + _PER_ARGUMENT
+                if hit >= limit:
+                    return None
+        else:
+            return None
+        sizes[node] = hit
+        return hit
+
+    return walk(expr)
 
 
 def _evaluate(expr: sympy.Expr, gens: dict, domain, allow_division: bool):
