@@ -1,7 +1,7 @@
 """One BLAS thread for the dense linear algebra of the symbolic analysis.
 
 The analysis is single-threaded Python; its few large dense solves (the basis pursuit of
-:mod:`dirac.analysis.polynomial_kernel`, a ``1120 x 272`` SVD for (228)) are small for
+:mod:`dirac.analysis.legendre.polynomial_kernel`, a ``1120 x 272`` SVD for (228)) are small for
 a threaded BLAS: OpenBLAS splits them over all cores and its threads spin while they
 wait. On a machine whose cores are busy with other jobs that SVD took 0.9-1.6 s of CPU
 time (4-8 s wall) with the default threads and 0.035 s with one thread (OpenBLAS

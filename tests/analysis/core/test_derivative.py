@@ -1,4 +1,4 @@
-"""The tree derivative of the phase space (``dirac.analysis.phase_space.derivative``).
+"""The tree derivative of the phase space (``dirac.analysis.core.phase_space.derivative``).
 
 It replaces ``sympy.diff`` in the gradients and Poisson brackets of the analysis, so it
 must give the same expression: checked against derivatives worked out by hand and
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sympy
 
-from dirac.analysis.phase_space import PhaseSpace, derivative
+from dirac.analysis.core.phase_space import PhaseSpace, derivative
 
 x, y, z, a = sympy.symbols("x y z a", real=True)
 
@@ -54,7 +54,7 @@ def test_partials_and_bracket() -> None:
 
 def test_prints_shorter_is_len_of_str() -> None:
     """``prints_shorter(e, n)`` answers ``len(str(e)) < n`` exactly (it only avoids printing)."""
-    from dirac.analysis.algebra import prints_shorter
+    from dirac.analysis.core.algebra import prints_shorter
 
     shared = (x * y - z / 3) ** 2
     expressions = [
