@@ -21,6 +21,7 @@ from dirac.analysis.chain.special_values import MAX_BLOCK, RankUse, SpecialValue
 from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.blas_threads import one_blas_thread
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
 from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
@@ -585,7 +586,8 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     """
     if not isinstance(lagrangian, Lagrangian):
         raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
-    return at_given_values(ConstraintAnalysis(lagrangian, progress=progress), progress)
+    with one_blas_thread():  # small dense matrices: threads only wait (dirac.analysis.core.blas_threads)
+        return at_given_values(ConstraintAnalysis(lagrangian, progress=progress), progress)
 
 
 def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:

@@ -24,7 +24,7 @@ import numpy as np
 from dirac.bench.standard_body import STANDARD_INERTIA, STANDARD_M0
 from dirac.bench.timing import median_of, time_call
 
-__all__ = ["Target", "measure_targets", "work_precision_targets"]
+__all__ = ["Target", "analysis_targets", "measure_targets", "work_precision_targets"]
 
 _STANDARD_INERTIA = np.array(STANDARD_INERTIA)
 _STANDARD_M0 = np.array(STANDARD_M0)
@@ -474,6 +474,25 @@ def startup_targets(repeats: int, cold: bool) -> list[Target]:
     return targets
 
 
+# --------------------------------------------------------------------------- symbolic analysis
+def analysis_targets(repeats: int) -> list[Target]:
+    """Median CPU time of ``dirac.analyze`` per case of :mod:`dirac.bench.analysis_times`."""
+    from dirac.bench.analysis_times import analysis_runs
+
+    targets = []
+    for case, rows in analysis_runs(repeats):
+        cpu = median_of([r["cpu"] for r in rows])
+        wall = median_of([r["wall"] for r in rows])
+        outcomes = ", ".join(sorted({r["outcome"] for r in rows}))
+        targets.append(Target(
+            f"analysis: {case.name} (s CPU)", cpu, "s", case.target, "<=",
+            f"dirac.analyze in a fresh process (import excluded), median of {len(rows)}: CPU {cpu:.2f} s, "
+            f"wall {wall:.2f} s; outcome {outcomes}",
+            {"cpu_s": [r["cpu"] for r in rows], "wall_s": [r["wall"] for r in rows]},
+        ))
+    return targets
+
+
 # what one measurement returns: a target or several, optionally with a note for the report
 _Measured = Target | list[Target] | tuple[Target, str] | tuple[list[Target], str]
 
@@ -522,4 +541,7 @@ def measure_targets(quick: bool, rows: list[dict], progress: Callable[[str], Non
     targets.append(heavy_top_equal_cpu_target(rows))
     targets.append(torqued_target(rows))
     attempt("start-up", lambda: startup_targets(3 if quick else 5, cold=not quick))
+
+    attempt("symbolic analysis: the paper's Lagrangians (19), (78), (228) and a square-root one",
+            lambda: analysis_targets(1 if quick else 3))
     return targets, notes

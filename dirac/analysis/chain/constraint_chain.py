@@ -51,7 +51,7 @@ from dirac.analysis.classes.multiplier_solution import (
     general_multiplier_solution,
     unsolved_multipliers,
 )
-from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
@@ -201,7 +201,7 @@ class ConstraintChain:
 
     def _run(self, max_stages: int | None) -> ConstraintChain:
         self._row_cache: dict = {}
-        primary = [tidy(p, self.phase_space.variables, sign=True, rational=len(str(p)) < 4000) for p in self.primary]
+        primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
         points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
         base_grads = self._independent(primary, [], points) if primary else []
@@ -264,7 +264,7 @@ class ConstraintChain:
         for c, k in zip(candidates, keep):
             if k:  # a product as written: its branches must not meet (read before expanding)
                 self._refuse_crossing(c, self.constraints)
-        kept = [tidy(c, self.phase_space.variables, sign=True, rational=len(str(c)) < 4000) for c, k in zip(candidates, keep) if k]
+        kept = [tidy(c, self.phase_space.variables, sign=True, rational=prints_shorter(c, 4000)) for c, k in zip(candidates, keep) if k]
         # a product, written (a holonomic constraint) or expanded (x**2 - y**2, z x + z): sample
         # points may all fall on one branch or on the crossing, so its branches are found here,
         # by factorisation, not left to chance

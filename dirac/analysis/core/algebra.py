@@ -8,17 +8,91 @@ fraction field when the variables occur in denominators) is orders of magnitude 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import sympy
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["tidy"]
+__all__ = ["tidy", "prints_shorter"]
 
 
 class _NotRational(Exception):
     pass
+
+
+def prints_shorter(expr: sympy.Expr, limit: int) -> bool:
+    """``len(str(expr)) < limit``, without printing a long expression.
+
+    Every occurrence of a symbol prints its whole name, so the names summed over the
+    occurrences (a shared sub-tree counted as often as it occurs, as the printer does)
+    are a lower bound of the printed length: when that bound reaches ``limit`` the
+    answer is ``False`` at once (printing a 15 000-character condition of (228) costs
+    more than a tenth of a second); otherwise the expression is printed and measured,
+    so the answer is always that of ``len(str(expr)) < limit``.
+    """
+    names: dict[sympy.Basic, int] = {}
+
+    def walk(node: sympy.Basic) -> int:
+        hit = names.get(node)
+        if hit is None:
+            if node.is_Symbol:
+                hit = len(node.name)
+            else:
+                hit = 0
+                for a in node.args:
+                    hit += walk(a)
+                    if hit >= limit:
+                        break
+            names[node] = hit
+        return hit
+
+    if walk(expr) >= limit:
+        return False
+    longest = _printed_at_most(expr, limit)
+    if longest is not None and longest < limit:
+        return True
+    return len(str(expr)) < limit
+
+
+#: characters the str printer adds per argument (" + ", "*", "**", "/", "-") and per node
+#: (parentheses, "sqrt(", "1/"): generous bounds for sums, products and powers of atoms
+_PER_ARGUMENT, _PER_NODE = 8, 8
+
+
+def _printed_at_most(expr: sympy.Expr, limit: int) -> int | None:
+    """An upper bound of ``len(str(expr))`` for sums, products and powers of atoms, else ``None``.
+
+    Atoms count their own printed length; every sum, product or power adds at most
+    ``_PER_ARGUMENT`` characters per argument and ``_PER_NODE`` for itself. ``None`` for
+    any other node (a function, a relation) or once the bound reaches ``limit``.
+    """
+    sizes: dict[sympy.Basic, int] = {}
+
+    def walk(node: sympy.Basic) -> int | None:
+        hit = sizes.get(node)
+        if hit is not None:
+            return hit
+        if not node.args:
+            if not (node.is_Symbol or node.is_Number):
+                return None
+            hit = len(str(node))
+        elif node.is_Add or node.is_Mul or node.is_Pow:
+            hit = _PER_NODE
+            for a in node.args:
+                size = walk(a)
+                if size is None:
+                    return None
+                hit += size + _PER_ARGUMENT
+                if hit >= limit:
+                    return None
+        else:
+            return None
+        sizes[node] = hit
+        return hit
+
+    return walk(expr)
 
 
 def _evaluate(expr: sympy.Expr, gens: dict, domain, allow_division: bool):
@@ -82,6 +156,12 @@ def _split_denominators(expr: sympy.Expr, variables: set) -> tuple[sympy.Expr, d
     return expr.xreplace(replacements), {d: 1 / b for d, b in back.items()}, list(back)
 
 
+@functools.lru_cache(maxsize=4096)
+def _combined(coeff: sympy.Expr) -> sympy.Expr:
+    """``factor_terms(together(coeff))``, once per distinct coefficient (many monomials share one)."""
+    return sympy.factor_terms(sympy.together(coeff))
+
+
 def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.Symbol], back: dict) -> sympy.Expr:
     """Ring element in ``variables + others`` -> sympy, terms grouped by variable monomial."""
     nv = len(variables)
@@ -93,7 +173,7 @@ def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.S
     for monom, coeffs in groups.items():
         coeff = sympy.Add(*coeffs).xreplace(back) if back else sympy.Add(*coeffs)
         if back and len(coeffs) > 1:
-            coeff = sympy.factor_terms(sympy.together(coeff))
+            coeff = _combined(coeff)
         terms.append(coeff * sympy.Mul(*[v**k for v, k in zip(variables, monom)]))
     return sympy.Add(*terms)
 

@@ -24,7 +24,7 @@ import sympy
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_bipartite_matching
 
-from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.errors import AnalysisError
 
 __all__ = ["weak_solve", "block_order"]
@@ -190,6 +190,6 @@ def weak_solve(
                     continue
                 value = sol[r, c]
                 if simplify and len(block) == 1:
-                    value = tidy(value, variables, rational=len(str(value)) < TIDY_LIMIT)
+                    value = tidy(value, variables, rational=prints_shorter(value, TIDY_LIMIT))
                 X[u, c] = value
     return X

@@ -303,12 +303,17 @@ def _unit_denominator(
     if tangent:
         # columns of B tangent to chi = 0: J_chi B = 0 there, so the flow of H_c keeps chi = 0
         # and no multiple of the primary constraints is hidden in H_c
+        # (J_chi B evaluated as the product of the values of J_chi and of B at each point:
+        # no symbolic product of the m candidate matrices)
         n, k = solutions[0][0].shape
-        gradients = [numerics.phase_space.gradient(c)[:n] for c in holonomic]
-        products = [list(sympy.Matrix(gradients) * B) for B, _ in solutions]
-        fn = numerics.function([e for p in products for e in p])
-        per_point = len(products[0]) or 1  # J B has this many entries: as many equations per point
-        T = np.vstack([fn(z).reshape(m, -1).T for z in points[: (2 * m + 10) // per_point + 10]])
+        gradients = [g for c in holonomic for g in numerics.phase_space.gradient(c)[:n]]
+        j_fn = numerics.function(gradients)
+        b_fn = numerics.function([e for B, _ in solutions for e in B])
+        per_point = len(holonomic) * k or 1  # J B has this many entries: as many equations per point
+        T = np.vstack([
+            np.einsum("hn,mnk->mhk", j_fn(z).reshape(len(holonomic), n), b_fn(z).reshape(m, n, k)).reshape(m, -1).T
+            for z in points[: (2 * m + 10) // per_point + 10]
+        ])
         T *= scale / (np.max(np.abs(T)) or 1.0)
         D = np.vstack([D, T])
         target = np.concatenate([target, np.zeros(len(T))])

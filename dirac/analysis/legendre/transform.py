@@ -41,7 +41,7 @@ import sympy
 
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.numeric import Numerics, independent_rows
-from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.phase_space import PhaseSpace, derivative
 from dirac.analysis.legendre.first_order import FIRST_ORDER_METHOD, first_order_primary
 from dirac.analysis.legendre.polynomial_kernel import polynomial_kernel
 from dirac.codegen import array_function
@@ -90,8 +90,8 @@ def _quadratic_parts(lagrangian: Lagrangian) -> tuple[sympy.Matrix, list[sympy.E
     """``W``, ``a`` and ``V`` of a Lagrangian quadratic in the velocities (else NotQuadraticError)."""
     v = lagrangian.velocities
     L = lagrangian.expression
-    first = [sympy.diff(L, vi) for vi in v]
-    W = sympy.Matrix(len(v), len(v), lambda i, j: sympy.diff(first[i], v[j]))
+    first = [derivative(L, vi) for vi in v]  # sympy.diff's expressions, each shared sub-tree once
+    W = sympy.Matrix(len(v), len(v), lambda i, j: derivative(first[i], v[j]))
     vset = set(v)
     for i in range(len(v)):
         for j in range(len(v)):

@@ -45,6 +45,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.numeric import independent_rows
+from dirac.analysis.core.phase_space import derivative
 from dirac.codegen import array_function
 from dirac.errors import AnalysisError
 from dirac.model.lagrangian import Lagrangian
@@ -312,8 +313,8 @@ def eliminate_velocities(
     q, v = lagrangian.coordinates, lagrangian.velocities
     n = len(q)
     L = lagrangian.expression
-    P = [sympy.diff(L, vi) for vi in v]
-    W = sympy.Matrix(n, n, lambda i, j: sympy.diff(P[i], v[j]))
+    P = [derivative(L, vi) for vi in v]  # sympy.diff's expressions, each shared sub-tree once
+    W = sympy.Matrix(n, n, lambda i, j: derivative(P[i], v[j]))
     samples = _physical_samples(lagrangian, P, W, rng, parameter_values)
     rank = len(independent_rows(samples.hessians, list(range(n))))
     if rank == n:

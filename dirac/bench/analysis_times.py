@@ -1,0 +1,87 @@
+"""Symbolic speed of ``dirac.analyze`` on the paper's Lagrangians and a square-root one.
+
+Each case is analysed in a fresh Python process (so that sympy's global cache of an
+earlier analysis does not help a later one); the import of ``dirac`` and the building
+of the Lagrangian are outside the timed region. The figure is the median CPU time
+(``time.process_time``) of the ``dirac.analyze`` call over the repeats: the analysis is
+single-threaded, and CPU time does not grow when other jobs share the machine, as wall
+time does; the median wall time is reported beside it.
+
+Cases: the rigid body as particles (the paper's (19)), as a matrix with the
+orthogonality constraint (78), through its angular momentum (228), and the
+relativistic particle ``L = -m sqrt(t_dot^2 - x_dot^2 - y_dot^2)`` on the ellipse
+``x^2 + y^2/4 = 1`` (the engine refuses it at stage 2 with a clear error: the
+consistency of the mass shell gives ``lambda_1 (4 x p_x + y p_y) = 0``, two branches that
+meet; the figure is the time to that answer).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from dataclasses import dataclass
+
+__all__ = ["ANALYSIS_CASES", "AnalysisCase", "analysis_time", "analysis_runs"]
+
+
+@dataclass(frozen=True)
+class AnalysisCase:
+    """One Lagrangian to analyse: Python that builds ``L``, and the CPU-time target (s)."""
+
+    name: str
+    build: str
+    target: float
+
+
+#: the ellipse the square-root particle is held on (a regular curve: its gradient never vanishes on it)
+CONIC = "x**2 + y**2/4 - 1"
+
+ANALYSIS_CASES = (
+    AnalysisCase("rigid body (228), angular momentum", "dirac.load_system('rigid_body_momentum')", 2.0),
+    AnalysisCase("rigid body (19), particles", "dirac.load_system('rigid_body_particles')", 1.5),
+    AnalysisCase("rigid body (78), matrix", "dirac.load_system('rigid_body_matrix')", 1.0),
+    AnalysisCase(
+        "square-root particle on an ellipse (refused at stage 2)",
+        "dirac.Lagrangian.from_strings('relativistic_conic', ['t', 'x', 'y'], "
+        "'-m*sqrt(t_dot**2 - x_dot**2 - y_dot**2)', constraints=[" + repr(CONIC) + "], parameters={'m': 1.0})",
+        5.0,
+    ),
+)
+
+_CHILD = """
+import json, time, warnings
+import dirac
+warnings.simplefilter("ignore")
+L = {build}
+c0, w0 = time.process_time(), time.perf_counter()
+try:
+    dirac.analyze(L)
+    outcome = "analysed"
+except dirac.DiracError as exc:
+    outcome = type(exc).__name__
+print(json.dumps({{"cpu": time.process_time() - c0, "wall": time.perf_counter() - w0, "outcome": outcome}}))
+"""
+
+
+def analysis_time(case: AnalysisCase) -> dict:
+    """CPU and wall seconds of ``dirac.analyze`` on ``case`` in a fresh process, and its outcome."""
+    completed = subprocess.run(
+        [sys.executable, "-c", _CHILD.format(build=case.build)], capture_output=True, text=True, timeout=900
+    )
+    if completed.returncode != 0:
+        raise RuntimeError(f"{case.name}: the analysis process failed: {completed.stderr.strip().splitlines()[-1:]}")
+    return json.loads(completed.stdout.strip().splitlines()[-1])
+
+
+def analysis_runs(repeats: int) -> list[tuple[AnalysisCase, list[dict]]]:
+    """Each case with its ``repeats`` runs (:func:`analysis_time`), cases interleaved.
+
+    The cases are run in turn (case 1, 2, 3, 4, then again), so that a change in the
+    load of the machine touches them alike.
+    """
+    runs: dict[str, list[dict]] = {case.name: [] for case in ANALYSIS_CASES}
+    for _ in range(repeats):
+        for case in ANALYSIS_CASES:
+            runs[case.name].append(analysis_time(case))
+    return [(case, runs[case.name]) for case in ANALYSIS_CASES]
