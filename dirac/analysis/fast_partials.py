@@ -16,7 +16,6 @@ from collections.abc import Sequence
 import sympy
 from sympy.polys.rings import PolyElement, PolyRing
 
-
 __all__ = ["PolynomialPartials"]
 
 
