@@ -7,8 +7,9 @@ and 2+1-dimensional lattice Maxwell theory on a torus. The docstrings give the
 Lagrangian and the hand counts (stages, classes, reducible constraints, degrees of
 freedom) that the tests check.
 
-The factories are built-in systems (entry points ``chain``, ``maxwell_ring``,
-``maxwell_torus``) whose size is a structural option: ``dirac.load_system("chain", n=16)``.
+The factories are functions of the size, not entry-point systems (those take no
+required size, and the list of built-in names stays the paper's systems):
+``from dirac_systems.scale_models import chain; chain(16)``.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ def _size(value: int, least: int, what: str) -> int:
     return value
 
 
-def chain(n: int = 4) -> Lagrangian:
+def chain(n: int) -> Lagrangian:
     """Planar chain of ``n`` rigid links in Cartesian coordinates, under gravity.
 
     Point masses ``m`` at ``r_k = (x_k, y_k)``, ``k = 1..n``, joined by massless rods of
@@ -61,7 +62,7 @@ def chain(n: int = 4) -> Lagrangian:
     )
 
 
-def maxwell_ring(n: int = 8) -> Lagrangian:
+def maxwell_ring(n: int) -> Lagrangian:
     """1+1-dimensional lattice Maxwell theory on a ring of ``n`` sites (temporal links ``A0``).
 
     Site variables ``A0_i`` (no velocity in ``L``) and link variables ``A1_i``
@@ -87,7 +88,7 @@ def maxwell_ring(n: int = 8) -> Lagrangian:
     )
 
 
-def maxwell_torus(size: int = 3) -> Lagrangian:
+def maxwell_torus(size: int) -> Lagrangian:
     """2+1-dimensional lattice Maxwell theory on a ``size`` x ``size`` torus.
 
     Per site ``(a, b)`` (periodic in both directions): the temporal link ``A0_a_b`` (no

@@ -14,20 +14,23 @@ singular value from below). ``O(m r n)`` per point for ``r`` kept rows.
 
 The Gauss–Newton steps of the surface points (minimum-norm solution of ``J dz = -r``)
 and the regularity test of a point (the row-normalised Jacobian has full rank) work on
-the sparse Jacobian of a local system: :func:`minimum_norm_step` solves with LSQR
-(Paige–Saunders 1982), whose iterates from zero converge to the minimum-norm solution,
+the sparse Jacobian of a local system: :func:`minimum_norm_step` solves the normal
+equations of the second kind ``J J^T y = -r``, ``dz = J^T y`` by sparse LU when they are
+regular, and otherwise with LSQR (Paige–Saunders 1982), whose iterates from zero converge
+to the minimum-norm solution,
 and :func:`full_row_rank` decides the rank of ``J J^T`` block by block over the connected
 components of its sparsity graph (dense eigenvalues of each small block).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
-from scipy.sparse.linalg import lsqr
+from scipy.sparse.linalg import MatrixRankWarning, lsqr, splu
 
 __all__ = ["independent_rows_one_pass", "minimum_norm_step", "full_row_rank", "components", "ZERO"]
 
@@ -164,5 +167,16 @@ def minimum_norm_step(jacobian: sp.spmatrix, residual: np.ndarray) -> np.ndarray
     step ``numpy.linalg.lstsq`` gives, without a dense factorisation.
     """
     J = sp.csr_matrix(jacobian, dtype=float)
-    result = lsqr(J, -np.asarray(residual, dtype=float), atol=1e-15, btol=1e-15, iter_lim=20 * max(J.shape))
+    rhs = -np.asarray(residual, dtype=float)
+    if J.shape[0] <= J.shape[1]:  # full row rank: dz = J^T y with J J^T y = -r, by sparse LU
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", MatrixRankWarning)
+                y = splu((J @ J.T).tocsc()).solve(rhs)
+            step = J.T @ y
+            if np.all(np.isfinite(step)) and np.linalg.norm(J @ step - rhs) <= 1e-10 * (1.0 + np.linalg.norm(rhs)):
+                return np.asarray(step, dtype=float)
+        except (RuntimeError, MatrixRankWarning):
+            pass  # singular J J^T (dependent rows): LSQR below
+    result = lsqr(J, rhs, atol=1e-15, btol=1e-15, iter_lim=20 * max(J.shape))
     return np.asarray(result[0], dtype=float)

@@ -1,6 +1,6 @@
 """The scale table of ``dirac bench --scale``: analysis time against system size, with the fitted exponent.
 
-Three local systems whose size is a structural option of a built-in system
+Three local systems built by functions of their size in ``dirac_systems.scale_models``
 (docs/scale.md): the planar ``n``-link chain (``chain``), 1+1 lattice Maxwell theory on a
 ring of ``n`` sites (``maxwell_ring``) and 2+1 lattice Maxwell theory on an ``L x L`` torus
 (``maxwell_torus``). Each size is analysed in a fresh process (import excluded from the
@@ -40,8 +40,6 @@ __all__ = [
     "SCALE_TARGET_SIZES",
 ]
 
-#: the option that sets each model's size
-SIZE_OPTION = {"chain": "n", "maxwell_ring": "n", "maxwell_torus": "size"}
 
 
 def scale_sizes(quick: bool) -> dict[str, list[int]]:

@@ -27,12 +27,14 @@ def measure_one(model: str, size: int) -> dict:
     The bracket is ``{x1, p_x1}_D`` (chain) or ``{A1_1, p_A1_1}_D`` / ``{Ax_0_0, p_Ax_0_0}_D``
     (Maxwell) at a point of the constraint surface.
     """
+    import importlib
     import resource
 
     import dirac
-    from dirac.bench.scale import SIZE_OPTION
 
-    system = dirac.load_system(model, **{SIZE_OPTION[model]: size})
+    # the models are functions of the size in the systems package (dirac_systems), which
+    # the engine never imports at module level: looked up here, in the measuring process
+    system = getattr(importlib.import_module("dirac_systems.scale_models"), model)(size)
     start = time.perf_counter()
     analysis = dirac.analyze(system)
     analyze_s = time.perf_counter() - start

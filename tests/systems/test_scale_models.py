@@ -32,6 +32,7 @@ from stress_scaling import stress_scale
 
 import dirac
 from dirac.errors import InputError
+from dirac_systems.scale_models import chain, maxwell_ring, maxwell_torus
 
 
 def _full() -> bool:
@@ -67,7 +68,7 @@ def _same_up_to_sign(found: list[sympy.Expr], expected: list[sympy.Expr]) -> boo
 
 
 def check_chain(n: int) -> None:
-    analysis = dirac.analyze(dirac.load_system("chain", n=n))
+    analysis = dirac.analyze(chain(n))
     assert [len(stage) for stage in analysis.stages] == [n, n, n, n]
     assert len(analysis.second_class) == 4 * n and analysis.first_class == []
     assert analysis.reducible_constraints == []
@@ -87,7 +88,7 @@ def check_chain(n: int) -> None:
 
 
 def check_ring(n: int) -> None:
-    analysis = dirac.analyze(dirac.load_system("maxwell_ring", n=n))
+    analysis = dirac.analyze(maxwell_ring(n))
     assert [len(stage) for stage in analysis.stages] == [n, n - 1]
     assert len(analysis.reducible_constraints) == 1
     assert _same_up_to_sign(analysis.stages[1] + analysis.reducible_constraints, _ring_gauss_laws(n))
@@ -97,7 +98,7 @@ def check_ring(n: int) -> None:
 
 
 def check_torus(size: int) -> None:
-    analysis = dirac.analyze(dirac.load_system("maxwell_torus", size=size))
+    analysis = dirac.analyze(maxwell_torus(size))
     sites = size * size
     assert [len(stage) for stage in analysis.stages] == [sites, sites - 1]
     assert len(analysis.reducible_constraints) == 1
@@ -137,7 +138,7 @@ def test_torus_at_scale():
     check_torus(16 if _full() else 4)
 
 
-@pytest.mark.parametrize(("name", "option", "value"), [("chain", "n", 0), ("maxwell_ring", "n", 1), ("maxwell_torus", "size", 2.5)])
-def test_bad_sizes_are_refused(name, option, value):
+@pytest.mark.parametrize(("factory", "value"), [(chain, 0), (maxwell_ring, 1), (maxwell_torus, 2.5)])
+def test_bad_sizes_are_refused(factory, value):
     with pytest.raises(InputError, match="must be"):
-        dirac.load_system(name, **{option: value})
+        factory(value)
