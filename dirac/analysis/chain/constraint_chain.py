@@ -51,6 +51,7 @@ from dirac.analysis.classes.multiplier_solution import (
     general_multiplier_solution,
     unsolved_multipliers,
 )
+from dirac.analysis.chain_regularity import irregular_candidates
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
@@ -65,6 +66,7 @@ from dirac.analysis.legendre.regularity import (
     normal_components,
     square_free_part,
 )
+from dirac.analysis.sparse_surface import LARGE_SYSTEM
 from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]
@@ -480,6 +482,8 @@ class ConstraintChain:
         vanishes on the surface: ``f^2 = 0`` or ``x^2 + y^2 = 0``.
         """
         n = len(self.phase_space.variables)
+        if n >= LARGE_SYSTEM:  # one factorisation per point instead of one per candidate
+            return irregular_candidates(self.phase_space, self.numerics, candidates, chosen, old, self.reducible, points)
         everything = old + self.reducible + [candidates[i] for i in chosen]
         grads = [g for c in everything for g in self.phase_space.gradient(c)]
         stacked = self.numerics.evaluate(grads, points).reshape(len(points), len(everything), n)

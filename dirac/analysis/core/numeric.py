@@ -23,6 +23,8 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.sparse_numeric import independent_rows_one_pass
+from dirac.analysis.sparse_surface import LARGE_SYSTEM, sparse_surface_points
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
@@ -39,6 +41,8 @@ REGULAR_TOLERANCE = 1e-6
 #: however independent the row-normalised gradients look there (at a converged point next
 #: to such a locus the gradient is of the order of the square root of the residual, ~1e-6)
 SINGULAR_GRADIENT = 1e-4
+#: rows (candidates and base together) from which independence is decided in one pass
+LARGE_ROWS = 64
 
 
 class SingularSurface(AnalysisError):
@@ -92,7 +96,15 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
     -------
     list of int
         Chosen row indices; a row is kept when it raises the rank at a majority of points.
+
+    Large matrices (rows from ``LARGE_ROWS`` or columns from ``LARGE_SYSTEM``) are decided
+    in one orthogonalisation pass per point
+    (:func:`~dirac.analysis.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
     """
+    if len(matrices) and matrices[0].ndim == 2 and (
+        len(order) + (len(base[0]) if base is not None else 0) >= LARGE_ROWS or matrices[0].shape[1] >= LARGE_SYSTEM
+    ):
+        return independent_rows_one_pass(matrices, order, base)
     chosen: list[int] = []
     for row in order:
         votes = 0
@@ -290,6 +302,8 @@ class Numerics:
             If no point is found: the surface may be empty (no real solution), or it has
             no regular point (its constraints are irregular).
         """
+        if len(self.phase_space.variables) >= LARGE_SYSTEM:  # sparse Jacobian, same rules
+            return sparse_surface_points(self, constraints, count, fixed, attempts, start, regular)
         constraints = [sympy.sympify(c) for c in constraints]
         residual = self.function(constraints)
         grads = [self.phase_space.gradient(c) for c in constraints]
