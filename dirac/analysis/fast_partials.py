@@ -139,7 +139,7 @@ class PolynomialPartials:
             k = position.get(s)
             if k is None:
                 continue
-            d = p.diff(p.ring.gens[k])
+            d = p.diff(k)
             if d:
                 out[s] = self.to_expr(d, back)
         return out
@@ -175,13 +175,13 @@ def quadratic_parts(
     for i, ki in enumerate(vel):
         if ki is None:
             continue
-        first = p.diff(ring.gens[ki])
+        first = p.diff(ki)
         linear = ring.from_dict({m: c for m, c in first.items() if all(m[k] == 0 for k in vel_positions)})
         a[i] = forms.to_expr(linear, back) if linear else sympy.S.Zero
         for j, kj in enumerate(vel):
             if kj is None or j < i:
                 continue
-            second = first.diff(ring.gens[kj])
+            second = first.diff(kj)
             if second:
                 W[i, j] = W[j, i] = forms.to_expr(second, back)
     V = -forms.to_expr(static, back) if static else sympy.S.Zero

@@ -159,10 +159,13 @@ class Numerics:
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
         """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""
-        exprs = [sympy.sympify(e) for e in exprs]
-        self._compile(exprs)
+        zero = sympy.S.Zero  # most entries of a large gradient or bracket matrix: no conversion
+        exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        self._compile([e for e in exprs if e is not zero])
         # (batch, index in it) of a compiled expression, (None, value) of a number
-        plan: list[tuple[int | None, Any]] = [(self._index[e] if not e.is_number else (None, float(e))) for e in exprs]
+        plan: list[tuple[int | None, Any]] = [
+            (None, 0.0) if e is zero else (self._index[e] if not e.is_number else (None, float(e))) for e in exprs
+        ]
         batches = sorted({b for b, _ in plan if b is not None})
 
         def fn(z: np.ndarray) -> np.ndarray:
