@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -19,6 +20,10 @@ BUDGET_SECONDS = 180.0
 QUICK_BUDGET_SECONDS = 60.0
 #: dirac_bracket(at=) calls timed after the first one
 BRACKET_CALLS = 20
+#: thread counts of the BLAS libraries, set to 1 in the measuring processes unless already set:
+#: the analysis factorises many small dense blocks, for which BLAS threads only add
+#: contention (on a loaded 2-core machine a 256 x 127 QR took 0.5-4 s with threads, 2 ms without)
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def measure_one(model: str, size: int) -> dict:
@@ -62,8 +67,11 @@ def _measure_in_child(model: str, size: int, budget: float) -> dict:
         "import json, sys; from dirac.commands.bench_scale import measure_one; "
         f"print(json.dumps(measure_one({model!r}, {size})))"
     )
+    env = dict(os.environ)
+    for name in BLAS_THREAD_VARIABLES:  # unless the user chose: see BLAS_THREADS
+        env.setdefault(name, "1")
     try:
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=budget)
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=budget, env=env)
     except subprocess.TimeoutExpired:
         return {"failed": f"over the {budget:g} s budget"}
     if done.returncode != 0:
@@ -109,6 +117,8 @@ def main(args: argparse.Namespace) -> int:
     command = "dirac bench --scale" + (" --quick" if quick else "")
     print(f"{command}: dirac.analyze wall time against system size, every figure measured in this run")
     print(f"machine: {machine_line(machine)}")
+    threads = ", ".join(f"{name}={os.environ.get(name, '1')}" for name in BLAS_THREAD_VARIABLES)
+    print(f"measuring processes: {threads} (BLAS threads; 1 unless set in the environment)")
     print(format_scale_rows(rows))
     print(format_targets(targets))
     if getattr(args, "json", None):
