@@ -31,6 +31,7 @@ import sympy
 from stress_scaling import stress_scale
 
 import dirac
+from dirac.analysis.constraint_analysis import ConstraintAnalysis
 from dirac.errors import InputError
 from dirac_systems.scale_models import chain, maxwell_ring, maxwell_torus
 
@@ -67,8 +68,8 @@ def _same_up_to_sign(found: list[sympy.Expr], expected: list[sympy.Expr]) -> boo
     return not left
 
 
-def check_chain(n: int) -> None:
-    analysis = dirac.analyze(chain(n))
+def check_chain(n: int, analysis: ConstraintAnalysis | None = None) -> None:
+    analysis = analysis or dirac.analyze(chain(n))
     assert [len(stage) for stage in analysis.stages] == [n, n, n, n]
     assert len(analysis.second_class) == 4 * n and analysis.first_class == []
     assert analysis.reducible_constraints == []
@@ -87,7 +88,7 @@ def check_chain(n: int) -> None:
     assert _same_up_to_sign(analysis.stages[0], primary)
 
 
-def check_ring(n: int) -> None:
+def check_ring(n: int) -> ConstraintAnalysis:
     analysis = dirac.analyze(maxwell_ring(n))
     assert [len(stage) for stage in analysis.stages] == [n, n - 1]
     assert len(analysis.reducible_constraints) == 1
@@ -95,6 +96,7 @@ def check_ring(n: int) -> None:
     assert len(analysis.first_class) == 2 * n - 1 and analysis.second_class == []
     assert analysis.physical_degrees_of_freedom == 1
     assert len(analysis.undetermined_multipliers) == n
+    return analysis
 
 
 def check_torus(size: int) -> None:
@@ -108,12 +110,30 @@ def check_torus(size: int) -> None:
     assert len(analysis.undetermined_multipliers) == sites
 
 
-def test_chain_hand_counts():
-    check_chain(6)
+@pytest.fixture(scope="module")
+def chain9() -> ConstraintAnalysis:
+    return dirac.analyze(chain(9))
 
 
-def test_ring_hand_counts():
-    check_ring(12)
+def test_chain_hand_counts(chain9):
+    check_chain(9, chain9)
+
+
+def test_ring_hand_counts_on_the_large_system_path():
+    analysis = check_ring(32)  # 128 phase-space variables: the sparse surface points and one-pass ranks
+    assert any(note.startswith("large system (128 phase-space variables)") for note in analysis.notes)
+
+
+def test_dirac_bracket_at_a_point_with_a_sparse_c(chain9):
+    """36 second-class constraints (C solved by sparse LU): every constraint's Dirac bracket vanishes, (240)."""
+    analysis = chain9
+    point = analysis.surface_point(seed=3)
+    for constraint in analysis.constraints[::5]:
+        for other in ("x1", "p_y5", "p_x9"):
+            assert abs(analysis.dirac_bracket(constraint, other, at=point)) < 1e-9
+    # equal masses: {q_i, p_j}_D is an orthogonal projector onto the tangent space of the
+    # configuration surface, so its diagonal entries lie in [0, 1] (strictly inside at a generic point)
+    assert 0.0 < analysis.dirac_bracket("x9", "p_x9", at=point) < 1.0
 
 
 def test_torus_hand_counts():
