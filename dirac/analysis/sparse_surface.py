@@ -14,17 +14,13 @@ of non-zeros times the LSQR iterations.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.sparse_numeric import full_row_rank, minimum_norm_step
-from dirac.errors import AnalysisError
-
-if TYPE_CHECKING:
-    from dirac.analysis.numeric import Numerics
 
 __all__ = ["sparse_surface_points", "SparseJacobian", "LARGE_SYSTEM"]
 
@@ -35,7 +31,8 @@ LARGE_SYSTEM = 120
 class SparseJacobian:
     """The Jacobian of ``constraints`` compiled over its non-zero pattern: ``J(z)`` as a CSR matrix."""
 
-    def __init__(self, numerics: Numerics, constraints: Sequence[sympy.Expr]) -> None:
+    def __init__(self, numerics: Any, constraints: Sequence[sympy.Expr]) -> None:
+        # numerics: a dirac.analysis.numeric.Numerics (not imported: numeric imports this module)
         space = numerics.phase_space
         position = {s: k for k, s in enumerate(space.variables)}
         rows: list[int] = []
@@ -61,19 +58,22 @@ class SparseJacobian:
 
 
 def sparse_surface_points(
-    numerics: Numerics,
+    numerics: Any,
     constraints: Sequence[sympy.Expr],
     count: int,
     fixed: Mapping[int, float] | None = None,
     attempts: int = 40,
     start: np.ndarray | None = None,
     regular: int = 0,
-) -> list[np.ndarray]:
-    """``count`` regular points on ``constraints = 0``: :meth:`Numerics.surface_points` with sparse linear algebra.
+    surface_tolerance: float = 1e-11,
+    regular_tolerance: float = 1e-6,
+) -> tuple[list[np.ndarray], int]:
+    """Regular points on ``constraints = 0``: :meth:`Numerics.surface_points` with sparse linear algebra.
 
-    Same arguments, tolerances and errors as :meth:`dirac.analysis.numeric.Numerics.surface_points`.
+    Same arguments and tolerances as :meth:`dirac.analysis.numeric.Numerics.surface_points`
+    (which passes its own). Returns the points found (up to ``count``) and the number of
+    converged points dropped as singular; the caller raises when there are too few.
     """
-    from dirac.analysis.numeric import REGULAR_TOLERANCE, SURFACE_TOLERANCE, SingularSurface
 
     constraints = [sympy.sympify(c) for c in constraints]
     residual = numerics.function(constraints)
@@ -99,7 +99,7 @@ def sparse_surface_points(
             if not np.all(np.isfinite(r)):
                 break
             size = numerics.term_scale(constraints, [z])[0] if np.max(np.abs(r)) < 1e-6 else None
-            if size is not None and np.all(np.abs(r) <= SURFACE_TOLERANCE * size):
+            if size is not None and np.all(np.abs(r) <= surface_tolerance * size):
                 ok = True
                 break
             J = jacobian(z)
@@ -111,21 +111,9 @@ def sparse_surface_points(
                 step *= 10.0 / norm
             z = z.copy()
             z[free] += step
-        if ok and regular and not full_row_rank(jacobian(z)[:regular], REGULAR_TOLERANCE):
+        if ok and regular and not full_row_rank(jacobian(z)[:regular], regular_tolerance):
             singular += 1
             continue
         if ok:
             points.append(z)
-    if len(points) < count:
-        names = "; ".join(str(c) for c in constraints[:6])
-        if singular:
-            raise SingularSurface(
-                f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
-                f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
-                "(irregular constraints); write the surface with constraints whose gradients are independent on it"
-            )
-        raise AnalysisError(
-            f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
-            "after many random starts: the constraints may have no real solution for these parameters"
-        )
-    return points
+    return points, singular

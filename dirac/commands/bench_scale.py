@@ -35,13 +35,13 @@ def measure_one(model: str, size: int) -> dict:
     import importlib
     import resource
 
-    import dirac
+    from dirac.analysis.constraint_analysis import analyze
 
     # the models are functions of the size in the systems package (dirac_systems), which
     # the engine never imports at module level: looked up here, in the measuring process
     system = getattr(importlib.import_module("dirac_systems.scale_models"), model)(size)
     start = time.perf_counter()
-    analysis = dirac.analyze(system)
+    analysis = analyze(system)
     analyze_s = time.perf_counter() - start
     counts = (
         f"stages {'+'.join(str(len(s)) for s in analysis.stages)}, {len(analysis.first_class)} first, "

@@ -305,8 +305,13 @@ class Numerics:
             If no point is found: the surface may be empty (no real solution), or it has
             no regular point (its constraints are irregular).
         """
-        if len(self.phase_space.variables) >= LARGE_SYSTEM:  # sparse Jacobian, same rules
-            return sparse_surface_points(self, constraints, count, fixed, attempts, start, regular)
+        if len(self.phase_space.variables) >= LARGE_SYSTEM:  # sparse Jacobian, same rules and errors
+            found, dropped = sparse_surface_points(
+                self, constraints, count, fixed, attempts, start, regular, SURFACE_TOLERANCE, REGULAR_TOLERANCE
+            )
+            if len(found) < count:
+                raise _no_surface_point([sympy.sympify(c) for c in constraints], dropped)
+            return found
         constraints = [sympy.sympify(c) for c in constraints]
         residual = self.function(constraints)
         grads = [self.phase_space.gradient(c) for c in constraints]
@@ -354,16 +359,22 @@ class Numerics:
             if ok:
                 points.append(z)
         if len(points) < count:
-            names = "; ".join(str(c) for c in constraints[:6])
-            if singular:
-                raise SingularSurface(
-                    f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
-                    f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
-                    "(irregular constraints); write the surface with constraints whose gradients are independent on it"
-                )
-            raise AnalysisError(
-                f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
-                "after many random starts: the constraints may have no real solution for these parameters"
-            )
+            raise _no_surface_point(constraints, singular)
         return points
+
+
+def _no_surface_point(constraints: list[sympy.Expr], singular: int) -> AnalysisError:
+    """The error when too few points were found: none regular among ``singular`` found, or none at all."""
+    m = len(constraints)
+    names = "; ".join(str(c) for c in constraints[:6])
+    if singular:
+        return SingularSurface(
+            f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
+            f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
+            "(irregular constraints); write the surface with constraints whose gradients are independent on it"
+        )
+    return AnalysisError(
+        f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
+        "after many random starts: the constraints may have no real solution for these parameters"
+    )
 
