@@ -192,7 +192,7 @@ class DiracBracket:
         sparse = m > SPARSE_C
         if sparse:  # only the non-zero entries of C are compiled, and C x = beta is solved by sparse LU
             if self._c_pattern is None:
-                entries = [(i, j) for i in range(m) for j in range(m) if self.C[i, j] != 0]
+                entries = sorted(self.C.todok())
                 self._c_pattern = (entries, np.array([i for i, _ in entries], dtype=int), np.array([j for _, j in entries], dtype=int))
             entries, rows, cols = self._c_pattern
             c_fn, c_needed = self._compiled_once("C-sparse", lambda: [self.C[i, j] for i, j in entries])

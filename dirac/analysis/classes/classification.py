@@ -91,7 +91,14 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
         return Classification([], [], [], 0, 0)
     if C is None:
         C = bracket_matrix(space, constraints)
-    values = numerics.evaluate(list(C), points).reshape(len(points), m, m)
+    nonzero = C.todok()  # only the non-zero entries are compiled and evaluated (most, for a local system, are zero)
+    values = np.zeros((len(points), m, m))
+    if nonzero:
+        where = list(nonzero)
+        at = numerics.evaluate([nonzero[k] for k in where], points)
+        rows = np.array([i for i, _ in where], dtype=int)
+        cols = np.array([j for _, j in where], dtype=int)
+        values[:, rows, cols] = at
     scale = 1.0 + np.max(np.abs(values), axis=(1, 2), keepdims=True)
     tiny = np.all(np.abs(values) <= 1e-9 * scale, axis=0)
     alone_first = [a for a in range(m) if np.all(tiny[a])]
