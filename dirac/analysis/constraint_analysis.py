@@ -23,11 +23,11 @@ from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsol
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
 from dirac.analysis.legendre.regularity import regular_holonomic
 from dirac.analysis.legendre.transform import legendre_transform
 from dirac.analysis.report import to_json, to_latex, to_text
-from dirac.analysis.sparse_surface import LARGE_SYSTEM
 from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian, momentum_name, velocity_name
 

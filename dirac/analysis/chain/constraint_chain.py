@@ -46,16 +46,17 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 import sympy
 
+from dirac.analysis.chain.chain_regularity import irregular_candidates
 from dirac.analysis.classes.multiplier_solution import (
     MultiplierSolution,
     general_multiplier_solution,
     unsolved_multipliers,
 )
-from dirac.analysis.chain_regularity import irregular_candidates
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.regularity import (
     IRREGULAR_GRADIENT,
     MAX_FACTOR_TERMS,
@@ -66,7 +67,6 @@ from dirac.analysis.legendre.regularity import (
     normal_components,
     square_free_part,
 )
-from dirac.analysis.sparse_surface import LARGE_SYSTEM
 from dirac.errors import AnalysisError, InconsistentSystemError
 
 __all__ = ["ConstraintChain", "tidy"]

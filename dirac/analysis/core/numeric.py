@@ -23,8 +23,8 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.sparse_numeric import independent_rows_one_pass
-from dirac.analysis.sparse_surface import LARGE_SYSTEM, sparse_surface_points
+from dirac.analysis.core.sparse_numeric import independent_rows_one_pass
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, sparse_surface_points
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
@@ -99,7 +99,7 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
 
     Large matrices (rows from ``LARGE_ROWS`` or columns from ``LARGE_SYSTEM``) are decided
     in one orthogonalisation pass per point
-    (:func:`~dirac.analysis.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
+    (:func:`~dirac.analysis.core.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
     """
     if len(matrices) and matrices[0].ndim == 2 and (
         len(order) + (len(base[0]) if base is not None else 0) >= LARGE_ROWS or matrices[0].shape[1] >= LARGE_SYSTEM
@@ -307,7 +307,8 @@ class Numerics:
         """
         if len(self.phase_space.variables) >= LARGE_SYSTEM:  # sparse Jacobian, same rules and errors
             found, dropped = sparse_surface_points(
-                self, constraints, count, fixed, attempts, start, regular, SURFACE_TOLERANCE, REGULAR_TOLERANCE
+                self, constraints, count, fixed, attempts, start, regular, SURFACE_TOLERANCE, REGULAR_TOLERANCE,
+                SINGULAR_GRADIENT,
             )
             if len(found) < count:
                 raise _no_surface_point([sympy.sympify(c) for c in constraints], dropped)

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import sympy
 
-from dirac.analysis.fast_partials import PolynomialPartials
+from dirac.analysis.core.fast_partials import PolynomialPartials
 
 __all__ = ["PhaseSpace"]
 
@@ -59,7 +59,7 @@ class PhaseSpace:
         Both dictionaries are keyed by the coordinate, so the bracket pairs them up.
         Results are cached (constraints are differentiated many times). Polynomials in
         the variables are differentiated in the sparse polynomial ring
-        (:mod:`dirac.analysis.fast_partials`, the same derivatives, expanded), other
+        (:mod:`dirac.analysis.core.fast_partials`, the same derivatives, expanded), other
         expressions by ``sympy.diff``.
         """
         expr = sympy.sympify(expr)

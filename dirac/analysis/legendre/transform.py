@@ -40,9 +40,9 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.fast_partials import quadratic_parts
 from dirac.analysis.core.numeric import Numerics, independent_rows
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.fast_partials import quadratic_parts
 from dirac.analysis.legendre.first_order import FIRST_ORDER_METHOD, first_order_primary
 from dirac.analysis.legendre.polynomial_kernel import polynomial_kernel
 from dirac.codegen import array_function
@@ -91,7 +91,7 @@ def _quadratic_parts(lagrangian: Lagrangian) -> tuple[sympy.Matrix, list[sympy.E
     """``W``, ``a`` and ``V`` of a Lagrangian quadratic in the velocities (else NotQuadraticError).
 
     A polynomial ``L`` is split in the sparse polynomial ring
-    (:func:`dirac.analysis.fast_partials.quadratic_parts`: only the non-zero entries of
+    (:func:`dirac.analysis.core.fast_partials.quadratic_parts`: only the non-zero entries of
     ``W``); other Lagrangians with ``sympy.diff``.
     """
     extra = (lagrangian.time,) if lagrangian.is_time_dependent else ()

@@ -17,17 +17,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 import sympy
 
-from dirac.analysis.regularity import IRREGULAR_GRADIENT, ROUND_OFF
+from dirac.analysis.legendre.regularity import IRREGULAR_GRADIENT, ROUND_OFF
 
 if TYPE_CHECKING:
-    from dirac.analysis.numeric import Numerics
-    from dirac.analysis.phase_space import PhaseSpace
+    from dirac.analysis.core.numeric import Numerics
+    from dirac.analysis.core.phase_space import PhaseSpace
 
 __all__ = ["irregular_candidates"]
 
 
 def _basis(base: np.ndarray) -> np.ndarray | None:
-    """Orthonormal columns spanning the rows of ``base`` (as in :func:`~dirac.analysis.regularity.normal_components`)."""
+    """Orthonormal columns spanning the rows of ``base`` (as in :func:`~dirac.analysis.legendre.regularity.normal_components`)."""
     if not base.size:
         return None
     q, r = np.linalg.qr(base.T)

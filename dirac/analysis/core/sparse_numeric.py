@@ -3,7 +3,7 @@
 The Dirac–Bergmann chain decides independence (of constraint gradients, of the rows of
 the consistency matrix) by a greedy choice of rows in an order of preference: a row is
 kept when it raises the rank at a majority of the surface points
-(:func:`dirac.analysis.numeric.independent_rows`). Computed with one SVD of the growing
+(:func:`dirac.analysis.core.numeric.independent_rows`). Computed with one SVD of the growing
 stack per candidate row, that costs ``O(m)`` SVDs, ``O(m^2 n^2)`` in all for ``m`` rows of
 length ``n``. Here the same greedy choice is made in one pass per point: an orthonormal
 basis of the rows kept so far is extended row by row (Gram–Schmidt with one
@@ -80,7 +80,7 @@ def independent_rows_one_pass(
 ) -> list[int]:
     """Greedy choice of rows that raise the rank, in the given order, at a majority of points.
 
-    The same choice as :func:`dirac.analysis.numeric.independent_rows` (same arguments,
+    The same choice as :func:`dirac.analysis.core.numeric.independent_rows` (same arguments,
     same majority vote), made in one orthogonalisation pass per point instead of one SVD
     per candidate row. The rows of ``base`` (already kept) enter the basis first, the
     independent ones among them only.
@@ -135,7 +135,7 @@ def full_row_rank(jacobian: sp.spmatrix, tolerance: float) -> bool:
     """Whether the rows of the sparse ``jacobian`` are independent after scaling each to unit length.
 
     The smallest singular value of the row-normalised ``J`` must exceed ``tolerance``
-    (the test of :meth:`dirac.analysis.numeric.Numerics._regular_point`): the smallest
+    (the test of :meth:`dirac.analysis.core.numeric.Numerics._regular_point`): the smallest
     eigenvalue of ``J J^T`` must exceed ``tolerance**2``. ``J J^T`` is block diagonal over
     the connected components of its sparsity graph; each block's eigenvalues are taken
     densely.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sympy
 
-from dirac.analysis.fast_partials import PolynomialPartials, quadratic_parts
+from dirac.analysis.core.fast_partials import PolynomialPartials, quadratic_parts
 
 x, y, p, q = sympy.symbols("x y p q", real=True)
 m, g, k = sympy.symbols("m g k", real=True)

@@ -1,12 +1,12 @@
 """Points of the constraint surface of a large, local system: Gauss–Newton with a sparse Jacobian.
 
-The same projection as :meth:`dirac.analysis.numeric.Numerics.surface_points` (random
+The same projection as :meth:`dirac.analysis.core.numeric.Numerics.surface_points` (random
 start, minimum-norm Gauss–Newton steps bounded in length, convergence relative to each
 constraint's term sizes, only regular points kept), with the Jacobian compiled entry by
 entry over its non-zero pattern (a constraint of a local system touches O(1)
 variables) and the step and the regularity test taken sparsely
-(:func:`~dirac.analysis.sparse_numeric.minimum_norm_step`,
-:func:`~dirac.analysis.sparse_numeric.full_row_rank`). Dense ``lstsq`` and SVD of an
+(:func:`~dirac.analysis.core.sparse_numeric.minimum_norm_step`,
+:func:`~dirac.analysis.core.sparse_numeric.full_row_rank`). Dense ``lstsq`` and SVD of an
 ``m x n`` Jacobian cost ``O(m n min(m, n))`` per step; here a step costs about the number
 of non-zeros times the LSQR iterations.
 """
@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 import sympy
 
-from dirac.analysis.sparse_numeric import full_row_rank, minimum_norm_step
+from dirac.analysis.core.sparse_numeric import full_row_rank, minimum_norm_step
 
 __all__ = ["sparse_surface_points", "SparseJacobian", "LARGE_SYSTEM"]
 
@@ -32,7 +32,7 @@ class SparseJacobian:
     """The Jacobian of ``constraints`` compiled over its non-zero pattern: ``J(z)`` as a CSR matrix."""
 
     def __init__(self, numerics: Any, constraints: Sequence[sympy.Expr]) -> None:
-        # numerics: a dirac.analysis.numeric.Numerics (not imported: numeric imports this module)
+        # numerics: a dirac.analysis.core.numeric.Numerics (not imported: numeric imports this module)
         space = numerics.phase_space
         position = {s: k for k, s in enumerate(space.variables)}
         rows: list[int] = []
@@ -53,8 +53,29 @@ class SparseJacobian:
         self.cols = np.array(cols, dtype=int)
         self._values = numerics.function(entries)
 
+        self._entries = entries
+        self._numerics = numerics
+
     def __call__(self, z: np.ndarray) -> sp.csr_matrix:
         return sp.csr_matrix((self._values(z), (self.rows, self.cols)), shape=self.shape)
+
+    def vanishing(self, z: np.ndarray, regular: int, threshold: float) -> bool:
+        """Whether one of the first ``regular`` gradients is vanishing at ``z`` relative to its terms.
+
+        The test of :meth:`dirac.analysis.core.numeric.Numerics._vanishing_gradient` over the
+        non-zero entries: each row's length against ``1 + sum |term|`` of its entries; below
+        ``threshold`` the point lies next to where the gradient vanishes (a singular point,
+        Henneaux–Teitelboim, Sect. 1.1.2).
+        """
+        keep = self.rows < regular
+        if not np.any(keep):
+            return False
+        values = np.asarray(self._values(z), dtype=float)[keep]
+        rows = self.rows[keep]
+        scales = self._numerics.term_scale([e for e, k in zip(self._entries, keep) if k], [z])[0] - 1.0
+        lengths = np.sqrt(np.bincount(rows, weights=values**2, minlength=regular))
+        sizes = lengths / (1.0 + np.bincount(rows, weights=scales, minlength=regular))
+        return bool(np.any(sizes < threshold))
 
 
 def sparse_surface_points(
@@ -67,10 +88,11 @@ def sparse_surface_points(
     regular: int = 0,
     surface_tolerance: float = 1e-11,
     regular_tolerance: float = 1e-6,
+    singular_gradient: float = 1e-4,
 ) -> tuple[list[np.ndarray], int]:
     """Regular points on ``constraints = 0``: :meth:`Numerics.surface_points` with sparse linear algebra.
 
-    Same arguments and tolerances as :meth:`dirac.analysis.numeric.Numerics.surface_points`
+    Same arguments and tolerances as :meth:`dirac.analysis.core.numeric.Numerics.surface_points`
     (which passes its own). Returns the points found (up to ``count``) and the number of
     converged points dropped as singular; the caller raises when there are too few.
     """
@@ -112,6 +134,9 @@ def sparse_surface_points(
             z = z.copy()
             z[free] += step
         if ok and regular and not full_row_rank(jacobian(z)[:regular], regular_tolerance):
+            singular += 1
+            continue
+        if ok and regular and jacobian.vanishing(z, regular, singular_gradient):
             singular += 1
             continue
         if ok:

@@ -1,7 +1,7 @@
 """The one-pass numerical decisions for large systems against dense references.
 
 Independent checks: the greedy choice of rows is compared with the SVD-based choice of
-:func:`dirac.analysis.numeric.independent_rows` (its definition: a row is kept when it
+:func:`dirac.analysis.core.numeric.independent_rows` (its definition: a row is kept when it
 raises the rank at a majority of points) on random matrices of known rank; the
 minimum-norm step with ``numpy.linalg.lstsq``; the regularity test with the smallest
 singular value of the dense row-normalised matrix.
@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from dirac.analysis.numeric import independent_rows
-from dirac.analysis.sparse_numeric import full_row_rank, independent_rows_one_pass, minimum_norm_step
+from dirac.analysis.core.numeric import independent_rows
+from dirac.analysis.core.sparse_numeric import full_row_rank, independent_rows_one_pass, minimum_norm_step
 
 
 def test_one_pass_choice_equals_the_svd_choice_on_matrices_of_known_rank():
