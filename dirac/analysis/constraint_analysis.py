@@ -24,6 +24,7 @@ from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.blas_threads import one_blas_thread
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
 from dirac.analysis.legendre.regularity import regular_holonomic
 from dirac.analysis.legendre.transform import legendre_transform
@@ -224,6 +225,13 @@ class ConstraintAnalysis:
                 "p_dot = -dH/dq + Q, so every consistency condition is d Phi/dt = {Phi, H_T} + sum_r dPhi/dp_r Q_r "
                 "(+ d_t Phi), and the multipliers are solved with the forces; the Dirac bracket and the classes "
                 "are those of H (forces are not Hamiltonian)"
+            )
+        if space.dimension >= LARGE_SYSTEM:
+            self.notes.append(
+                f"large system ({space.dimension} phase-space variables): surface points found with the sparse "
+                "Jacobian (minimum-norm steps by sparse LU, LSQR where rows depend), regular points tested block by "
+                "block, independence of rows decided in one orthogonalisation pass per point; weak zeros, the rank "
+                "of C and the exact multiplier solve stay on the dense path"
             )
         if self.time is not None and lagrangian.is_time_dependent:
             self.notes.append(

@@ -26,6 +26,15 @@ from dirac.bench.timing import median_of, time_call
 
 __all__ = ["Target", "analysis_targets", "measure_targets", "work_precision_targets"]
 
+#: ``dirac bench --scale``: wall time of ``dirac.analyze`` at each model's target size (s)
+SCALE_TARGET_SECONDS = 10.0
+#: ``dirac bench --scale``: growth exponent of the analysis time between the two largest sizes
+SCALE_TARGET_EXPONENT = 1.3
+#: ``dirac bench --scale``: peak resident memory of one analysis process (MB)
+SCALE_TARGET_MEMORY_MB = 2048.0
+#: ``dirac bench --scale``: the size at which each model must meet SCALE_TARGET_SECONDS
+SCALE_TARGET_SIZES = {"chain": 128, "maxwell_ring": 1024, "maxwell_torus": 16}
+
 _STANDARD_INERTIA = np.array(STANDARD_INERTIA)
 _STANDARD_M0 = np.array(STANDARD_M0)
 

@@ -1,7 +1,7 @@
 """``dirac bench``: work–precision benchmark against scipy baselines, in one run.
 
-``dirac bench [--quick] [--json FILE] [--plot FILE.png]``. The flags ``--stress`` and
-``--ensemble`` hand over to their own commands, :mod:`dirac.commands.bench_stress` and
+``dirac bench [--quick] [--json FILE] [--plot FILE.png]``. The flags ``--stress``,
+``--ensemble`` and ``--scale`` (:mod:`dirac.commands.bench_scale`) hand over to their own commands, :mod:`dirac.commands.bench_stress` and
 :mod:`dirac.commands.bench_ensemble`, when those are installed.
 """
 
@@ -30,6 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
     parser.add_argument("--stress", action="store_true", help="run the stress benchmark instead (docs/stress.md)")
     parser.add_argument("--ensemble", action="store_true", help="run the ensemble benchmark instead (docs/ensembles.md)")
+    parser.add_argument("--scale", action="store_true",
+                        help="analysis time against system size instead, with fitted exponents (docs/scale.md)")
     return parser
 
 
@@ -56,8 +58,9 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _main(args: argparse.Namespace) -> int:
-    if args.stress and args.ensemble:
-        raise InputError("give either --stress or --ensemble, not both")
+    chosen = [flag for flag in ("stress", "ensemble", "scale") if getattr(args, flag, False)]
+    if len(chosen) > 1:
+        raise InputError(f"give only one of --stress, --ensemble, --scale, not {' and '.join('--' + f for f in chosen)}")
     if args.stress:
         return _delegate("stress", "dirac.commands.bench_stress", args)
     if args.ensemble:
@@ -72,6 +75,8 @@ def _main(args: argparse.Namespace) -> int:
             import matplotlib  # noqa: F401 -- imported only to check that it is installed
         except ModuleNotFoundError:
             raise InputError("--plot needs matplotlib: pip install 'dirac-mechanics[plot]'") from None
+    if args.scale:
+        return _delegate("scale", "dirac.commands.bench_scale", args)
     from dirac.bench.run import run_benchmark
 
     run_benchmark(quick=bool(args.quick), json_path=args.json, plot_path=args.plot, progress=not args.no_progress and getattr(args, "verbosity", 0) >= 0)

@@ -7,15 +7,20 @@ the entries of ``C`` that vanish weakly are dropped, and ``C x = {Phi, B}`` is s
 the block triangular method of :mod:`dirac.analysis.core.linear_solve` — the automatic form of
 the paper's block inversion (245)-(246). The result is equal to the true bracket on the
 constraint surface (weakly). Numeric brackets (``at=point``) evaluate compiled
-``{A, Phi}``, ``{Phi, B}`` and ``C`` at the point and solve the linear system with numpy.
+``{A, Phi}``, ``{Phi, B}`` and ``C`` at the point and solve the linear system with numpy
+(for more than ``SPARSE_C`` second-class constraints: ``C`` over its non-zero entries,
+solved by sparse LU).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
 import sympy
+from scipy.sparse import csc_matrix
+from scipy.sparse.linalg import MatrixRankWarning, splu
 
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics
@@ -24,6 +29,9 @@ from dirac.codegen import scalar_function
 from dirac.errors import InputError
 
 __all__ = ["DiracBracket"]
+
+#: second-class sets larger than this evaluate C over its non-zero entries and solve by sparse LU at a point
+SPARSE_C = 32
 
 
 class DiracBracket:
@@ -63,6 +71,7 @@ class DiracBracket:
         self.defaults = dict(defaults)
         self._compiled: dict = {}
         self._c_values: np.ndarray | None = None
+        self._c_pattern: tuple[list[tuple[int, int]], np.ndarray, np.ndarray] | None = None
         self.time = numerics.time  # a time-dependent system's t: an argument, not a variable
         self._args = (*phase_space.variables, *([self.time] if self.time is not None else []), *phase_space.parameters)
 
@@ -179,22 +188,43 @@ class DiracBracket:
         # {Phi_a, g} = -{g, Phi_a}
         f_fn, f_needed = self._compiled_once(("row", f), lambda: [pb(f, c) for c in self.constraints])
         g_fn, g_needed = self._compiled_once(("row", g), lambda: [pb(g, c) for c in self.constraints])
-        c_fn, c_needed = self._compiled_once("C", lambda: list(self.C))
+        m = len(self.constraints)
+        sparse = m > SPARSE_C
+        if sparse:  # only the non-zero entries of C are compiled, and C x = beta is solved by sparse LU
+            if self._c_pattern is None:
+                entries = sorted(self.C.todok())
+                self._c_pattern = (entries, np.array([i for i, _ in entries], dtype=int), np.array([j for _, j in entries], dtype=int))
+            entries, rows, cols = self._c_pattern
+            c_fn, c_needed = self._compiled_once("C-sparse", lambda: [self.C[i, j] for i, j in entries])
+        else:
+            c_fn, c_needed = self._compiled_once("C", lambda: list(self.C))
         args = self._arguments(point, plain_needed | f_needed | g_needed | c_needed)
         plain = float(np.asarray(plain_fn(*args), dtype=float)[0])
-        m = len(self.constraints)
         if m == 0:
             return plain
         alpha = np.asarray(f_fn(*args), dtype=float)
         beta = -np.asarray(g_fn(*args), dtype=float)
+        singular = InputError(
+            "the second-class bracket matrix C is singular at the given point: the Dirac bracket "
+            "is not defined there (use a point on the constraint surface, e.g. from surface_point())"
+        )
+        if sparse:
+            values = np.asarray(c_fn(*args), dtype=float)
+            C_sparse = csc_matrix((values, (rows, cols)), shape=(m, m))
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", MatrixRankWarning)
+                    x = splu(C_sparse).solve(beta)
+            except (RuntimeError, MatrixRankWarning):
+                raise singular from None
+            if not np.all(np.isfinite(x)):
+                raise singular
+            return float(plain - alpha @ x)
         C = np.asarray(c_fn(*args), dtype=float).reshape(m, m)
         try:
             x = np.linalg.solve(C, beta)
         except np.linalg.LinAlgError:
-            raise InputError(
-                "the second-class bracket matrix C is singular at the given point: the Dirac bracket "
-                "is not defined there (use a point on the constraint surface, e.g. from surface_point())"
-            ) from None
+            raise singular from None
         return float(plain - alpha @ x)
 
     def _compiled_once(self, key: object, build) -> tuple:

@@ -46,6 +46,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 import sympy
 
+from dirac.analysis.chain.chain_regularity import irregular_candidates
 from dirac.analysis.classes.multiplier_solution import (
     MultiplierSolution,
     general_multiplier_solution,
@@ -55,6 +56,7 @@ from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.regularity import (
     IRREGULAR_GRADIENT,
     MAX_FACTOR_TERMS,
@@ -480,6 +482,8 @@ class ConstraintChain:
         vanishes on the surface: ``f^2 = 0`` or ``x^2 + y^2 = 0``.
         """
         n = len(self.phase_space.variables)
+        if n >= LARGE_SYSTEM:  # one factorisation per point instead of one per candidate
+            return irregular_candidates(self.phase_space, self.numerics, candidates, chosen, old, self.reducible, points)
         everything = old + self.reducible + [candidates[i] for i in chosen]
         grads = [g for c in everything for g in self.phase_space.gradient(c)]
         stacked = self.numerics.evaluate(grads, points).reshape(len(points), len(everything), n)

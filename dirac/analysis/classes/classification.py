@@ -27,15 +27,36 @@ __all__ = ["Classification", "classify", "bracket_matrix"]
 
 
 def bracket_matrix(space: PhaseSpace, constraints: list[sympy.Expr]) -> sympy.Matrix:
-    """``C_ab = {Phi_a, Phi_b}`` (antisymmetric; only ``a < b`` is computed)."""
+    """``C_ab = {Phi_a, Phi_b}`` (antisymmetric; only ``a < b`` is computed).
+
+    Only pairs that share a canonical pair can have a non-zero bracket: the constraints
+    are indexed by the coordinates whose ``q`` or ``p`` they contain, and brackets are
+    computed only where ``Phi_a`` contains ``q_i`` and ``Phi_b`` contains ``p_i`` or the
+    reverse (for a local system ``O(m)`` brackets instead of ``m^2 / 2``).
+    """
     m = len(constraints)
-    C = sympy.zeros(m, m)
-    for a in range(m):
-        for b in range(a + 1, m):
-            value = space.poisson_bracket(constraints[a], constraints[b])
-            C[a, b] = value
-            C[b, a] = -value
-    return C
+    by_q: dict[sympy.Symbol, list[int]] = {}
+    by_p: dict[sympy.Symbol, list[int]] = {}
+    for a, c in enumerate(constraints):
+        dq, dp = space.partials(c)
+        for q in dq:
+            by_q.setdefault(q, []).append(a)
+        for q in dp:
+            by_p.setdefault(q, []).append(a)
+    pairs = {
+        (min(a, b), max(a, b))
+        for q, rows in by_q.items()
+        for a in rows
+        for b in by_p.get(q, ())
+        if a != b
+    }
+    entries: dict[tuple[int, int], sympy.Expr] = {}
+    for a, b in sorted(pairs):
+        value = space.poisson_bracket(constraints[a], constraints[b])
+        if value != 0:
+            entries[(a, b)] = value
+            entries[(b, a)] = -value
+    return sympy.Matrix(sympy.SparseMatrix(m, m, entries)) if m else sympy.zeros(0, 0)
 
 
 @dataclass
@@ -70,7 +91,14 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
         return Classification([], [], [], 0, 0)
     if C is None:
         C = bracket_matrix(space, constraints)
-    values = numerics.evaluate(list(C), points).reshape(len(points), m, m)
+    nonzero = C.todok()  # only the non-zero entries are compiled and evaluated (most, for a local system, are zero)
+    values = np.zeros((len(points), m, m))
+    if nonzero:
+        where = list(nonzero)
+        at = numerics.evaluate([nonzero[k] for k in where], points)
+        rows = np.array([i for i, _ in where], dtype=int)
+        cols = np.array([j for _, j in where], dtype=int)
+        values[:, rows, cols] = at
     scale = 1.0 + np.max(np.abs(values), axis=(1, 2), keepdims=True)
     tiny = np.all(np.abs(values) <= 1e-9 * scale, axis=0)
     alone_first = [a for a in range(m) if np.all(tiny[a])]

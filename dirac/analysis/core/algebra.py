@@ -167,14 +167,14 @@ def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.S
     nv = len(variables)
     groups: dict = {}
     for monom, c in p.terms():
-        coeff = sympy.Rational(int(c.numerator), int(c.denominator)) * sympy.Mul(*[s**k for s, k in zip(others, monom[nv:])])
+        coeff = sympy.Rational(int(c.numerator), int(c.denominator)) * sympy.Mul(*[s**k for s, k in zip(others, monom[nv:]) if k])
         groups.setdefault(monom[:nv], []).append(coeff)
     terms = []
     for monom, coeffs in groups.items():
         coeff = sympy.Add(*coeffs).xreplace(back) if back else sympy.Add(*coeffs)
         if back and len(coeffs) > 1:
             coeff = _combined(coeff)
-        terms.append(coeff * sympy.Mul(*[v**k for v, k in zip(variables, monom)]))
+        terms.append(coeff * sympy.Mul(*[v**k for v, k in zip(variables, monom) if k]))
     return sympy.Add(*terms)
 
 

@@ -23,6 +23,8 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.sparse_numeric import independent_rows_one_pass
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, sparse_surface_points
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
@@ -39,6 +41,8 @@ REGULAR_TOLERANCE = 1e-6
 #: however independent the row-normalised gradients look there (at a converged point next
 #: to such a locus the gradient is of the order of the square root of the residual, ~1e-6)
 SINGULAR_GRADIENT = 1e-4
+#: rows (candidates and base together) from which independence is decided in one pass
+LARGE_ROWS = 64
 
 
 class SingularSurface(AnalysisError):
@@ -92,7 +96,15 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
     -------
     list of int
         Chosen row indices; a row is kept when it raises the rank at a majority of points.
+
+    Large matrices (rows from ``LARGE_ROWS`` or columns from ``LARGE_SYSTEM``) are decided
+    in one orthogonalisation pass per point
+    (:func:`~dirac.analysis.core.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
     """
+    if len(matrices) and matrices[0].ndim == 2 and (
+        len(order) + (len(base[0]) if base is not None else 0) >= LARGE_ROWS or matrices[0].shape[1] >= LARGE_SYSTEM
+    ):
+        return independent_rows_one_pass(matrices, order, base)
     chosen: list[int] = []
     for row in order:
         votes = 0
@@ -147,10 +159,13 @@ class Numerics:
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
         """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""
-        exprs = [sympy.sympify(e) for e in exprs]
-        self._compile(exprs)
+        zero = sympy.S.Zero  # most entries of a large gradient or bracket matrix: no conversion
+        exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        self._compile([e for e in exprs if e is not zero])
         # (batch, index in it) of a compiled expression, (None, value) of a number
-        plan: list[tuple[int | None, Any]] = [(self._index[e] if not e.is_number else (None, float(e))) for e in exprs]
+        plan: list[tuple[int | None, Any]] = [
+            (None, 0.0) if e is zero else (self._index[e] if not e.is_number else (None, float(e))) for e in exprs
+        ]
         batches = sorted({b for b, _ in plan if b is not None})
 
         def fn(z: np.ndarray) -> np.ndarray:
@@ -290,6 +305,14 @@ class Numerics:
             If no point is found: the surface may be empty (no real solution), or it has
             no regular point (its constraints are irregular).
         """
+        if len(self.phase_space.variables) >= LARGE_SYSTEM:  # sparse Jacobian, same rules and errors
+            found, dropped = sparse_surface_points(
+                self, constraints, count, fixed, attempts, start, regular, SURFACE_TOLERANCE, REGULAR_TOLERANCE,
+                SINGULAR_GRADIENT,
+            )
+            if len(found) < count:
+                raise _no_surface_point([sympy.sympify(c) for c in constraints], dropped)
+            return found
         constraints = [sympy.sympify(c) for c in constraints]
         residual = self.function(constraints)
         grads = [self.phase_space.gradient(c) for c in constraints]
@@ -337,16 +360,22 @@ class Numerics:
             if ok:
                 points.append(z)
         if len(points) < count:
-            names = "; ".join(str(c) for c in constraints[:6])
-            if singular:
-                raise SingularSurface(
-                    f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
-                    f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
-                    "(irregular constraints); write the surface with constraints whose gradients are independent on it"
-                )
-            raise AnalysisError(
-                f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
-                "after many random starts: the constraints may have no real solution for these parameters"
-            )
+            raise _no_surface_point(constraints, singular)
         return points
+
+
+def _no_surface_point(constraints: list[sympy.Expr], singular: int) -> AnalysisError:
+    """The error when too few points were found: none regular among ``singular`` found, or none at all."""
+    m = len(constraints)
+    names = "; ".join(str(c) for c in constraints[:6])
+    if singular:
+        return SingularSurface(
+            f"the constraint surface ({names}{' ...' if m > 6 else ''}) has no regular point among "
+            f"{singular} points found: the gradients of its constraints are dependent wherever they hold "
+            "(irregular constraints); write the surface with constraints whose gradients are independent on it"
+        )
+    return AnalysisError(
+        f"could not find points on the constraint surface ({names}{' ...' if m > 6 else ''}) "
+        "after many random starts: the constraints may have no real solution for these parameters"
+    )
 

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import sympy
 
+from dirac.analysis.core.fast_partials import PolynomialPartials
+
 __all__ = ["PhaseSpace", "derivative"]
 
 
@@ -112,6 +114,7 @@ class PhaseSpace:
     momenta: tuple[sympy.Symbol, ...]
     parameters: tuple[sympy.Symbol, ...] = ()
     _gradients: dict[sympy.Expr, tuple[dict, dict]] = field(default_factory=dict, repr=False)
+    _polynomials: PolynomialPartials | None = field(default=None, repr=False)
 
     @property
     def variables(self) -> tuple[sympy.Symbol, ...]:
@@ -132,12 +135,23 @@ class PhaseSpace:
         """Non-zero partial derivatives of ``expr``: ``({q_i: df/dq_i}, {q_i: df/dp_i})``.
 
         Both dictionaries are keyed by the coordinate, so the bracket pairs them up.
-        Results are cached (constraints are differentiated many times).
+        Results are cached (constraints are differentiated many times). Polynomials in
+        the variables are differentiated in the sparse polynomial ring
+        (:mod:`dirac.analysis.core.fast_partials`, the same derivatives, expanded), other
+        expressions by ``sympy.diff``.
         """
         expr = sympy.sympify(expr)
         cached = self._gradients.get(expr)
         if cached is not None:
             return cached
+        if self._polynomials is None:
+            self._polynomials = PolynomialPartials(self.variables, self.parameters)
+        found = self._polynomials.partials(expr, self.variables)
+        if found is not None:
+            pairs = list(zip(self.coordinates, self.momenta))
+            fast = ({q: found[q] for q, _ in pairs if q in found}, {q: found[p] for q, p in pairs if p in found})
+            self._gradients[expr] = fast
+            return fast
         free = _free_symbols_memo(expr)
         dq: dict = {}
         dp: dict = {}

@@ -40,6 +40,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.fast_partials import quadratic_parts
 from dirac.analysis.core.numeric import Numerics, independent_rows
 from dirac.analysis.core.phase_space import PhaseSpace, derivative
 from dirac.analysis.legendre.first_order import FIRST_ORDER_METHOD, first_order_primary
@@ -87,7 +88,16 @@ class NotQuadraticError(AnalysisError):
 
 
 def _quadratic_parts(lagrangian: Lagrangian) -> tuple[sympy.Matrix, list[sympy.Expr], sympy.Expr]:
-    """``W``, ``a`` and ``V`` of a Lagrangian quadratic in the velocities (else NotQuadraticError)."""
+    """``W``, ``a`` and ``V`` of a Lagrangian quadratic in the velocities (else NotQuadraticError).
+
+    A polynomial ``L`` is split in the sparse polynomial ring
+    (:func:`dirac.analysis.core.fast_partials.quadratic_parts`: only the non-zero entries of
+    ``W``); other Lagrangians with ``sympy.diff``.
+    """
+    extra = (lagrangian.time,) if lagrangian.is_time_dependent else ()
+    fast = quadratic_parts(lagrangian.expression, lagrangian.coordinates, lagrangian.velocities, (*lagrangian.parameters, *extra))
+    if fast is not None:
+        return fast
     v = lagrangian.velocities
     L = lagrangian.expression
     first = [derivative(L, vi) for vi in v]  # sympy.diff's expressions, each shared sub-tree once
@@ -179,13 +189,19 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     # numerical rank and pivots of W at generic configurations
     time = [lagrangian.time] if lagrangian.is_time_dependent else []  # sampled with q
     args = (*q, *time, *lagrangian.parameters)
-    w_fn = array_function(args, W, cse=False)
+    entries = [(i, j) for i in range(n) for j in range(n) if W[i, j] != 0]  # compiled: the non-zero entries only
+    w_fn = array_function(args, [W[i, j] for i, j in entries], cse=False) if entries else None
+    rows_w = np.array([i for i, _ in entries], dtype=int)
+    cols_w = np.array([j for _, j in entries], dtype=int)
     pvals = [float(parameter_values[s]) for s in lagrangian.parameters]
     samples = []
     for _ in range(3):
         z = rng.uniform(0.5, 1.5, n + len(time)) * rng.choice([-1.0, 1.0], n + len(time))
-        with np.errstate(all="ignore"):
-            samples.append(np.array(w_fn(*z, *pvals), dtype=float).reshape(n, n))
+        sample = np.zeros((n, n))
+        if w_fn is not None:
+            with np.errstate(all="ignore"):
+                sample[rows_w, cols_w] = np.array(w_fn(*z, *pvals), dtype=float).reshape(-1)
+        samples.append(sample)
     pivots = independent_rows(samples, list(range(n)))
     rank = len(pivots)
     others = [j for j in range(n) if j not in pivots]
@@ -195,9 +211,13 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     tidy_hamiltonian = True  # expand H_c over one denominator (not when that only grows it)
     method = "regular Hessian" if rank == n else ""
     if rank == n:
-        W_inv = _inverse(W)
-        H_c = (shifted.T * W_inv * shifted)[0, 0] / 2 + potential
-        velocity = W_inv * shifted
+        if W.is_diagonal():  # O(n), not the O(n^2) products of dense n x n matrices
+            velocity = sympy.Matrix([shifted[i] / W[i, i] for i in range(n)])
+            H_c = sympy.Add(*[shifted[i] ** 2 / (2 * W[i, i]) for i in range(n)]) + potential
+        else:
+            W_inv = _inverse(W)
+            H_c = (shifted.T * W_inv * shifted)[0, 0] / 2 + potential
+            velocity = W_inv * shifted
     elif rank == 0:
         primary.extend(first_order_primary(shifted, space.variables))
         H_c = potential
@@ -264,13 +284,13 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
                     "combinations l = A q_dot, so null(W) = null(A) (no inverse of W needed)"
                 )
         if not used_forms and W[S, S].is_diagonal():
-            W_SS = W[S, S]
-            W_inv = _inverse(W_SS)
-            p_S = sympy.Matrix([shifted[s] for s in S])
+            # W_SS diagonal: phi_j = (p - a)_j - sum_s W_js (p - a)_s / W_ss, H_c = sum_s (p - a)_s^2 / (2 W_ss)
+            # (only the non-zero W_js enter: O(non-zeros), not O(n^2) matrix products)
+            diagonal = [W[s, s] for s in S]
             for j in others:
-                coeff = W[j, S] * W_inv
-                primary.append(shifted[j] - (coeff * p_S)[0, 0])
-            H_c = (p_S.T * W_inv * p_S)[0, 0] / 2 + potential
+                terms = [W[j, s] * shifted[s] / w for s, w in zip(S, diagonal) if W[j, s] != 0]
+                primary.append(shifted[j] - sympy.Add(*terms))
+            H_c = sympy.Add(*[shifted[s] ** 2 / (2 * w) for s, w in zip(S, diagonal)]) + potential
             velocity = None
             method = f"singular Hessian of rank {rank}: null space from an invertible diagonal {rank}x{rank} block of W"
             used_forms = True
