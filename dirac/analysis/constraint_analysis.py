@@ -30,6 +30,7 @@ from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
 
 if TYPE_CHECKING:  # imported where used: most analyses never ask for them (start-up time of the CLI)
+    from dirac.analysis.cases import ParameterCase
     from dirac.analysis.brackets.vector_field import VectorField
     from dirac.analysis.gauge.generators import GaugeGenerator, GaugeStructure
 
@@ -197,10 +198,26 @@ class ConstraintAnalysis:
         self.gauge_conditions: tuple[str, ...] = ()
         self._gauge: GaugeStructure | None = None
         self.special_parameter_values: list[SpecialValue] = []
+        self._cases: list[ParameterCase] | None = None
+        self._generic_analysis: ConstraintAnalysis | None = None
         if self.parameters:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
             self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
+
+    # ------------------------------------------------------------------ cases
+    def parameter_cases(self, progress: Callable[[str], None] | None = None) -> list[ParameterCase]:
+        """The generic case and every special parameter case below it (:mod:`dirac.analysis.cases`).
+
+        Computed from the analysis with the parameters symbolic (also when this analysis
+        is at given special values); cached after the first call.
+        """
+        if self._cases is None:
+            from dirac.analysis.cases import parameter_cases
+
+            base = self._generic_analysis if self._generic_analysis is not None else self
+            self._cases = parameter_cases(base, progress=progress)
+        return self._cases
 
     # ------------------------------------------------------------------ gauge
     @property
@@ -551,5 +568,6 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
     )
     at.notes.append(message)
     at.special_parameter_values = analysis.special_parameter_values
+    at._generic_analysis = analysis
     warn(message)
     return at
