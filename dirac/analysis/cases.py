@@ -28,10 +28,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import sympy
 
-from dirac.analysis.constraint_analysis import ConstraintAnalysis
 from dirac.errors import DiracError
 from dirac.model.lagrangian import Lagrangian
 
@@ -60,7 +60,7 @@ class ParameterCase:
 
     condition: str
     depth: int
-    analysis: ConstraintAnalysis | None
+    analysis: Any
     error: str | None = None
 
     def to_json(self) -> dict:
@@ -105,7 +105,7 @@ def _substitute(lagrangian: Lagrangian, parameter: sympy.Symbol, value: sympy.Ex
     )
 
 
-def _content_zeros(analysis: ConstraintAnalysis) -> list[tuple[sympy.Symbol, sympy.Expr, str]]:
+def _content_zeros(analysis: Any) -> list[tuple[sympy.Symbol, sympy.Expr, str]]:
     """``(parameter, value, equation)`` where a constraint's parameter-only factor vanishes.
 
     The content of a constraint ``c`` is the gcd of its coefficients as a polynomial in the
@@ -141,13 +141,13 @@ def _content_zeros(analysis: ConstraintAnalysis) -> list[tuple[sympy.Symbol, sym
     return out
 
 
-def _structure(analysis: ConstraintAnalysis) -> tuple:
+def _structure(analysis: Any) -> tuple:
     """Stage sizes and class counts: two analyses with the same structure are one case."""
     return (tuple(len(s) for s in analysis.stages), len(analysis.first_class), len(analysis.second_class))
 
 
 def parameter_cases(
-    analysis: ConstraintAnalysis, progress: Callable[[str], None] | None = None, max_depth: int = MAX_CASE_DEPTH
+    analysis: Any, progress: Callable[[str], None] | None = None, max_depth: int = MAX_CASE_DEPTH
 ) -> list[ParameterCase]:
     """The generic case and every special parameter case below it, depth first (generic first).
 
@@ -168,13 +168,14 @@ def parameter_cases(
         condition of a case names the substitutions that lead to it and excludes the
         special sets below it (``"b = a**2, a != 0"``).
     """
+    analysis = getattr(analysis, "_generic_analysis", None) or analysis  # the analysis with the parameters symbolic
     cases: list[ParameterCase] = []
     seen: set[tuple] = set()
 
     def key(lagrangian: Lagrangian) -> tuple:
         return (sympy.srepr(sympy.expand(lagrangian.expression)), tuple(sympy.srepr(sympy.expand(c)) for c in lagrangian.constraints))
 
-    def children(node: ConstraintAnalysis) -> list[tuple[sympy.Symbol, sympy.Expr, str, str]]:
+    def children(node: Any) -> list[tuple[sympy.Symbol, sympy.Expr, str, str]]:
         """(parameter, value, equation, its negation) of every candidate below ``node``."""
         symbols = {p.name: p for p in node.parameters}
         found = []
@@ -188,7 +189,7 @@ def parameter_cases(
                 found.append((p, value, equation, equation.replace(" = ", " != ", 1)))
         return found
 
-    def visit(lagrangian: Lagrangian, node: ConstraintAnalysis | None, error: str | None, path: list[str], depth: int) -> None:
+    def visit(lagrangian: Lagrangian, node: Any, error: str | None, path: list[str], depth: int) -> None:
         index = len(cases)
         case = ParameterCase("", depth, node, error)
         cases.append(case)
@@ -200,7 +201,7 @@ def parameter_cases(
                     continue
                 seen.add(key(child))
                 try:
-                    sub: ConstraintAnalysis | None = ConstraintAnalysis(child)
+                    sub: Any = type(analysis)(child)
                     why = None
                 except DiracError as exc:
                     sub, why = None, str(exc)

@@ -8,6 +8,7 @@ paper's (1); Sect. X for the rigid body (78), Sect. XI for (228)).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
@@ -16,6 +17,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.brackets.dirac_bracket import DiracBracket
+from dirac.analysis.chain.assumptions import parse_assumptions
 from dirac.analysis.chain.constraint_chain import ConstraintChain
 from dirac.analysis.chain.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
 from dirac.analysis.classes.classification import bracket_matrix, classify
@@ -30,7 +32,6 @@ from dirac.errors import AnalysisError, InputError, warn
 from dirac.model.lagrangian import Lagrangian
 
 if TYPE_CHECKING:  # imported where used: most analyses never ask for them (start-up time of the CLI)
-    from dirac.analysis.cases import ParameterCase
     from dirac.analysis.brackets.vector_field import VectorField
     from dirac.analysis.gauge.generators import GaugeGenerator, GaugeStructure
 
@@ -98,7 +99,11 @@ class ConstraintAnalysis:
     """
 
     def __init__(
-        self, lagrangian: Lagrangian, seed: int = 20240607, progress: Callable[[str], None] | None = None
+        self,
+        lagrangian: Lagrangian,
+        seed: int = 20240607,
+        progress: Callable[[str], None] | None = None,
+        assume: Sequence[str] = (),
     ) -> None:
         start = time.perf_counter()
         clock = [start]
@@ -110,6 +115,15 @@ class ConstraintAnalysis:
                 progress(f"{message} ({now - clock[0]:.2f} s)")
                 clock[0] = now
 
+        nonzero_text = [str(a) for a in assume if "!=" in str(a)]
+        equalities = parse_assumptions(
+            [str(a) for a in assume if "!=" not in str(a)], {**lagrangian.symbols, **{c.name: c for c in lagrangian.coordinates}}
+        )
+        if any(e.expression.free_symbols & set(lagrangian.velocities) for e in equalities):
+            raise InputError("an assumption EXPR = 0 is added as a holonomic constraint: EXPR may use coordinates and parameters, not velocities")
+        if equalities:
+            lagrangian = dataclasses.replace(lagrangian, constraints=(*lagrangian.constraints, *(e.expression for e in equalities)))
+        self.assumptions = tuple(str(a) for a in assume)
         lagrangian, regularised = regular_holonomic(lagrangian)
         self.lagrangian = lagrangian
         self.name = lagrangian.name
@@ -132,6 +146,8 @@ class ConstraintAnalysis:
         self.primary_multipliers = tuple(sympy.Symbol(f"u_{k + 1}", real=True) for k in range(K))
         self.time = lagrangian.time if lagrangian.is_time_dependent else None
         self._numerics = Numerics(space, self._generic, seed=seed, time=self.time)
+        nonzero = parse_assumptions(nonzero_text, {**space.symbols, **{p.name: p for p in lagrangian.parameters}})
+        self._numerics.avoid = [a.expression for a in nonzero]
         chain = ConstraintChain(
             space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
         )
@@ -188,6 +204,8 @@ class ConstraintAnalysis:
             + (" (symbolic parameters at generic random values)" if self.parameters else ""),
             *regularised,
             *chain.regularity_notes,
+            *(f"assumed {a}: every point of the surface where ranks were decided is away from {a.expression} = 0" for a in nonzero),
+            *(f"assumed {e}: added as the holonomic constraint {e.expression} = 0" for e in equalities),
         ]
         if self.time is not None:
             self.notes.append(
@@ -198,26 +216,15 @@ class ConstraintAnalysis:
         self.gauge_conditions: tuple[str, ...] = ()
         self._gauge: GaugeStructure | None = None
         self.special_parameter_values: list[SpecialValue] = []
-        self._cases: list[ParameterCase] | None = None
+        #: the parameter case tree (:mod:`dirac.analysis.cases`) when asked for: ``dirac.analyze(system, cases=True)``
+        self.parameter_cases: list | None = None
+        #: the parts of a surface with parts of different structure (:class:`dirac.analysis.components.Component`), else empty
+        self.components: list = []
         self._generic_analysis: ConstraintAnalysis | None = None
         if self.parameters:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
             self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
-
-    # ------------------------------------------------------------------ cases
-    def parameter_cases(self, progress: Callable[[str], None] | None = None) -> list[ParameterCase]:
-        """The generic case and every special parameter case below it (:mod:`dirac.analysis.cases`).
-
-        Computed from the analysis with the parameters symbolic (also when this analysis
-        is at given special values); cached after the first call.
-        """
-        if self._cases is None:
-            from dirac.analysis.cases import parameter_cases
-
-            base = self._generic_analysis if self._generic_analysis is not None else self
-            self._cases = parameter_cases(base, progress=progress)
-        return self._cases
 
     # ------------------------------------------------------------------ gauge
     @property
@@ -459,12 +466,25 @@ class ConstraintAnalysis:
 
     # ------------------------------------------------------------------ reports
     def to_json(self) -> dict:
-        """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys)."""
-        return to_json(self)
+        """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys).
+
+        With parts of different structure, ``"components"`` lists each (:mod:`dirac.analysis.components`);
+        with assumptions, ``"assumptions"`` lists them.
+        """
+        data = to_json(self)
+        if self.assumptions:
+            data["assumptions"] = list(self.assumptions)
+        if self.components:
+            data["components"] = [c.to_json() for c in self.components]
+        return data
 
     def to_text(self) -> str:
-        """The chain stage by stage, classes, multipliers, counts: readable text."""
-        return to_text(self)
+        """The chain stage by stage, classes, multipliers, counts: readable text (and each part, with components)."""
+        text = to_text(self)
+        if self.components:
+            text += "\n\ncomponents of the constraint surface:"
+            text += "".join(f"\n  - {c.condition}: {c.summary()}" for c in self.components)
+        return text
 
     def to_latex(self) -> str:
         """The analysis as a LaTeX fragment (align environments)."""
@@ -481,7 +501,9 @@ class ConstraintAnalysis:
         )
 
 
-def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
+def analyze(
+    lagrangian: Lagrangian, progress: Callable[[str], None] | None = None, assume: Sequence[str] = ()
+) -> ConstraintAnalysis:
     """Run the Dirac–Bergmann algorithm on ``lagrangian``.
 
     Parameters
@@ -493,6 +515,11 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
         Called with one line as each stage of the algorithm finishes (the Legendre
         transform, the constraint chain, the classification, the Dirac bracket), each
         with its seconds; ``None`` (the default) reports nothing.
+    assume
+        Assumptions that pick a part of the phase space: ``"EXPR != 0"`` keeps every point
+        where a rank is decided away from ``EXPR = 0``; ``"EXPR = 0"`` adds ``EXPR`` (a
+        function of the coordinates) as a holonomic constraint
+        (:mod:`dirac.analysis.chain.assumptions`).
 
     Returns
     -------
@@ -522,7 +549,9 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     """
     if not isinstance(lagrangian, Lagrangian):
         raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
-    return at_given_values(ConstraintAnalysis(lagrangian, progress=progress), progress)
+    if isinstance(assume, str):
+        assume = [assume]
+    return at_given_values(ConstraintAnalysis(lagrangian, progress=progress, assume=assume), progress)
 
 
 def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
@@ -543,7 +572,7 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
     names |= {sym.name for h in hits if h.factor is not None for sym in h.factor.free_symbols}
     given = {n: v for n in sorted(names) if (v := values.get(n)) is not None}
     fixed = analysis.lagrangian.fix(**given)
-    at = ConstraintAnalysis(fixed, progress=progress)
+    at = ConstraintAnalysis(fixed, progress=progress, assume=analysis.assumptions)
     shown = ", ".join(f"{h.parameter} = {h.value}" for h in hits if not h.is_curve)
     curves = "; ".join(h.equation for h in hits if h.is_curve)
     if curves:  # name the values given and the curve they lie on

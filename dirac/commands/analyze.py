@@ -43,6 +43,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "analyse the gauge-fixed system: Dirac bracket in that gauge, first-class constraints left",
     )
     parser.add_argument(
+        "--assume",
+        action="append",
+        default=[],
+        metavar="CONDITION",
+        help='analyse the part of the phase space where CONDITION holds (repeatable): "EXPR != 0" keeps the points '
+        'where ranks are decided away from EXPR = 0, "EXPR = 0" adds EXPR (a function of the coordinates) as a '
+        'holonomic constraint; e.g. --assume "am1**2 + am2**2 + am3**2 != 0"',
+    )
+    parser.add_argument(
         "--cases",
         action="store_true",
         help="also analyse every special parameter set (and special sets of those): the case tree, generic case first "
@@ -116,7 +125,7 @@ def _at_special(system: str, params: dict[str, float], report: Callable[[str], N
 
 
 def main(args: argparse.Namespace) -> int:
-    from dirac.analysis.constraint_analysis import analyze
+    from dirac.analysis.components import analyze
     from dirac.model.systems import load_system
 
     if getattr(args, "cases", False) and args.latex:
@@ -126,9 +135,9 @@ def main(args: argparse.Namespace) -> int:
     params = parse_params(args.param)
     lagrangian = load_system(args.system, **params)
     report = stage_printer(getattr(args, "verbosity", 0))
-    analysis = _at_special(args.system, params, report) if params else None
+    analysis = _at_special(args.system, params, report) if params and not args.assume else None
     if analysis is None:
-        analysis = analyze(lagrangian, progress=report)
+        analysis = analyze(lagrangian, progress=report, assume=args.assume)
     if args.gauge:
         analysis = analysis.fix_gauge(args.gauge)
         if report is not None:
@@ -140,7 +149,9 @@ def main(args: argparse.Namespace) -> int:
         return 0
     cases = None
     if getattr(args, "cases", False):
-        cases = analysis.parameter_cases(progress=report)
+        from dirac.analysis.cases import parameter_cases
+
+        cases = parameter_cases(analysis, progress=report)
     if args.json:
         data = analysis.to_json()
         if cases is not None:
