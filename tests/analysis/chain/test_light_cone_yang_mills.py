@@ -97,3 +97,12 @@ def test_published_counts(light_cone):
     assert (len(light_cone.first_class), len(light_cone.second_class)) == (8, 4)
     assert len(light_cone.multiplier_solution.null_vectors) == 9 - 4
     assert light_cone.physical_degrees_of_freedom == 2
+
+
+def test_the_part_a_minus_zero_is_refused_not_a_traceback():
+    """Guards the check in ``general_multiplier_solution`` that the consistency rows independent
+    on the surface have as many independent multiplier columns: with ``A_- = 0`` imposed as
+    holonomic constraints they did not (ranks that differ between parts), and reshaping the
+    numeric block raised a ``ValueError``. It is an ``AnalysisError`` naming the mismatch now."""
+    with pytest.raises(AnalysisError, match="independent multiplier columns"):
+        dirac.analyze(light_cone_lagrangian(), assume=["am1 = 0", "am2 = 0", "am3 = 0"])
