@@ -11,7 +11,10 @@ accepted, at its sample points of the constraint surface (Henneaux & Teitelboim,
   ``v_a = 0``, and also with each null vector added), keeps the motion on the surface:
   ``{Phi_a, H'} + d_t Phi_a ~ 0``;
 * the Dirac bracket kills the second-class constraints: ``{Phi_a, z}_D ~ 0`` for every
-  phase-space variable ``z``.
+  phase-space variable ``z``;
+* the Dirac bracket satisfies the Jacobi identity on the first three phase-space variables
+  (for systems without first-class constraints and at most 4 second-class ones, whose
+  exact brackets are simplified modulo second-class constraints only).
 
 "~ 0" is ``|value| <= 1e-7 (1 + sum of |terms|)`` at the point: a value that is not
 round-off of the terms that cancelled is a violation.
@@ -86,6 +89,15 @@ def check_invariants(analysis) -> list[str]:
                     value = analysis.dirac_bracket(a, var, at=at)
                     if abs(value) > 1e-6 * (1.0 + max(abs(x) for x in z)):
                         problems.append(f"{{{a}, {var}}}_D = {value} at a surface point, not 0")
+    if second and not analysis.first_class and len(second) <= 4 and time is None and len(space.variables) >= 3:
+        # Jacobi identity of the Dirac bracket on three phase-space variables. Without first-class
+        # constraints the exact brackets are simplified modulo second-class constraints only, which
+        # the Dirac bracket kills, so the nested brackets are weakly those of the unsimplified ones.
+        x, y, z = space.variables[:3]
+        db = analysis.dirac_bracket
+        jacobi = db(x, db(y, z)) + db(y, db(z, x)) + db(z, db(x, y))
+        for bad in _weakly_zero(analysis, [jacobi], points):
+            problems.append(f"the Dirac bracket violates the Jacobi identity on {x}, {y}, {z}: {bad}")
     return problems
 
 
