@@ -55,7 +55,7 @@ _LAZY: dict[str, str] = {
     "Lagrangian": "dirac.model.lagrangian",
     "load_system": "dirac.model.systems",
     "builtin_systems": "dirac.model.systems",
-    "analyze": "dirac.analysis.constraint_analysis",
+    "analyze": "dirac.analysis.components",
     "integrate": "dirac.flows.integration",
     "RigidBodyProblem": "dirac.flows.problems",
     "HeavyTopProblem": "dirac.flows.problems",

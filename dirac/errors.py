@@ -45,6 +45,38 @@ class AnalysisError(DiracError):
     constraints of a Lagrangian that is not quadratic in the velocities)."""
 
 
+class SeparableParts(AnalysisError):
+    """The constraint surface has parts of different structure that can be told apart.
+
+    Attributes
+    ----------
+    holonomic
+        For a holonomic constraint that is a union of crossing branches: its index (1-based)
+        in the system's constraints, with ``branches`` its factors; else ``None``.
+    branches
+        The factors of that constraint (sympy expressions).
+    points, ranks, variables
+        For a rank that differs between points of the surface: the points (arrays over the
+        phase-space ``variables``, by name) and the rank at each.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        holonomic: int | None = None,
+        branches: list | None = None,
+        points: list | None = None,
+        ranks: list[int] | None = None,
+        variables: list | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.holonomic = holonomic
+        self.branches = list(branches or [])
+        self.points = list(points or [])
+        self.ranks = list(ranks or [])
+        self.variables = list(variables or [])
+
+
 class IntegrationError(DiracError):
     """A numerical integration had to stop (non-finite state, Newton non-convergence,
     constraint drift). ``partial`` holds what was computed up to that point, if any."""

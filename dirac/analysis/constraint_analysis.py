@@ -8,6 +8,7 @@ paper's (1); Sect. X for the rigid body (78), Sect. XI for (228)).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
@@ -16,6 +17,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.brackets.dirac_bracket import DiracBracket
+from dirac.analysis.chain.assumptions import parse_assumptions
 from dirac.analysis.chain.constraint_chain import ConstraintChain
 from dirac.analysis.chain.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
 from dirac.analysis.classes.classification import bracket_matrix, classify
@@ -125,7 +127,11 @@ class ConstraintAnalysis:
     """
 
     def __init__(
-        self, lagrangian: Lagrangian, seed: int = 20240607, progress: Callable[[str], None] | None = None
+        self,
+        lagrangian: Lagrangian,
+        seed: int = 20240607,
+        progress: Callable[[str], None] | None = None,
+        assume: Sequence[str] = (),
     ) -> None:
         start = time.perf_counter()
         clock = [start]
@@ -137,6 +143,15 @@ class ConstraintAnalysis:
                 progress(f"{message} ({now - clock[0]:.2f} s)")
                 clock[0] = now
 
+        nonzero_text = [str(a) for a in assume if "!=" in str(a)]
+        equalities = parse_assumptions(
+            [str(a) for a in assume if "!=" not in str(a)], {**lagrangian.symbols, **{c.name: c for c in lagrangian.coordinates}}
+        )
+        if any(e.expression.free_symbols & set(lagrangian.velocities) for e in equalities):
+            raise InputError("an assumption EXPR = 0 is added as a holonomic constraint: EXPR may use coordinates and parameters, not velocities")
+        if equalities:
+            lagrangian = dataclasses.replace(lagrangian, constraints=(*lagrangian.constraints, *(e.expression for e in equalities)))
+        self.assumptions = tuple(str(a) for a in assume)
         lagrangian, regularised = regular_holonomic(lagrangian)
         self.lagrangian = lagrangian
         self.name = lagrangian.name
@@ -161,6 +176,8 @@ class ConstraintAnalysis:
         forced_in_time = lagrangian.time is not None and any(lagrangian.time in e.free_symbols for e in self.forces.values())
         self.time = lagrangian.time if (lagrangian.is_time_dependent or forced_in_time) else None
         self._numerics = Numerics(space, self._generic, seed=seed, time=self.time)
+        nonzero = parse_assumptions(nonzero_text, {**space.symbols, **{p.name: p for p in lagrangian.parameters}})
+        self._numerics.avoid = [a.expression for a in nonzero]
         chain = ConstraintChain(
             space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
         )
@@ -218,6 +235,8 @@ class ConstraintAnalysis:
             + (" (symbolic parameters at generic random values)" if self.parameters else ""),
             *regularised,
             *chain.regularity_notes,
+            *(f"assumed {a}: every point of the surface where ranks were decided is away from {a.expression} = 0" for a in nonzero),
+            *(f"assumed {e}: added as the holonomic constraint {e.expression} = 0" for e in equalities),
         ]
         if self.forces:
             self.notes.append(
@@ -242,6 +261,11 @@ class ConstraintAnalysis:
         self.gauge_conditions: tuple[str, ...] = ()
         self._gauge: GaugeStructure | None = None
         self.special_parameter_values: list[SpecialValue] = []
+        #: the parameter case tree (:mod:`dirac.analysis.cases`) when asked for: ``dirac.analyze(system, cases=True)``
+        self.parameter_cases: list | None = None
+        #: the parts of a surface with parts of different structure (:class:`dirac.analysis.components.Component`), else empty
+        self.components: list = []
+        self._generic_analysis: ConstraintAnalysis | None = None
         if self.parameters:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
             self.notes.extend(searched)
@@ -526,12 +550,25 @@ class ConstraintAnalysis:
 
     # ------------------------------------------------------------------ reports
     def to_json(self) -> dict:
-        """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys)."""
-        return to_json(self)
+        """The ``dirac analyze --json`` object of docs/file_formats.md (plus extra keys).
+
+        With parts of different structure, ``"components"`` lists each (:mod:`dirac.analysis.components`);
+        with assumptions, ``"assumptions"`` lists them.
+        """
+        data = to_json(self)
+        if self.assumptions:
+            data["assumptions"] = list(self.assumptions)
+        if self.components:
+            data["components"] = [c.to_json() for c in self.components]
+        return data
 
     def to_text(self) -> str:
-        """The chain stage by stage, classes, multipliers, counts: readable text."""
-        return to_text(self)
+        """The chain stage by stage, classes, multipliers, counts: readable text (and each part, with components)."""
+        text = to_text(self)
+        if self.components:
+            text += "\n\ncomponents of the constraint surface:"
+            text += "".join(f"\n  - {c.condition}: {c.summary()}" for c in self.components)
+        return text
 
     def to_latex(self) -> str:
         """The analysis as a LaTeX fragment (align environments)."""
@@ -553,7 +590,9 @@ def _count(number: int, noun: str) -> str:
     return f"{number} {noun}{'' if number == 1 else 's'}"
 
 
-def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
+def analyze(
+    lagrangian: Lagrangian, progress: Callable[[str], None] | None = None, assume: Sequence[str] = ()
+) -> ConstraintAnalysis:
     """Run the Dirac–Bergmann algorithm on ``lagrangian``.
 
     Parameters
@@ -565,6 +604,11 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
         Called with one line as each stage of the algorithm finishes (the Legendre
         transform, the constraint chain, the classification, the Dirac bracket), each
         with its seconds; ``None`` (the default) reports nothing.
+    assume
+        Assumptions that pick a part of the phase space: ``"EXPR != 0"`` keeps every point
+        where a rank is decided away from ``EXPR = 0``; ``"EXPR = 0"`` adds ``EXPR`` (a
+        function of the coordinates) as a holonomic constraint
+        (:mod:`dirac.analysis.chain.assumptions`).
 
     Returns
     -------
@@ -594,8 +638,10 @@ def analyze(lagrangian: Lagrangian, progress: Callable[[str], None] | None = Non
     """
     if not isinstance(lagrangian, Lagrangian):
         raise InputError(f"analyze() needs a dirac.Lagrangian, not {type(lagrangian).__name__}")
+    if isinstance(assume, str):
+        assume = [assume]
     with one_blas_thread():  # small dense matrices: threads only wait (dirac.analysis.core.blas_threads)
-        return at_given_values(ConstraintAnalysis(lagrangian, progress=progress), progress)
+        return at_given_values(ConstraintAnalysis(lagrangian, progress=progress, assume=assume), progress)
 
 
 def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None] | None = None) -> ConstraintAnalysis:
@@ -616,7 +662,7 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
     names |= {sym.name for h in hits if h.factor is not None for sym in h.factor.free_symbols}
     given = {n: v for n in sorted(names) if (v := values.get(n)) is not None}
     fixed = analysis.lagrangian.fix(**given)
-    at = ConstraintAnalysis(fixed, progress=progress)
+    at = ConstraintAnalysis(fixed, progress=progress, assume=analysis.assumptions)
     shown = ", ".join(f"{h.parameter} = {h.value}" for h in hits if not h.is_curve)
     curves = "; ".join(h.equation for h in hits if h.is_curve)
     if curves:  # name the values given and the curve they lie on
@@ -641,5 +687,6 @@ def at_given_values(analysis: ConstraintAnalysis, progress: Callable[[str], None
     )
     at.notes.append(message)
     at.special_parameter_values = analysis.special_parameter_values
+    at._generic_analysis = analysis
     warn(message)
     return at

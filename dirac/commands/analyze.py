@@ -42,6 +42,21 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "the time t unless t is a coordinate) and "
         "analyse the gauge-fixed system: Dirac bracket in that gauge, first-class constraints left",
     )
+    parser.add_argument(
+        "--assume",
+        action="append",
+        default=[],
+        metavar="CONDITION",
+        help='analyse the part of the phase space where CONDITION holds (repeatable): "EXPR != 0" keeps the points '
+        'where ranks are decided away from EXPR = 0, "EXPR = 0" adds EXPR (a function of the coordinates) as a '
+        'holonomic constraint; e.g. --assume "am1**2 + am2**2 + am3**2 != 0"',
+    )
+    parser.add_argument(
+        "--cases",
+        action="store_true",
+        help="also analyse every special parameter set (and special sets of those): the case tree, generic case first "
+        "(JSON key parameter_cases)",
+    )
     output = parser.add_mutually_exclusive_group()
     output.add_argument("--json", action="store_true", help="print one JSON object (stages, classes, multipliers, degrees of freedom)")
     output.add_argument("--latex", action="store_true", help="print the analysis as LaTeX")
@@ -110,15 +125,19 @@ def _at_special(system: str, params: dict[str, float], report: Callable[[str], N
 
 
 def main(args: argparse.Namespace) -> int:
-    from dirac.analysis.constraint_analysis import analyze
+    from dirac.analysis.components import analyze
     from dirac.model.systems import load_system
 
+    if getattr(args, "cases", False) and args.latex:
+        raise InputError("--cases works with the text and the --json output, not with --latex: drop one of them")
+    if getattr(args, "cases", False) and args.gauge:
+        raise InputError("--cases analyses the system without gauge conditions: drop --gauge or --cases")
     params = parse_params(args.param)
     lagrangian = load_system(args.system, **params)
     report = stage_printer(getattr(args, "verbosity", 0))
-    analysis = _at_special(args.system, params, report) if params else None
+    analysis = _at_special(args.system, params, report) if params and not args.assume else None
     if analysis is None:
-        analysis = analyze(lagrangian, progress=report)
+        analysis = analyze(lagrangian, progress=report, assume=args.assume)
     if args.gauge:
         analysis = analysis.fix_gauge(args.gauge)
         if report is not None:
@@ -128,10 +147,23 @@ def main(args: argparse.Namespace) -> int:
 
         print(cli_compare(analysis, args.compare, as_json=args.json, progress=report))
         return 0
+    cases = None
+    if getattr(args, "cases", False):
+        from dirac.analysis.cases import parameter_cases
+
+        cases = parameter_cases(analysis, progress=report)
     if args.json:
-        print(json.dumps(analysis.to_json(), indent=2))
+        data = analysis.to_json()
+        if cases is not None:
+            data["parameter_cases"] = [case.to_json() for case in cases]
+        print(json.dumps(data, indent=2))
     elif args.latex:
         print(analysis.to_latex())
     else:
         print(analysis.to_text())
+        if cases is not None:
+            from dirac.analysis.cases import cases_text
+
+            print()
+            print(cases_text(cases))
     return 0

@@ -67,7 +67,7 @@ from dirac.analysis.legendre.regularity import (
     normal_components,
     square_free_part,
 )
-from dirac.errors import AnalysisError, InconsistentSystemError
+from dirac.errors import AnalysisError, InconsistentSystemError, SeparableParts
 
 __all__ = ["ConstraintChain", "tidy"]
 
@@ -466,11 +466,13 @@ class ConstraintChain:
                     continue  # these branches do not meet: the product is regular where it holds
                 shown = " and ".join(f"{f} = 0" for f in parts)
                 where = f"constraint {holonomic} ({name} = 0)" if holonomic else f"the stage-{len(self.stages) + 1} constraint {name} = 0"
-                raise AnalysisError(
+                raise SeparableParts(
                     f"{where} is irregular: it is the union of the "
                     f"branches {shown}, which meet (where {parts[i]} = {parts[j]} = 0 its gradient vanishes), so there "
                     f"is no single regular constraint surface; analyse the branches {shown} separately "
-                    "(one system each" + (", with the branch as its constraint)" if holonomic else ")")
+                    "(one system each" + (", with the branch as its constraint)" if holonomic else ")"),
+                    holonomic=holonomic,
+                    branches=list(parts),
                 )
 
     def _irregular(self, candidates: list[sympy.Expr], chosen: list[int], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:

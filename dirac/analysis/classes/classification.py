@@ -21,7 +21,7 @@ from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.legendre.regularity import branch_hint
-from dirac.errors import AnalysisError
+from dirac.errors import AnalysisError, SeparableParts
 
 __all__ = ["Classification", "classify", "bracket_matrix"]
 
@@ -106,11 +106,14 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
     # entries at round-off of the matrix's scale are weak zeros, as in ``tiny``: not rank
     ranks = [numeric_rank(np.where(np.abs(v) <= 1e-9 * sc, 0.0, v)) for v, sc in zip(values, scale)]
     if len(set(ranks)) > 1:
-        raise AnalysisError(
+        raise SeparableParts(
             f"the rank of the bracket matrix C_ab = {{Phi_a, Phi_b}} differs between regular points of the constraint "
             f"surface ({', '.join(map(str, ranks))}): the first/second-class split is not the same everywhere on it "
             "(parts of different structure)"
-            + (branch_hint(constraints, space.variables) or "; analyse each part as a system of its own")
+            + (branch_hint(constraints, space.variables) or "; analyse each part as a system of its own"),
+            points=list(points),
+            ranks=list(ranks),
+            variables=list(space.variables),
         )
     rank = ranks[0] if ranks else 0
     if not rest:

@@ -38,6 +38,7 @@ import sympy
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import independent_rows
+from dirac.errors import AnalysisError
 
 __all__ = ["MultiplierSolution", "general_multiplier_solution", "unsolved_multipliers"]
 
@@ -180,6 +181,12 @@ def general_multiplier_solution(
     B_num = [np.asarray(b, dtype=float).reshape(-1, 1) for b in b_num]
     Q = independent_rows([A.T for A in A_num], list(order))
     F = [k for k in range(K) if k not in Q]
+    if len(Q) != a_rows.shape[0]:  # rows independent on the surface, columns not: ranks decided inconsistently
+        raise AnalysisError(
+            f"the consistency conditions have {a_rows.shape[0]} rows independent on the surface but only {len(Q)} "
+            "independent multiplier columns at its points: the rank of {Phi_a, phi_k} is not the same everywhere "
+            "on the surface (parts of different structure); analyse each part as a system of its own"
+        )
     A_PQ = a_rows[:, Q]
     A_num_Q = [A[:, Q] for A in A_num]
     particular = {name: sympy.S.Zero for name in names}

@@ -122,6 +122,10 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
     return chosen
 
 
+#: relative size below which an expression assumed nonzero counts as vanishing at a point
+AVOID_TOLERANCE = 1e-6
+
+
 class Numerics:
     """Lambdified evaluation, surface points and weak-zero tests for one phase space.
 
@@ -155,6 +159,8 @@ class Numerics:
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
+        #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
+        self.avoid: list[sympy.Expr] = []
 
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
@@ -270,6 +276,16 @@ class Numerics:
         n = len(self.phase_space.variables) + (self.time is not None)
         return self.rng.uniform(0.5, 1.5, n) * self.rng.choice([-1.0, 1.0], n)
 
+    def _near_avoided(self, z: np.ndarray) -> bool:
+        """Whether an expression assumed nonzero (:attr:`avoid`) vanishes at ``z``.
+
+        ``|e(z)| <= AVOID_TOLERANCE * (1 + sum of |terms of e| at z)``: a point on (or next to)
+        the excluded set ``e = 0``, where the ranks are not those of the part assumed.
+        """
+        values = self.evaluate(self.avoid, [z])[0]
+        scales = self.term_scale(self.avoid, [z])[0]
+        return bool(np.any(np.abs(values) <= AVOID_TOLERANCE * scales))
+
     def surface_points(
         self,
         constraints: Sequence[sympy.Expr],
@@ -356,6 +372,8 @@ class Numerics:
                 continue
             if ok and regular and self._vanishing_gradient(flat[: regular * n], jac_fn(z).reshape(m, n)[:regular], z):
                 singular += 1
+                continue
+            if ok and self.avoid and self._near_avoided(z):
                 continue
             if ok:
                 points.append(z)

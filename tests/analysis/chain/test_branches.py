@@ -5,37 +5,45 @@ Each test states the hand derivation it checks (canonical bracket ``{q, p} = 1``
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 import sympy
-from cli_output import one_error_line
 
 import dirac
 import dirac.analysis.chain.constraint_chain as constraint_chain
-from dirac.errors import AnalysisError, DiracError
+from dirac.errors import AnalysisError, DiracWarning
 
 GRAVITY = "(x_dot**2 + y_dot**2)/2 - y"
 
 
-def test_two_crossing_lines_are_refused_naming_both_branches(run_cli, tmp_path):
+def test_two_crossing_lines_are_analysed_as_two_components(run_cli, tmp_path):
     """``x^2 - y^2 = 0`` is the union of the lines ``x - y = 0`` and ``x + y = 0``, which cross at
     the origin, where the gradient ``(2x, -2y)`` vanishes. On either line alone the motion is
     a bead on a straight wire under gravity (``p_lambda``, the line, the velocity along its
     normal, the equation fixing ``lambda``: 4 second class, ``(6 - 4)/2 = 1`` degree of
     freedom), but at the crossing the multiplier is free; the union has no single regular
-    surface, so the analysis is refused, naming both branches (written expanded: found by
-    factorisation, not from the written form)."""
+    surface, so each line is analysed as a component of its own (found by factorisation of
+    the expanded constraint), with a warning naming both."""
     L = dirac.Lagrangian.from_strings("cross", ["x", "y"], GRAVITY, ["x**2 - y**2"])
-    with pytest.raises(AnalysisError, match=r"constraint 1 \(x\*\*2 - y\*\*2 = 0\) is irregular") as caught:
-        dirac.analyze(L)
-    assert isinstance(caught.value, DiracError)
-    assert "x - y = 0" in str(caught.value) and "x + y = 0" in str(caught.value)
+    with pytest.warns(DiracWarning, match=r"2 crossing branches.*x \+ y = 0.*x - y = 0"):
+        analysis = dirac.analyze(L)
+    assert sorted(c.condition for c in analysis.components) == ["x + y = 0", "x - y = 0"]
+    for part in analysis.components:
+        a = part.analysis
+        assert [len(s) for s in a.stages] == [1, 1, 1, 1]
+        assert len(a.second_class) == 4 and a.first_class == [] and a.physical_degrees_of_freedom == 1
     path = tmp_path / "cross.toml"
     path.write_text('[system]\nname = "cross"\ncoordinates = ["x", "y"]\n'
                     f'lagrangian = "{GRAVITY}"\nconstraints = ["x**2 - y**2"]\n')
-    status, out, err = run_cli("analyze", str(path))
-    line = one_error_line(status, err)
-    assert "x - y = 0" in line and "x + y = 0" in line and out == ""
+    status, out, err = run_cli("analyze", str(path), "--json")
+    listed = json.loads(out)["components"]
+    assert status == 0 and err.startswith("warning:")
+    assert sorted((c["condition"], len(c["second_class"]), c["physical_degrees_of_freedom"]) for c in listed) == [
+        ("x + y = 0", 4, 1), ("x - y = 0", 4, 1)]
+    status, out, _ = run_cli("analyze", str(path))
+    assert status == 0 and "components of the constraint surface:" in out and "  - x - y = 0: stages 1+1+1+1" in out
 
 
 def test_either_line_alone_is_a_bead_on_a_wire():
@@ -61,17 +69,22 @@ def test_sample_points_stay_off_the_crossing_when_the_product_is_not_factored(mo
     assert len(a.second_class) == 4 and a.physical_degrees_of_freedom == 1
 
 
-def test_expanded_product_of_two_crossing_planes_is_refused():
+def test_expanded_product_of_two_crossing_planes_is_analysed_plane_by_plane():
     """``(w + x - 2z + 2)(2w + x + 2y + z - 4)`` written expanded (13 terms): two hyperplanes of
     ``(w, x, y, z)`` with independent normals, which meet in a plane where the gradient of the
-    product vanishes; refused, naming both factors."""
+    product vanishes. Each plane is a component: a particle on a hyperplane of R^4 under
+    gravity (``p_lambda``, the plane, the normal velocity, the ``lambda`` equation: 4 second
+    class, ``(10 - 4)/2 = 3`` degrees of freedom)."""
     w, x, y, z = sympy.symbols("w x y z")
     chi = str(sympy.expand((w + x - 2 * z + 2) * (2 * w + x + 2 * y + z - 4)))
     L = dirac.Lagrangian.from_strings(
         "planes", ["w", "x", "y", "z"], "(w_dot**2 + x_dot**2 + y_dot**2 + z_dot**2)/2 - y", [chi]
     )
-    with pytest.raises(AnalysisError, match=r"branches .*w \+ x - 2\*z \+ 2 = 0.* and .*2\*w \+ x \+ 2\*y \+ z - 4 = 0"):
-        dirac.analyze(L)
+    with pytest.warns(DiracWarning, match=r"crossing branches"):
+        analysis = dirac.analyze(L)
+    assert sorted(c.condition for c in analysis.components) == ["2*w + x + 2*y + z - 4 = 0", "w + x - 2*z + 2 = 0"]
+    for part in analysis.components:
+        assert (len(part.analysis.second_class), part.analysis.physical_degrees_of_freedom) == (4, 3)
 
 
 FIRST_ORDER = "-3*x**2*x_dot - x*z**2/2 + x_dot*z - y**2*y_dot - 2*y*y_dot - y*z**2 + y*z*z_dot"

@@ -145,13 +145,18 @@ def test_sample_points_are_regular():
         assert np.linalg.matrix_rank(J) == len(a.constraints)
 
 
-def test_squared_factor_of_a_crossing_product_is_refused():
+def test_squared_factor_of_a_crossing_product_is_analysed_branch_by_branch():
     """``(x - 1)^2 (y - 2) = 0``: the square-free part ``(x - 1)(y - 2)`` is the union of the lines
     ``x = 1`` and ``y = 2``, which cross at ``(1, 2)`` where its gradient ``(y - 2, x - 1)``
-    vanishes: after regularisation it is still refused, naming both branches."""
+    vanishes: after regularisation each line is a component of its own, a particle on a line
+    under gravity (``p_lambda``, the line, the normal velocity, the ``lambda`` equation: 4
+    second class, ``(6 - 4)/2 = 1`` degree of freedom), with a warning naming both."""
     L = dirac.Lagrangian.from_strings("corner", ["x", "y"], "(x_dot**2 + y_dot**2)/2 - y", ["(x - 1)**2*(y - 2)"])
-    with pytest.raises(AnalysisError, match=r"branches x - 1 = 0 and y - 2 = 0"):
-        dirac.analyze(L)
+    with pytest.warns(dirac.DiracWarning, match=r"crossing branches"):
+        analysis = dirac.analyze(L)
+    assert sorted(c.condition for c in analysis.components) == ["x - 1 = 0", "y - 2 = 0"]
+    for part in analysis.components:
+        assert (len(part.analysis.second_class), part.analysis.physical_degrees_of_freedom) == (4, 1)
 
 
 def test_expanded_product_met_in_the_chain_is_refused_with_its_branches():
