@@ -169,11 +169,18 @@ class TieredFunction:
     def _interpreted_call(self, steps: int, args: tuple[Any, ...]) -> Any:
         function = getattr(self.module.interpreted, self.name)
         start = time.perf_counter()
+        saved = [(a, a.copy()) for a in args if isinstance(a, np.ndarray)]  # the state the call changes in place
         try:
             with np.errstate(divide="raise", over="ignore", invalid="ignore", under="ignore"):
                 return function(*args)
         except FloatingPointError as error:  # numpy scalars: a division by zero, as compiled code raises it
             raise ZeroDivisionError(str(error)) from None
+        except OverflowError:
+            # Python's math raises where the compiled code returns inf (which the run's guard rails
+            # then report as a non-finite state): the same call again, compiled, from the saved state
+            for array, before in saved:
+                array[...] = before
+            return self.compile("the interpreted kernel overflowed (math range error)")(*args)
         finally:
             self.interpreted_seconds += time.perf_counter() - start
             self.interpreted_steps += steps

@@ -102,7 +102,7 @@ def assert_one_error_line(status: int, err: str) -> str:
     assert "Traceback" not in err, err
     errors = [line for line in lines if line.startswith("error:")]
     assert len(errors) == 1, err
-    assert all(line.startswith(("error:", "warning:")) for line in lines), err
+    assert all(line.startswith(("error:", "warning:", "dirac: compiling ")) for line in lines), err
     return errors[0]
 
 
