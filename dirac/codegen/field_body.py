@@ -35,7 +35,7 @@ import sympy
 
 from dirac.codegen.printer import straight_line
 
-__all__ = ["FieldBody", "dirac_field_body", "SCRATCH_SOLVER", "UNROLL_LIMIT"]
+__all__ = ["FieldBody", "dirac_field_body", "BANDED_SOLVER", "SCRATCH_SOLVER", "UNROLL_LIMIT"]
 
 
 def _product(a: str | None, b: str | None) -> str | None:
@@ -53,14 +53,21 @@ def _sum(terms: Sequence[tuple[str, str | None]]) -> str | None:
     return text
 
 
-class _Lines:
-    """Source lines of the function body and fresh local names."""
+class _TooLong(Exception):
+    """The unrolled elimination passed its line limit (the looped solve takes over)."""
 
-    def __init__(self) -> None:
+
+class _Lines:
+    """Source lines of the function body (at most ``limit`` of them, else :class:`_TooLong`)."""
+
+    def __init__(self, limit: int | None = None) -> None:
         self.lines: list[str] = []
+        self.limit = limit
 
     def add(self, text: str) -> None:
         self.lines.append("    " + text)
+        if self.limit is not None and len(self.lines) > self.limit:
+            raise _TooLong
 
 
 def _elimination(lines: _Lines, matrix: list[list[str | None]], rhs: list[str | None]) -> list[str | None]:
@@ -170,6 +177,105 @@ def solve_scratch(w, start, k):
 '''
 
 
+#: the looped solve of a banded ``C`` (after a symmetric reordering): LAPACK's ``gbsv``
+#: scheme (Golub & Van Loan, *Matrix Computations*, 4th ed., Sect. 4.3.5): partial pivoting
+#: within the ``lower`` rows below the diagonal, so the upper band widens to ``lower + upper``
+BANDED_SOLVER = '''@numba.njit("void(float64[::1], int64, int64, int64, int64)", cache=True, error_model="numpy")
+def solve_banded(w, start, k, lower, upper):
+    """Solve C x = b in place by Gaussian elimination with partial pivoting on band storage:
+    row r of C holds columns r - lower .. r + lower + upper at w[start + r * W + (j - r + lower)]
+    (W = 2 lower + upper + 1), then b at w[start + k * W:]; x replaces b."""
+    W = 2 * lower + upper + 1
+    rhs = start + k * W
+    for c in range(k):
+        last = min(k - 1, c + lower)
+        high = min(k - 1, c + lower + upper)
+        pivot = c
+        best = abs(w[start + c * W + lower])
+        for r in range(c + 1, last + 1):
+            size = abs(w[start + r * W + (c - r + lower)])
+            if size > best:
+                best = size
+                pivot = r
+        if pivot != c:
+            for j in range(c, high + 1):
+                a = start + c * W + (j - c + lower)
+                b = start + pivot * W + (j - pivot + lower)
+                swap = w[a]
+                w[a] = w[b]
+                w[b] = swap
+            swap = w[rhs + c]
+            w[rhs + c] = w[rhs + pivot]
+            w[rhs + pivot] = swap
+        d = w[start + c * W + lower]
+        for r in range(c + 1, last + 1):
+            factor = w[start + r * W + (c - r + lower)] / d
+            if factor != 0.0:
+                for j in range(c + 1, high + 1):
+                    w[start + r * W + (j - r + lower)] -= factor * w[start + c * W + (j - c + lower)]
+                w[rhs + r] -= factor * w[rhs + c]
+    for c in range(k - 1, -1, -1):
+        acc = w[rhs + c]
+        for j in range(c + 1, min(k - 1, c + lower + upper) + 1):
+            acc -= w[start + c * W + (j - c + lower)] * w[rhs + j]
+        w[rhs + c] = acc / w[start + c * W + lower]
+
+
+'''
+
+
+def _band_order(matrix: list[list[str | None]]) -> tuple[list[int], int, int]:
+    """A symmetric reordering of ``matrix`` that makes it banded (reverse Cuthill-McKee on
+    its structure; Cuthill & McKee 1969, George & Liu 1981) and the lower and upper
+    bandwidths after it: ``order[p]`` is the row (and column) moved to position ``p``."""
+    import numpy as np
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    k = len(matrix)
+    rows, cols = zip(*[(a, b) for a in range(k) for b in range(k) if matrix[a][b] is not None]) or ((), ())
+    pattern = csr_matrix((np.ones(len(rows)), (np.array(rows, dtype=np.int64), np.array(cols, dtype=np.int64))),
+                         shape=(k, k))
+    order = [int(a) for a in reverse_cuthill_mckee(pattern, symmetric_mode=True)]
+    position = {a: p for p, a in enumerate(order)}
+    lower = upper = 0
+    for a, b in zip(rows, cols):
+        lower = max(lower, position[a] - position[b])
+        upper = max(upper, position[b] - position[a])
+    return order, lower, upper
+
+
+def _banded_pays(k: int, lower: int, upper: int) -> bool:
+    """The banded solve (about ``k lower (lower + upper)`` products, ``k (2 lower + upper +
+    2)`` entries) beats the dense one (``k^3 / 3``, ``k (k + 1)`` entries) by a margin."""
+    return 3 * (2 * lower + upper + 2) <= k
+
+
+def _banded_solve(lines: _Lines, matrix: list[list[str | None]], rhs: list[str | None], scratch: str, start: int,
+                  order: list[int], lower: int, upper: int) -> list[str | None]:
+    """``matrix x = rhs`` by the looped banded solve ``solve_banded`` on ``scratch[start:]``.
+
+    The band of the reordered matrix is zeroed by one loop and its structurally non-zero
+    entries written (one line each: the source grows with the entries, not with ``k^2``),
+    solved in place, and ``x`` read back in the original order.
+    """
+    k = len(matrix)
+    width = 2 * lower + upper + 1
+    lines.add(f"for i_ in range({start}, {start + k * width}):")
+    lines.add(f"    {scratch}[i_] = 0.0")
+    for p, a in enumerate(order):
+        for q, b in enumerate(order):
+            if matrix[a][b] is not None:
+                lines.add(f"{scratch}[{start + p * width + q - p + lower}] = {matrix[a][b]}")
+        lines.add(f"{scratch}[{start + k * width + p}] = {rhs[a] or '0.0'}")
+    lines.add(f"solve_banded({scratch}, {start}, {k}, {lower}, {upper})")
+    x: list[str | None] = [None] * k
+    for p, a in enumerate(order):
+        lines.add(f"x{a}_ = {scratch}[{start + k * width + p}]")
+        x[a] = f"x{a}_"
+    return x
+
+
 def _scratch_solve(lines: _Lines, matrix: list[list[str | None]], rhs: list[str | None], scratch: str,
                    start: int) -> list[str | None]:
     """``matrix x = rhs`` by the looped solve ``solve_scratch`` on ``scratch[start:]``.
@@ -188,6 +294,35 @@ def _scratch_solve(lines: _Lines, matrix: list[list[str | None]], rhs: list[str 
         lines.add(f"x{a}_ = {scratch}[{start + a * m + k}]")
         x.append(f"x{a}_")
     return x
+
+
+#: with this many second-class constraints the whole field is one closed form (``C^{-1}`` of a
+#: 2 x 2 antisymmetric ``C`` written out), simplified by sympy and printed as one straight-line
+#: block, so constant entries fold away and one division remains
+CLOSED_FORM_SIZES = (0, 2)
+
+
+def _closed_form_body(z: list[sympy.Symbol], inputs: Mapping[sympy.Symbol, str], gradient: list[sympy.Expr],
+                      second_class: list[sympy.Expr], title: str, time: sympy.Symbol | None) -> FieldBody:
+    """The field (240) with ``k`` in ``(0, 2)`` as sympy expressions: ``f = J g``, and for ``k = 2``
+
+        z_dot = f - J D^T C^{-1} (D f + d_t Phi),   C^{-1} = [[0, -1/C_01], [1/C_01, 0]]."""
+    N = len(z)
+    n = N // 2
+    flow = sympy.Matrix([*gradient[n:], *[-e for e in gradient[:n]]])  # J g
+    k = len(second_class)
+    if k:
+        D = sympy.Matrix([[sympy.diff(phi, s) for s in z] for phi in second_class])
+        J = sympy.zeros(N, N)
+        for i in range(n):
+            J[i, n + i], J[n + i, i] = 1, -1
+        phi_t = sympy.Matrix([sympy.diff(phi, time) if time is not None else sympy.S.Zero for phi in second_class])
+        C = D * J * D.T
+        inverse = sympy.Matrix([[0, -1 / C[0, 1]], [1 / C[0, 1], 0]])
+        flow = flow - J * D.T * inverse * (D * flow + phi_t)
+    code = straight_line(dict(inputs), list(flow), "math", "cse", title)
+    lines = list(code.body()) + [f"    out[{i}] = {value}" for i, value in enumerate(code.outputs)]
+    return FieldBody(lines, 0, "")
 
 
 @dataclass(frozen=True)
@@ -213,6 +348,7 @@ def dirac_field_body(
     forces: Sequence[sympy.Expr] = (),
     unroll_limit: int = UNROLL_LIMIT,
     scratch: tuple[str, int] = ("params", 0),
+    banded: bool | None = None,
 ) -> FieldBody:
     """Lines filling ``out[0:N]`` with the Dirac vector field (see the module docstring).
 
@@ -238,6 +374,9 @@ def dirac_field_body(
         Largest number of lines of the unrolled elimination before the looped solve.
     scratch
         The array name and the first entry of the scratch space of the looped solve.
+    banded
+        The looped solve on band storage after a bandwidth-reducing reordering (True), or
+        the dense one (False); None: the banded one where it is cheaper.
     """
     z = list(variables)
     N = len(z)
@@ -246,6 +385,8 @@ def dirac_field_body(
     gradient = [sympy.diff(hamiltonian, s) for s in z]
     for i, Q in enumerate(forces):  # (J g)_{n+i} = -g_i: p_dot_i = -dH/dq_i + Q_i
         gradient[i] = gradient[i] - Q
+    if k in CLOSED_FORM_SIZES:
+        return _closed_form_body(z, inputs, gradient, list(second_class), title, time)
     wanted: list[sympy.Expr] = []
     slots: list[tuple[str, int, int]] = []
     for i, g in enumerate(gradient):
@@ -286,8 +427,14 @@ def dirac_field_body(
     if k:
         # C_ab = sum_i D_a,i D_b,n+i - D_a,n+i D_b,i  (antisymmetric), b_a = (D J g)_a + d_t Phi_a
         C: list[list[str | None]] = [[None] * k for _ in range(k)]
+        having: list[set[int]] = [set() for _ in range(N)]  # column -> the constraints whose gradient has it
         for a in range(k):
-            for b in range(a + 1, k):
+            for i in range(N):
+                if d_name[a][i] is not None:
+                    having[i].add(a)
+        for a in range(k):
+            partners = {b for i in range(N) if d_name[a][i] is not None for b in having[(i + n) % N] if b > a}
+            for b in sorted(partners):
                 entry = _sum([term for i in range(n) for term in (
                     ("+", _product(d_name[a][i], d_name[b][n + i])), ("-", _product(d_name[a][n + i], d_name[b][i])))])
                 if entry is not None:
@@ -302,14 +449,20 @@ def dirac_field_body(
             if entry is not None:
                 lines.add(f"b{a}_ = {entry}")
             rhs.append(f"b{a}_" if entry is not None else None)
-        unrolled = _Lines()
-        x = _elimination(unrolled, C, rhs)
-        if len(unrolled.lines) <= unroll_limit:
+        unrolled = _Lines(unroll_limit)
+        try:
+            x = _elimination(unrolled, C, rhs)
             lines.lines.extend(unrolled.lines)
-        else:
-            x = _scratch_solve(lines, C, rhs, scratch[0], scratch[1])
-            scratch_size = k * (k + 1)
-            solver = SCRATCH_SOLVER
+        except _TooLong:
+            order, lower, upper = _band_order(C)
+            if _banded_pays(k, lower, upper) if banded is None else banded:
+                x = _banded_solve(lines, C, rhs, scratch[0], scratch[1], order, lower, upper)
+                scratch_size = k * (2 * lower + upper + 2)
+                solver = BANDED_SOLVER
+            else:
+                x = _scratch_solve(lines, C, rhs, scratch[0], scratch[1])
+                scratch_size = k * (k + 1)
+                solver = SCRATCH_SOLVER
         # w = D^T x
         for j in range(N):
             total = _sum([("+", _product(d_name[a][j], x[a])) for a in range(k)])

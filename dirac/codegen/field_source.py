@@ -72,6 +72,7 @@ def vector_field_source(
     unroll_limit: int = UNROLL_LIMIT,
     time: sympy.Symbol | None = None,
     forces: Sequence[sympy.Expr] = (),
+    banded: bool | None = None,
 ) -> str:
     """Python source of the compiled Dirac vector field (see the module docstring).
 
@@ -105,6 +106,10 @@ def vector_field_source(
         The explicit time ``t`` of a rheonomic system, one of ``parameters`` (its slot in
         ``params`` is ``TIME``, which ``field(t, z, params)`` fills): the solve gets
         ``d_t Phi`` on its right side. ``None`` (an autonomous field): ``TIME = -1``.
+    banded
+        For a looped solve (past ``unroll_limit``): on band storage after a
+        bandwidth-reducing reordering of ``C`` (True; its cost and source grow linearly
+        with ``k`` at a fixed bandwidth) or dense (False); None: banded where cheaper.
 
     Returns
     -------
@@ -122,7 +127,7 @@ def vector_field_source(
     inputs = {symbol: f"a{i}_" for i, symbol in enumerate(z)}
     inputs.update({symbol: f"c{i}_" for i, symbol in enumerate(parameters)})
     body = dirac_field_body(z, inputs, hamiltonian, second_class, title, time, forces, unroll_limit,
-                            ("params", scratch))
+                            ("params", scratch), banded)
     lines = [f"    if z.shape[0] != {N} or out.shape[0] != {N}:",
              f'        raise ValueError("the state must have {N} entries")',
              "    if params.shape[0] != PARAMS:",
