@@ -88,3 +88,20 @@ def test_large_banded_C_gets_linear_source():
         assert "solve_banded" in source
         sizes[links] = source.count("\n")
     assert sizes[48] / sizes[24] < 2.2
+
+
+@pytest.mark.slow
+def test_analysed_kernel_uses_the_same_banded_field():
+    """The step kernels of an analysed system print their field with the same emitter: for
+    the chain of 24 links (k = 48) it takes the banded solve and agrees with numpy."""
+    from dirac.codegen.kernel_source import analysed_kernel_source, load_kernels
+
+    z, H, constraints = _chain(24)
+    source = analysed_kernel_source(z, [sympy.Symbol("g", real=True)], H, constraints)
+    assert "solve_banded" in source
+    module = load_kernels(source)
+    point = np.random.default_rng(5).normal(size=len(z))
+    out = np.empty(len(z))
+    module.field(point, 0.0, np.array([9.81]), out)
+    reference = _numpy_field(z, H, constraints, point, 9.81)
+    assert np.max(np.abs(out - reference)) <= 1e-10 * np.max(np.abs(reference))
