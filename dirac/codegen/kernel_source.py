@@ -15,9 +15,10 @@ inlines everything. This module writes, per system, one numba module in which
   ``chi(q, t)``, potentials ``V(q, t)`` and masses ``M(q, t)`` may depend on it;
 * where a closed form exists it replaces the loops: RATTLE with a constant mass is
   unrolled into scalar code (:mod:`dirac.codegen.rattle_scalar`), ``v = M^{-1} p`` and
-  RATTLE's implicit stage are single expressions for diagonal and 2 x 2 mass matrices,
-  and the Dirac field of an analysed system with two second-class constraints is one
-  expression (``C^{-1}`` of a 2 x 2 antisymmetric ``C`` written out).
+  RATTLE's implicit stage are single expressions for diagonal and 2 x 2 mass matrices;
+* the Dirac field of an analysed system is printed by the same emitter as the public
+  vector field (:func:`dirac.codegen.field_body.dirac_field_body`: ``C`` and its solve
+  unrolled on scalars, or looped on a scratch array for a large ``C``).
 
 The module is written to the cache directory under the hash of its source and imported
 (:func:`dirac.codegen.numba_backend.import_source`); numba caches the compiled kernels
@@ -36,6 +37,7 @@ from types import ModuleType
 
 import sympy
 
+from dirac.codegen.field_body import dirac_field_body
 from dirac.codegen.kernel_templates import analysed_templates, mechanical_templates
 from dirac.codegen.numba_backend import import_source
 from dirac.codegen.printer import flat_expressions, straight_line
@@ -291,25 +293,44 @@ def analysed_kernel_source(
         emit_function("second_class_dt", "d Phi/dt, (k,)", za, ts, phi_t, (k,), parameters),
         emit_function("second_class_jacobian", "grad Phi, (k, 2n)", za, ts, jacobian, (k, N), parameters),
     ]
-    closed = k <= 2
-    if closed:  # C is 2 x 2 antisymmetric (or empty): the whole field (240) in closed form
-        n = N // 2
-        flow = sympy.Matrix([*gradient[n:], *[-e for e in gradient[:n]]])  # J grad H
-        if k:
-            D = sympy.Matrix(k, N, jacobian)
-            J = sympy.zeros(N, N)
-            for i in range(n):
-                J[i, n + i], J[n + i, i] = 1, -1
-            C = D * J * D.T
-            C_inverse = sympy.Matrix([[0, -1 / C[0, 1]], [1 / C[0, 1], 0]])
-            flow = flow - J * D.T * C_inverse * (D * flow + sympy.Matrix(phi_t))
-        source = emit_function("field_into", "z_dot = {z, H}_D (240) in closed form, C = {Phi_1, Phi_2} inverted "
-                               "by hand", za, ts, list(flow), (N,), parameters)
-        functions.append(source.replace("def field_into(z, t, c, out):", "def field_into(z, t, c, out, work):")
-                         + "\n\n@numba.njit(cache=True)\ndef field_work():\n    \"\"\"No work arrays.\"\"\"\n"
-                         "    return np.empty(0)\n")
-    body = _solves({k}) + "\n\n".join(functions) + analysed_templates(N // 2, k, not closed)
+    functions.append(_analysed_field(z, parameters, hamiltonian, list(constraints), time, title))
+    body = _solves({k}) + "\n\n".join(functions) + analysed_templates(N // 2, k)
     return _HEADER.format(title=title) + body
+
+
+#: a field body of at most this many lines is inlined into the step loops (which call it three
+#: times); a longer one stays one compiled function, so the loops compile in proportion to it once
+INLINE_FIELD_LINES = 400
+
+
+def _analysed_field(z: list[sympy.Symbol], parameters: Sequence[sympy.Symbol], hamiltonian: sympy.Expr,
+                    constraints: list[sympy.Expr], time: sympy.Symbol | None, title: str) -> str:
+    """``field_into(z, t, c, out, work)`` and ``field_work()``: the Dirac vector field (240)
+    printed by the one field emitter :func:`dirac.codegen.field_body.dirac_field_body`
+    (solve unrolled on scalars, or looped on the scratch array ``work`` for a large ``C``),
+    inlined into the step loops."""
+    inputs: dict[sympy.Symbol, str] = {symbol: f"z{i}_" for i, symbol in enumerate(z)}
+    inputs.update({symbol: f"c{i}_" for i, symbol in enumerate(parameters)})
+    loads = [f"    z{i}_ = z[{i}]" for i in range(len(z))] + [f"    c{i}_ = c[{i}]" for i in range(len(parameters))]
+    if time is not None:
+        inputs[time] = "t_"
+        loads.append("    t_ = t")
+    body = dirac_field_body(z, inputs, hamiltonian, constraints, f"{title}: Dirac field", time, scratch=("work", 0))
+    return "\n".join([
+        body.solver,
+        INLINED if len(body.lines) <= INLINE_FIELD_LINES else "@numba.njit(cache=True)",
+        "def field_into(z, t, c, out, work):",
+        '    """z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + d_t Phi) (240)."""',
+        *loads,
+        *body.lines,
+        "",
+        "",
+        "@numba.njit(cache=True)",
+        "def field_work():",
+        '    """The scratch space of the looped solve of field_into (empty when the solve is unrolled)."""',
+        f"    return np.empty({body.scratch_size})",
+        "",
+    ])
 
 
 def load_kernels(source: str) -> ModuleType:

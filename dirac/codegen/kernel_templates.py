@@ -401,33 +401,7 @@ def residuals(q, p, t, c, out):
         out[__M__ + a] = acc
 '''
 
-_ANALYSED_FIELD = '''
-
-@numba.njit(cache=True)
-def field_into(z, t, c, out, work):
-    """z_dot = {z, H}_D = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + dPhi/dt) on
-    the phase space of the analysis (coordinates and multipliers, then their momenta),
-    over the __K__ second-class constraints Phi (240); C is evaluated and solved at z."""
-    g, D, e, C, rhs, mu, piv = work
-    hamiltonian_gradient(z, t, c, g)
-    for i in range(__N__):
-        out[i] = g[__N__ + i]
-        out[__N__ + i] = -g[i]
-    if __K__ == 0:
-        return
-    second_class_jacobian(z, t, c, D)
-    second_class_dt(z, t, c, e)
-    dirac_projection(D, e, out, C, rhs, mu, piv)
-'''
-
 _ANALYSED = '''
-
-@numba.njit(cache=True)
-def field_work():
-    """Work arrays of field_into."""
-    return (np.empty(2 * __N__), np.zeros((__K__, 2 * __N__)), np.empty(__K__), np.empty((__K__, __K__)),
-            np.empty(__K__), np.empty(__K__), np.empty(__K__, dtype=np.int64))
-
 
 @numba.njit(cache=True)
 def project_work():
@@ -499,11 +473,11 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     return _fill(by_elimination + _MECHANICAL + common, n, m, 2 * m)
 
 
-def analysed_templates(n: int, k: int, field_by_elimination: bool = True) -> str:
+def analysed_templates(n: int, k: int) -> str:
     """Step loops of an analysed system (``2n`` phase-space variables, ``k`` second-class
     constraints): ``field``, ``midpoint_run`` (projected), ``project``, ``energy``,
-    ``residuals``; ``field_into`` too when ``field_by_elimination`` (else the module
-    generates it in closed form)."""
+    ``residuals``. The module defines ``field_into(z, t, c, out, work)`` and
+    ``field_work()`` itself (:func:`dirac.codegen.field_body.dirac_field_body`)."""
     common = (_COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol, project_buffers)\n")
               .replace("    PROJECT_WORK\n", "    project_buffers = project_work()\n"))
-    return _fill((_ANALYSED_FIELD if field_by_elimination else "") + _ANALYSED + common, n, 0, k)
+    return _fill(_ANALYSED + common, n, 0, k)
