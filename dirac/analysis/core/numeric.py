@@ -24,7 +24,7 @@ import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.sparse_numeric import independent_rows_one_pass
-from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, sparse_surface_points
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
@@ -321,21 +321,14 @@ class Numerics:
             If no point is found: the surface may be empty (no real solution), or it has
             no regular point (its constraints are irregular).
         """
-        if len(self.phase_space.variables) >= LARGE_SYSTEM:  # sparse Jacobian, same rules and errors
-            found, dropped = sparse_surface_points(
-                self, constraints, count, fixed, attempts, start, regular, SURFACE_TOLERANCE, REGULAR_TOLERANCE,
-                SINGULAR_GRADIENT,
-            )
-            if len(found) < count:
-                raise _no_surface_point([sympy.sympify(c) for c in constraints], dropped)
-            return found
         constraints = [sympy.sympify(c) for c in constraints]
         residual = self.function(constraints)
-        grads = [self.phase_space.gradient(c) for c in constraints]
-        flat = [g for row in grads for g in row]
-        jac_fn = self.function(flat)
         n = len(self.phase_space.variables)
         m = len(constraints)
+        jacobian: _DenseJacobian | SparseJacobian | None = None
+        if m:  # a large system: sparse Jacobian, steps and rank tests; the same rules otherwise
+            jacobian = (SparseJacobian(self, constraints, REGULAR_TOLERANCE, SINGULAR_GRADIENT) if n >= LARGE_SYSTEM
+                        else _DenseJacobian(self, constraints))
         fixed = dict(fixed or {})
         free = np.array([i for i in range(n) if i not in fixed], dtype=int)
         points: list[np.ndarray] = []
@@ -346,7 +339,7 @@ class Numerics:
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
             for i, v in fixed.items():
                 z[i] = v
-            if m == 0:
+            if jacobian is None:
                 points.append(z)
                 continue
             ok = False
@@ -358,19 +351,16 @@ class Numerics:
                 if size is not None and np.all(np.abs(r) <= SURFACE_TOLERANCE * size):
                     ok = True
                     break
-                jac = jac_fn(z).reshape(m, n)[:, free]
-                if not np.all(np.isfinite(jac)):
+                J = jacobian(z)
+                if not jacobian.finite(J):
                     break
-                step = np.linalg.lstsq(jac, -r, rcond=1e-12)[0]
+                step = jacobian.step(J[:, free], r)
                 norm = np.linalg.norm(step)
                 if norm > 10.0:  # keep steps bounded far from the surface
                     step *= 10.0 / norm
                 z = z.copy()
                 z[free] += step
-            if ok and regular and not self._regular_point(jac_fn(z).reshape(m, n)[:regular]):
-                singular += 1
-                continue
-            if ok and regular and self._vanishing_gradient(flat[: regular * n], jac_fn(z).reshape(m, n)[:regular], z):
+            if ok and regular and jacobian.singular(z, regular):
                 singular += 1
                 continue
             if ok and self.avoid and self._near_avoided(z):
@@ -380,6 +370,36 @@ class Numerics:
         if len(points) < count:
             raise _no_surface_point(constraints, singular)
         return points
+
+
+class _DenseJacobian:
+    """The Jacobian of constraints as a dense array, with the dense step and regularity tests
+    of :meth:`Numerics.surface_points` (the sparse counterpart: :class:`SparseJacobian`)."""
+
+    def __init__(self, numerics: Numerics, constraints: Sequence[sympy.Expr]) -> None:
+        self._numerics = numerics
+        self.shape = (len(constraints), len(numerics.phase_space.variables))
+        self._flat = [g for c in constraints for g in numerics.phase_space.gradient(c)]
+        self._values = numerics.function(self._flat)
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        return self._values(z).reshape(self.shape)
+
+    @staticmethod
+    def finite(jacobian: np.ndarray) -> bool:
+        """Whether every entry is finite."""
+        return bool(np.all(np.isfinite(jacobian)))
+
+    @staticmethod
+    def step(jacobian: np.ndarray, residual: np.ndarray) -> np.ndarray:
+        """The minimum-norm Gauss–Newton step ``dz`` of ``J dz = -r`` (``lstsq``)."""
+        return np.linalg.lstsq(jacobian, -residual, rcond=1e-12)[0]
+
+    def singular(self, z: np.ndarray, regular: int) -> bool:
+        """Whether the first ``regular`` gradients are dependent, or one of them vanishing, at ``z``."""
+        rows = self(z)[:regular]
+        return not Numerics._regular_point(rows) or self._numerics._vanishing_gradient(
+            self._flat[: regular * self.shape[1]], rows, z)
 
 
 def _no_surface_point(constraints: list[sympy.Expr], singular: int) -> AnalysisError:

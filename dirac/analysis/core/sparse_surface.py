@@ -1,8 +1,8 @@
-"""Points of the constraint surface of a large, local system: Gauss–Newton with a sparse Jacobian.
+"""The sparse Jacobian of a large, local system, for the projection onto its constraint surface.
 
-The same projection as :meth:`dirac.analysis.core.numeric.Numerics.surface_points` (random
-start, minimum-norm Gauss–Newton steps bounded in length, convergence relative to each
-constraint's term sizes, only regular points kept), with the Jacobian compiled entry by
+:meth:`dirac.analysis.core.numeric.Numerics.surface_points` (random start, minimum-norm
+Gauss–Newton steps bounded in length, convergence relative to each constraint's term sizes,
+only regular points kept) takes its Jacobian from here for a large system, compiled entry by
 entry over its non-zero pattern (a constraint of a local system touches O(1)
 variables) and the step and the regularity test taken sparsely
 (:func:`~dirac.analysis.core.sparse_numeric.minimum_norm_step`,
@@ -13,7 +13,7 @@ of non-zeros times the LSQR iterations.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -22,7 +22,7 @@ import sympy
 
 from dirac.analysis.core.sparse_numeric import full_row_rank, minimum_norm_step
 
-__all__ = ["sparse_surface_points", "SparseJacobian", "LARGE_SYSTEM"]
+__all__ = ["SparseJacobian", "LARGE_SYSTEM"]
 
 #: phase-space dimension from which surface points, independence and regularity are decided sparsely
 LARGE_SYSTEM = 120
@@ -31,7 +31,9 @@ LARGE_SYSTEM = 120
 class SparseJacobian:
     """The Jacobian of ``constraints`` compiled over its non-zero pattern: ``J(z)`` as a CSR matrix."""
 
-    def __init__(self, numerics: Any, constraints: Sequence[sympy.Expr]) -> None:
+    def __init__(
+        self, numerics: Any, constraints: Sequence[sympy.Expr], regular_tolerance: float, singular_gradient: float
+    ) -> None:
         # numerics: a dirac.analysis.core.numeric.Numerics (not imported: numeric imports this module)
         space = numerics.phase_space
         position = {s: k for k, s in enumerate(space.variables)}
@@ -55,9 +57,26 @@ class SparseJacobian:
 
         self._entries = entries
         self._numerics = numerics
+        self._regular_tolerance = regular_tolerance
+        self._singular_gradient = singular_gradient
 
     def __call__(self, z: np.ndarray) -> sp.csr_matrix:
         return sp.csr_matrix((self._values(z), (self.rows, self.cols)), shape=self.shape)
+
+    @staticmethod
+    def finite(jacobian: sp.csr_matrix) -> bool:
+        """Whether every stored entry is finite."""
+        return bool(np.all(np.isfinite(jacobian.data)))
+
+    @staticmethod
+    def step(jacobian: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
+        """The minimum-norm Gauss–Newton step ``dz`` of ``J dz = -r`` (LSQR or sparse LU)."""
+        return minimum_norm_step(jacobian, residual)
+
+    def singular(self, z: np.ndarray, regular: int) -> bool:
+        """Whether the first ``regular`` gradients are dependent, or one of them vanishing, at ``z``."""
+        return not full_row_rank(self(z)[:regular], self._regular_tolerance) or self.vanishing(
+            z, regular, self._singular_gradient)
 
     def vanishing(self, z: np.ndarray, regular: int, threshold: float) -> bool:
         """Whether one of the first ``regular`` gradients is vanishing at ``z`` relative to its terms.
@@ -76,69 +95,3 @@ class SparseJacobian:
         lengths = np.sqrt(np.bincount(rows, weights=values**2, minlength=regular))
         sizes = lengths / (1.0 + np.bincount(rows, weights=scales, minlength=regular))
         return bool(np.any(sizes < threshold))
-
-
-def sparse_surface_points(
-    numerics: Any,
-    constraints: Sequence[sympy.Expr],
-    count: int,
-    fixed: Mapping[int, float] | None = None,
-    attempts: int = 40,
-    start: np.ndarray | None = None,
-    regular: int = 0,
-    surface_tolerance: float = 1e-11,
-    regular_tolerance: float = 1e-6,
-    singular_gradient: float = 1e-4,
-) -> tuple[list[np.ndarray], int]:
-    """Regular points on ``constraints = 0``: :meth:`Numerics.surface_points` with sparse linear algebra.
-
-    Same arguments and tolerances as :meth:`dirac.analysis.core.numeric.Numerics.surface_points`
-    (which passes its own). Returns the points found (up to ``count``) and the number of
-    converged points dropped as singular; the caller raises when there are too few.
-    """
-
-    constraints = [sympy.sympify(c) for c in constraints]
-    residual = numerics.function(constraints)
-    jacobian = SparseJacobian(numerics, constraints)
-    n = len(numerics.phase_space.variables)
-    m = len(constraints)
-    fixed = dict(fixed or {})
-    free = np.array([i for i in range(n) if i not in fixed], dtype=int)
-    points: list[np.ndarray] = []
-    tries = 0
-    singular = 0
-    while len(points) < count and tries < attempts:
-        tries += 1
-        z = start.copy() if (start is not None and tries == 1) else numerics.random_point()
-        for i, v in fixed.items():
-            z[i] = v
-        if m == 0:
-            points.append(z)
-            continue
-        ok = False
-        for _ in range(60):
-            r = residual(z)
-            if not np.all(np.isfinite(r)):
-                break
-            size = numerics.term_scale(constraints, [z])[0] if np.max(np.abs(r)) < 1e-6 else None
-            if size is not None and np.all(np.abs(r) <= surface_tolerance * size):
-                ok = True
-                break
-            J = jacobian(z)
-            if not np.all(np.isfinite(J.data)):
-                break
-            step = minimum_norm_step(J[:, free], r)
-            norm = np.linalg.norm(step)
-            if norm > 10.0:  # keep steps bounded far from the surface
-                step *= 10.0 / norm
-            z = z.copy()
-            z[free] += step
-        if ok and regular and not full_row_rank(jacobian(z)[:regular], regular_tolerance):
-            singular += 1
-            continue
-        if ok and regular and jacobian.vanishing(z, regular, singular_gradient):
-            singular += 1
-            continue
-        if ok:
-            points.append(z)
-    return points, singular
