@@ -32,6 +32,7 @@ from typing import Any
 
 import sympy
 
+from dirac.analysis.report import STRUCTURE_KEYS, structure_summary
 from dirac.errors import DiracError
 from dirac.model.lagrangian import Lagrangian
 
@@ -71,19 +72,13 @@ class ParameterCase:
         if self.analysis is None:
             return {"condition": self.condition, "depth": self.depth, "error": self.error}
         full = self.analysis.to_json()
-        keys = ("stages", "first_class", "second_class", "physical_degrees_of_freedom")
-        return {"condition": self.condition, "depth": self.depth, **{k: full[k] for k in keys}}
+        return {"condition": self.condition, "depth": self.depth, **{k: full[k] for k in STRUCTURE_KEYS}}
 
     def summary(self) -> str:
         """``"2 first class, 0 second class, 0 degrees of freedom"`` (or the refusal)."""
         if self.analysis is None:
             return f"refused: {self.error}"
-        a = self.analysis
-        sizes = "+".join(str(len(s)) for s in a.stages) or "0"
-        return (
-            f"stages {sizes}, {len(a.first_class)} first class, {len(a.second_class)} second class, "
-            f"{a.physical_degrees_of_freedom} degree(s) of freedom"
-        )
+        return structure_summary(self.analysis)
 
 
 def _substitute(lagrangian: Lagrangian, parameter: sympy.Symbol, value: sympy.Expr) -> Lagrangian:

@@ -31,6 +31,7 @@ import sympy
 
 from dirac.analysis.constraint_analysis import ConstraintAnalysis, at_given_values
 from dirac.analysis.constraint_analysis import analyze as analyze_one_part
+from dirac.analysis.report import STRUCTURE_KEYS, structure_summary
 from dirac.analysis.report import to_json as report_json
 from dirac.errors import DiracError, SeparableParts, warn
 from dirac.model.lagrangian import Lagrangian
@@ -55,19 +56,13 @@ class Component:
         if self.analysis is None:
             return {"condition": self.condition, "error": self.error}
         full = report_json(self.analysis)  # not analysis.to_json(): the first part is the top-level analysis
-        keys = ("stages", "first_class", "second_class", "physical_degrees_of_freedom")
-        return {"condition": self.condition, **{k: full[k] for k in keys}}
+        return {"condition": self.condition, **{k: full[k] for k in STRUCTURE_KEYS}}
 
     def summary(self) -> str:
         """One line: stage sizes and counts, or the refusal."""
         if self.analysis is None:
             return f"not analysed: {self.error}"
-        a = self.analysis
-        sizes = "+".join(str(len(s)) for s in a.stages) or "0"
-        return (
-            f"stages {sizes}, {len(a.first_class)} first class, {len(a.second_class)} second class, "
-            f"{a.physical_degrees_of_freedom} degree(s) of freedom"
-        )
+        return structure_summary(self.analysis)
 
 
 def separating_assumptions(error: SeparableParts) -> list[tuple[str, list[str]]] | None:

@@ -19,7 +19,7 @@ from dirac.model.lagrangian import Lagrangian, latex_names
 if TYPE_CHECKING:  # the report reads a solution; it needs no solver
     from dirac.analysis.classes.multiplier_solution import MultiplierSolution
 
-__all__ = ["AnalysisResult", "to_json", "to_text", "to_latex"]
+__all__ = ["AnalysisResult", "to_json", "to_text", "to_latex", "STRUCTURE_KEYS", "structure_summary"]
 
 
 class AnalysisResult(Protocol):
@@ -90,6 +90,19 @@ TREE_LIMIT = 20000
 
 #: prefix of the names of common sub-expressions in reports
 SUBEXPRESSION_PREFIX = "cse_"
+
+
+#: the JSON keys that describe the structure of one case or one part of the surface (docs/file_formats.md)
+STRUCTURE_KEYS = ("stages", "first_class", "second_class", "physical_degrees_of_freedom")
+
+
+def structure_summary(analysis: AnalysisResult) -> str:
+    """``"stages 1+1, 2 first class, 0 second class, 0 degree(s) of freedom"``: one line for a case or a part."""
+    sizes = "+".join(str(len(s)) for s in analysis.stages) or "0"
+    return (
+        f"stages {sizes}, {len(analysis.first_class)} first class, {len(analysis.second_class)} second class, "
+        f"{analysis.physical_degrees_of_freedom} degree(s) of freedom"
+    )
 
 
 def tree_size(expr: sympy.Basic) -> int:
