@@ -52,7 +52,8 @@ ROUND_OFF = 1e-9
 
 def _polynomial(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sympy.Poly | None:
     """``expr`` as a polynomial in the ``variables`` it contains (parameters in the coefficients), or None."""
-    present = [v for v in variables if v in expr.free_symbols]
+    free = expr.free_symbols  # once: sympy recomputes it on every access
+    present = [v for v in variables if v in free]
     if not present:
         return None
     terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
