@@ -169,10 +169,14 @@ class ConstraintChain:
             for momentum, force in self.forces.items():  # p_dot = -dH/dq + Q: + sum_r dPhi/dp_r Q_r
                 b = b + sympy.diff(constraint, momentum) * force
             row = [sympy.S.Zero] * len(self.primary)
+            support = []
             for k in self._sharing(constraint):  # only primaries sharing a canonical pair can give a non-zero bracket
                 row[k] = pb(constraint, self.primary[k])
+                if row[k] != 0:
+                    support.append(k)
             cached = (b, row)
             self._row_cache[constraint] = cached
+            self._row_support[constraint] = support
         return cached
 
     def _sharing(self, constraint: sympy.Expr) -> list[int]:
@@ -199,10 +203,12 @@ class ConstraintChain:
         where = []  # flat positions of the entries that are not identically zero (most, at scale, are)
         for a, c in enumerate(constraints):
             b, A = self._rows(c)
-            for k, e in enumerate((b, *A)):
-                if e != 0:
-                    exprs.append(e)
-                    where.append(a * (K + 1) + k)
+            if b != 0:
+                exprs.append(b)
+                where.append(a * (K + 1))
+            for k in self._row_support[c]:
+                exprs.append(A[k])
+                where.append(a * (K + 1) + k + 1)
         flat = np.zeros((len(points), len(constraints) * (K + 1)))
         if exprs:
             flat[:, where] = self.numerics.evaluate(exprs, points)
@@ -231,6 +237,7 @@ class ConstraintChain:
 
     def _run(self, max_stages: int | None) -> ConstraintChain:
         self._row_cache: dict = {}
+        self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
         points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
@@ -382,6 +389,7 @@ class ConstraintChain:
         for f in fields(self):
             setattr(self, f.name, getattr(adopted, f.name))
         self._row_cache = adopted._row_cache
+        self._row_support = adopted._row_support
         self.pivots = adopted.pivots
         self.regularity_notes = [*adopted.regularity_notes, *notes]
         return self

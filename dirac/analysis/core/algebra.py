@@ -16,7 +16,7 @@ import sympy
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["tidy", "prints_shorter"]
+__all__ = ["tidy", "prints_shorter", "present_in_order"]
 
 
 class _NotRational(Exception):
@@ -179,6 +179,27 @@ def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.S
     return sympy.Add(*terms)
 
 
+_POSITIONS: dict[int, tuple[Sequence[sympy.Symbol], dict[sympy.Symbol, int]]] = {}
+
+
+def present_in_order(variables: Sequence[sympy.Symbol], present: set | frozenset) -> list[sympy.Symbol]:
+    """The ``variables`` that are in ``present``, in the order of ``variables``.
+
+    ``O(len(present))`` for a long sequence passed again and again (the phase-space
+    variables): its positions are kept for the last few sequences, recognised by identity.
+    """
+    if len(variables) <= 2 * len(present) + 8:
+        return [v for v in variables if v in present]
+    held = _POSITIONS.get(id(variables))
+    if held is None or held[0] is not variables:
+        if len(_POSITIONS) >= 8:
+            _POSITIONS.clear()
+        held = (variables, {v: k for k, v in enumerate(variables)})
+        _POSITIONS[id(variables)] = held
+    position = held[1]
+    return sorted((v for v in present if v in position), key=position.__getitem__)
+
+
 def _tidy_by_term(work: sympy.Expr, variables: Sequence[sympy.Symbol], others: Sequence[sympy.Symbol], back: dict) -> sympy.Expr | None:
     """:func:`_poly_to_expr` of the polynomial ``work`` (a long sum), expanded term by term; ``None`` if a term is not one.
 
@@ -241,11 +262,7 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
     """
     expr = sympy.sympify(expr)
     present = expr.free_symbols
-    if len(variables) > len(present):  # O(size of expr), not O(all variables), for a small expression
-        position = {v: k for k, v in enumerate(variables)}
-        variables = sorted((v for v in present if v in position), key=position.__getitem__)
-    else:
-        variables = [v for v in variables if v in present]
+    variables = present_in_order(variables, present)
     if not variables:
         out = sympy.cancel(expr) if expr.free_symbols else expr
         return -out if sign and out.could_extract_minus_sign() else out

@@ -118,8 +118,12 @@ class PhaseSpace:
 
     @property
     def variables(self) -> tuple[sympy.Symbol, ...]:
-        """``coordinates + momenta``: the order of every numeric phase-space vector."""
-        return self.coordinates + self.momenta
+        """``coordinates + momenta``: the order of every numeric phase-space vector (the same tuple each time)."""
+        cached = self.__dict__.get("_variables")
+        if cached is None or cached[0] is not self.coordinates or cached[1] is not self.momenta:
+            cached = (self.coordinates, self.momenta, self.coordinates + self.momenta)
+            self.__dict__["_variables"] = cached
+        return cached[2]
 
     @property
     def dimension(self) -> int:
