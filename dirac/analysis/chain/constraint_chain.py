@@ -587,7 +587,7 @@ class ConstraintChain:
         if n >= LARGE_SYSTEM:  # sparse gradients, independence by sparse elimination
             cand_sparse = self.numerics.sparse_gradients(candidates, points)
             base_sparse = self.numerics.sparse_gradients(old, points) if old else None
-            return independent_rows(cand_sparse, list(range(len(candidates))), base=base_sparse, notes=self.notes)
+            return independent_rows(cand_sparse, list(range(len(candidates))), base=base_sparse, notes=self.regularity_notes)
         grads = [g for c in candidates for g in self.phase_space.gradient(c)]
         cand = self.numerics.evaluate(grads, points).reshape(len(points), len(candidates), n)
         if old:

@@ -209,7 +209,8 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
             sample = np.zeros((n, n))
             sample[rows_w, cols_w] = values
             samples.append(sample)
-    pivots = independent_rows(samples, list(range(n)))
+    undecided: list[str] = []  # a note when sparse rows of W had to be decided densely
+    pivots = independent_rows(samples, list(range(n)), notes=undecided)
     rank = len(pivots)
     others = [j for j in range(n) if j not in pivots]
     S = pivots
@@ -325,6 +326,8 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     if tidy_hamiltonian:
         H_c = tidy(H_c, space.variables)
     full_rank = rank
+    if undecided:
+        method += f" ({undecided[0].replace('independence of rows', 'rank of the Hessian')})"
     return LegendreTransform(
         phase_space=space,
         multipliers=lambdas,

@@ -135,7 +135,6 @@ def test_sparse_normal_components_equal_the_dense_projection():
     from dirac.analysis.chain.chain_regularity import _normal_norms
     from dirac.analysis.legendre.regularity import normal_components
 
-    rng = np.random.default_rng(8)
     for trial in range(6):
         base = (sp.random(40, 90, density=0.03, random_state=trial) + sp.eye(40, 90)).tocsr()
         if trial % 2:  # a dependent base row (a reducible constraint)
