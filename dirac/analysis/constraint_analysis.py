@@ -249,8 +249,10 @@ class ConstraintAnalysis:
             self.notes.append(
                 f"large system ({space.dimension} phase-space variables): surface points found with the sparse "
                 "Jacobian (minimum-norm steps by sparse LU, LSQR where rows depend), regular points tested block by "
-                "block, independence of rows decided in one orthogonalisation pass per point; weak zeros, the rank "
-                "of C and the exact multiplier solve stay on the dense path"
+                "block (large blocks by their L D L^T factorisation), independence of constraint gradients decided by "
+                "sparse elimination (by the dense orthogonalisation pass where a row is not clearly decided), brackets "
+                "only between expressions that share a canonical pair, the rank of C over its connected blocks; weak "
+                "zeros and the exact multiplier solve stay on the dense path"
             )
         if self.time is not None and lagrangian.is_time_dependent:
             self.notes.append(

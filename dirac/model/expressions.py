@@ -114,6 +114,8 @@ def parse_expression(
         tree = ast.parse(stripped, mode="eval")
     except SyntaxError as exc:
         raise InputError(f"{what} {stripped!r} is not a valid expression: {exc.msg}") from None
+    except RecursionError:
+        raise InputError(f"{what} is nested too deeply to parse: split it into shorter expressions") from None
     listed = list(names)
     if time is not None and time.name not in names:
         names = {**names, time.name: time}
@@ -157,6 +159,8 @@ class _Converter:
             suggestion = did_you_mean(name, [*self.listed, *ALLOWED_CONSTANTS])
             hint = f"; {self.unknown_hint}" if self.unknown_hint and not suggestion else ""
             raise self.fail(f"unknown name {name!r}{suggestion}{hint}; the names allowed here are: {known}")
+        if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Sub)):
+            return self._sum(node)
         if isinstance(node, ast.BinOp):
             op = _BINARY.get(type(node.op))
             if op is None:
@@ -187,3 +191,20 @@ class _Converter:
                 raise self.fail(f"{node.func.id} takes {expected} argument(s), got {len(args)}")
             return ALLOWED_FUNCTIONS[node.func.id](*args)
         raise self.fail(f"{ast.unparse(node)!r} is not allowed in an expression")
+
+    def _sum(self, node: ast.BinOp) -> sympy.Expr:
+        """A chain ``a + b - c + ...`` as one sum, walked down its left spine without recursion.
+
+        Python parses a long sum (a Lagrangian of a thousand terms) into a left-nested tree
+        as deep as the sum is long; visiting it recursively would exceed the recursion
+        limit. The terms are converted one by one and added in one ``sympy.Add`` (the same
+        expression as adding them pairwise).
+        """
+        terms: list[tuple[bool, ast.AST]] = []
+        head: ast.AST = node
+        while isinstance(head, ast.BinOp) and isinstance(head.op, (ast.Add, ast.Sub)):
+            terms.append((isinstance(head.op, ast.Sub), head.right))
+            head = head.left
+        values = [self.visit(head)]
+        values.extend(-self.visit(term) if negative else self.visit(term) for negative, term in reversed(terms))
+        return sympy.Add(*values)

@@ -63,3 +63,14 @@ def test_arbitrary_text_either_parses_or_raises_input_error(text):
         return
     assert isinstance(result, sympy.Basic)
     assert result.free_symbols <= {x, y, m}
+
+
+def test_a_sum_of_thousands_of_terms_parses_without_recursion():
+    # Python nests a long sum to the left as deep as it is long; 2000 terms exceed the
+    # default recursion limit of a recursive walk
+    names = {f"a{k}": sympy.Symbol(f"a{k}", real=True) for k in range(2000)}
+    text = " + ".join(f"a{k}**2" for k in range(0, 2000, 2)) + " - " + " - ".join(f"a{k}" for k in range(1, 2000, 2))
+    result = parse_expression(text, names)
+    expected = sum(names[f"a{k}"] ** 2 for k in range(0, 2000, 2)) - sum(names[f"a{k}"] for k in range(1, 2000, 2))
+    assert sympy.expand(result - expected) == 0
+    assert parse_expression("x - (y - x) - 2", NAMES) == 2 * x - y - 2

@@ -7,16 +7,22 @@ candidate's gradient off the span of the earlier gradients. Done candidate by ca
 that is one QR factorisation of the whole base per candidate and point; here the base is
 factorised once per point (twice: the old constraints for kept candidates, the old and
 kept ones for dropped candidates) and every candidate projected on it — the same sizes,
-the same decisions, at the cost of one factorisation per point.
+the same decisions, at the cost of one factorisation per point. With sparse gradients
+(:func:`_normal_norms`) the projection is taken per connected block of the gradients'
+sparsity graph by sparse LU, and the dense factorisation is only the fallback.
 """
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
+import scipy.sparse as sp
 import sympy
+from scipy.sparse.linalg import MatrixRankWarning, splu
 
+from dirac.analysis.core.sparse_numeric import components, independent_rows_eliminated
 from dirac.analysis.legendre.regularity import IRREGULAR_GRADIENT, ROUND_OFF
 
 if TYPE_CHECKING:
@@ -41,6 +47,94 @@ def _normal_sizes(rows: np.ndarray, q: np.ndarray | None, scales: np.ndarray) ->
     return np.linalg.norm(normal, axis=1) / scales
 
 
+def _normal_norms(base: sp.csr_matrix, rows: sp.csr_matrix) -> np.ndarray | None:
+    """``|(1 - P) row|`` for each row of ``rows``, ``P`` the orthogonal projector onto the rows of ``base``; sparse.
+
+    The rows of ``base`` spanning its row space are chosen by sparse elimination; then, per
+    connected component of the rows' sparsity graph (a row is projected only on the base
+    rows it is connected to: the others span a space orthogonal to it), the projection is
+    ``B^T (B B^T)^{-1} B row`` by sparse LU of ``B B^T`` with one step of iterative
+    refinement (Björck, "Numerical Methods for Least Squares Problems", Sect. 2.9).
+    ``None`` when a choice or a factorisation is not clear (the caller takes the dense path).
+    """
+    norms = np.sqrt(np.asarray(rows.multiply(rows).sum(axis=1)).ravel())
+    if base.shape[0]:
+        chosen = independent_rows_eliminated([base], list(range(base.shape[0])))
+        if chosen is None:
+            return None
+        base = base[chosen]
+    if not base.shape[0] or not rows.shape[0]:
+        return norms
+    stacked = sp.vstack([base, rows]).tocsr()
+    pattern = (stacked != 0).astype(float)
+    nb = base.shape[0]
+    for block in components(pattern @ pattern.T):
+        inside_base = block[block < nb]
+        inside_rows = block[block >= nb] - nb
+        if not len(inside_base) or not len(inside_rows):
+            continue
+        B = base[inside_base]
+        R = rows[inside_rows]
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", MatrixRankWarning)
+                lu = splu((B @ B.T).tocsc())
+        except (RuntimeError, MatrixRankWarning):
+            return None
+        normal = R.toarray()
+        for _ in range(2):  # the projection and one refinement of it
+            coefficients = lu.solve(np.asarray(B @ normal.T))
+            if not np.all(np.isfinite(coefficients)):
+                return None
+            normal = normal - np.asarray(B.T @ coefficients).T
+        norms[inside_rows] = np.linalg.norm(normal, axis=1)
+    return norms
+
+
+def _irregular_sparse(
+    space: PhaseSpace,
+    numerics: Numerics,
+    candidates: list[sympy.Expr],
+    chosen: list[int],
+    old: list[sympy.Expr],
+    reducible: list[sympy.Expr],
+    points: list[np.ndarray],
+) -> list[int] | None:
+    """:func:`irregular_candidates` with sparse gradients (``None``: not decided sparsely, take the dense path)."""
+    kept = np.array([i in chosen for i in range(len(candidates))], dtype=bool)
+    everything = old + reducible + [candidates[i] for i in chosen]
+    stacked = numerics.sparse_gradients(everything, points)
+    rows = numerics.sparse_gradients(candidates, points)
+    n_old = len(old) + len(reducible)
+    sizes = np.zeros((len(points), len(candidates)))
+    for p in range(len(points)):
+        for flag, base in ((True, stacked[p][:n_old]), (False, stacked[p])):
+            selected = np.flatnonzero(kept == flag)
+            if not len(selected):
+                continue
+            norms = _normal_norms(base.tocsr(), rows[p][selected].tocsr())
+            if norms is None:
+                return None
+            sizes[p, selected] = norms
+    rough = np.zeros_like(sizes)
+    for p in range(len(points)):
+        for flag, base in ((True, stacked[p][:n_old]), (False, stacked[p])):
+            selected = np.flatnonzero(kept == flag)
+            largest = float(np.max(np.abs(base.data), initial=0.0)) if base.nnz else 0.0
+            rough[p, selected] = sizes[p, selected] / (1.0 + largest)
+    found = []
+    for i, c in enumerate(candidates):
+        if np.max(rough[:, i]) > 1e-2:  # clearly regular: skip the finer test
+            continue
+        dq, dp = space.partials(c)
+        terms = [*dq.values(), *dp.values()]
+        scales = (numerics.term_scale(terms, points) - 1.0).sum(axis=1) + 1.0 if terms else np.ones(len(points))
+        fine = sizes[:, i] / scales  # 1 + sum of |terms| of the gradient
+        if np.all(fine < IRREGULAR_GRADIENT) and np.any(fine > ROUND_OFF):
+            found.append(i)
+    return found
+
+
 def irregular_candidates(
     space: PhaseSpace,
     numerics: Numerics,
@@ -57,6 +151,9 @@ def irregular_candidates(
     ``IRREGULAR_GRADIENT`` times the gradient's term size at every point, yet above
     ``ROUND_OFF`` at one, marks an irregular constraint.
     """
+    sparse = _irregular_sparse(space, numerics, candidates, chosen, old, reducible, points)
+    if sparse is not None:
+        return sparse
     n = len(space.variables)
     kept = np.array([i in chosen for i in range(len(candidates))], dtype=bool)
     everything = old + reducible + [candidates[i] for i in chosen]

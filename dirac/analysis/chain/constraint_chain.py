@@ -155,7 +155,8 @@ class ConstraintChain:
     @property
     def total_hamiltonian(self) -> sympy.Expr:
         """``H_T = H_c + sum_k u_k phi_k`` ((207), (234))."""
-        return self.canonical_hamiltonian + sum((u * phi for u, phi in zip(self.multipliers, self.primary)), sympy.S.Zero)
+        # one sum (adding term by term re-sorts the growing sum each time: O(n^2))
+        return sympy.Add(self.canonical_hamiltonian, *(u * phi for u, phi in zip(self.multipliers, self.primary)))
 
     # ------------------------------------------------------------------ helpers
     def _rows(self, constraint: sympy.Expr) -> tuple[sympy.Expr, list[sympy.Expr]]:
@@ -167,18 +168,51 @@ class ConstraintChain:
                 b = b + sympy.diff(constraint, self.time)
             for momentum, force in self.forces.items():  # p_dot = -dH/dq + Q: + sum_r dPhi/dp_r Q_r
                 b = b + sympy.diff(constraint, momentum) * force
-            cached = (b, [pb(constraint, phi) for phi in self.primary])
+            row = [sympy.S.Zero] * len(self.primary)
+            support = []
+            for k in self._sharing(constraint):  # only primaries sharing a canonical pair can give a non-zero bracket
+                row[k] = pb(constraint, self.primary[k])
+                if row[k] != 0:
+                    support.append(k)
+            cached = (b, row)
             self._row_cache[constraint] = cached
+            self._row_support[constraint] = support
         return cached
+
+    def _sharing(self, constraint: sympy.Expr) -> list[int]:
+        """Primary constraints that contain the ``p`` of a ``q`` in ``constraint`` or the ``q`` of a ``p`` in it."""
+        index = getattr(self, "_primary_index", None)
+        if index is None or index[0] is not self.primary:
+            by_q: dict[sympy.Symbol, list[int]] = {}
+            by_p: dict[sympy.Symbol, list[int]] = {}
+            for k, phi in enumerate(self.primary):
+                dq, dp = self.phase_space.partials(phi)
+                for q in dq:
+                    by_q.setdefault(q, []).append(k)
+                for q in dp:
+                    by_p.setdefault(q, []).append(k)
+            index = self._primary_index = (self.primary, by_q, by_p)
+        _, by_q, by_p = index
+        dq, dp = self.phase_space.partials(constraint)
+        found = {k for q in dq for k in by_p.get(q, ())} | {k for q in dp for k in by_q.get(q, ())}
+        return sorted(found)
 
     def _numeric_rows(self, constraints: list[sympy.Expr], points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         K = len(self.primary)
         exprs = []
-        for c in constraints:
+        where = []  # flat positions of the entries that are not identically zero (most, at scale, are)
+        for a, c in enumerate(constraints):
             b, A = self._rows(c)
-            exprs.append(b)
-            exprs.extend(A)
-        values = self.numerics.evaluate(exprs, points).reshape(len(points), len(constraints), K + 1)
+            if b != 0:
+                exprs.append(b)
+                where.append(a * (K + 1))
+            for k in self._row_support[c]:
+                exprs.append(A[k])
+                where.append(a * (K + 1) + k + 1)
+        flat = np.zeros((len(points), len(constraints) * (K + 1)))
+        if exprs:
+            flat[:, where] = self.numerics.evaluate(exprs, points)
+        values = flat.reshape(len(points), len(constraints), K + 1)
         return values[:, :, 0], values[:, :, 1:]
 
     # ------------------------------------------------------------------ the algorithm
@@ -203,6 +237,7 @@ class ConstraintChain:
 
     def _run(self, max_stages: int | None) -> ConstraintChain:
         self._row_cache: dict = {}
+        self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
         points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
@@ -354,6 +389,7 @@ class ConstraintChain:
         for f in fields(self):
             setattr(self, f.name, getattr(adopted, f.name))
         self._row_cache = adopted._row_cache
+        self._row_support = adopted._row_support
         self.pivots = adopted.pivots
         self.regularity_notes = [*adopted.regularity_notes, *notes]
         return self
@@ -548,6 +584,10 @@ class ConstraintChain:
 
     def _independent(self, candidates: list[sympy.Expr], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
         n = len(self.phase_space.variables)
+        if n >= LARGE_SYSTEM:  # sparse gradients, independence by sparse elimination
+            cand_sparse = self.numerics.sparse_gradients(candidates, points)
+            base_sparse = self.numerics.sparse_gradients(old, points) if old else None
+            return independent_rows(cand_sparse, list(range(len(candidates))), base=base_sparse, notes=self.regularity_notes)
         grads = [g for c in candidates for g in self.phase_space.gradient(c)]
         cand = self.numerics.evaluate(grads, points).reshape(len(points), len(candidates), n)
         if old:

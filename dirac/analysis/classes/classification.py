@@ -15,11 +15,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.sparse_numeric import components
 from dirac.analysis.legendre.regularity import branch_hint
 from dirac.errors import AnalysisError, SeparableParts
 
@@ -56,7 +58,40 @@ def bracket_matrix(space: PhaseSpace, constraints: list[sympy.Expr]) -> sympy.Ma
         if value != 0:
             entries[(a, b)] = value
             entries[(b, a)] = -value
-    return sympy.Matrix(sympy.SparseMatrix(m, m, entries)) if m else sympy.zeros(0, 0)
+    if not m:
+        return sympy.zeros(0, 0)
+    sparse = sympy.SparseMatrix(m, m, entries)
+    return sparse if m >= SPARSE_BRACKETS else sympy.Matrix(sparse)
+
+
+#: from this many constraints :func:`bracket_matrix` returns a ``sympy.SparseMatrix`` (most entries are zero)
+SPARSE_BRACKETS = 64
+
+
+def _rank_by_blocks(m: int, rows: np.ndarray, cols: np.ndarray, values: np.ndarray) -> int:
+    """The rank of the ``m x m`` matrix with ``values`` at ``(rows, cols)``, as :func:`numeric_rank` gives it.
+
+    The matrix is block diagonal over the connected components of its sparsity graph, so
+    its singular values are those of the blocks together: each block's are taken densely,
+    and the rank counts those above ``1e-8`` times the largest of all (the cut of
+    :func:`numeric_rank`). Cost: the blocks' sizes cubed, not ``m^3``.
+    """
+    keep = values != 0.0
+    if not np.any(keep):
+        return 0
+    pattern = sp.coo_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m)).tocsr()
+    matrix = sp.csr_matrix((values[keep], (rows[keep], cols[keep])), shape=(m, m))
+    singular = [
+        np.linalg.svd(matrix[block][:, block].toarray(), compute_uv=False)
+        for block in components(pattern + pattern.T)
+        if len(block) > 1 or matrix[block[0], block[0]] != 0.0
+    ]
+    if not singular:
+        return 0
+    pooled = np.concatenate(singular)
+    if not np.all(np.isfinite(pooled)):
+        return numeric_rank(matrix.toarray())  # raises the error about non-finite entries
+    return int(np.sum(pooled > 1e-8 * np.max(pooled))) if np.max(pooled) > 0 else 0
 
 
 @dataclass
@@ -92,19 +127,18 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
     if C is None:
         C = bracket_matrix(space, constraints)
     nonzero = C.todok()  # only the non-zero entries are compiled and evaluated (most, for a local system, are zero)
-    values = np.zeros((len(points), m, m))
-    if nonzero:
-        where = list(nonzero)
-        at = numerics.evaluate([nonzero[k] for k in where], points)
-        rows = np.array([i for i, _ in where], dtype=int)
-        cols = np.array([j for _, j in where], dtype=int)
-        values[:, rows, cols] = at
-    scale = 1.0 + np.max(np.abs(values), axis=(1, 2), keepdims=True)
-    tiny = np.all(np.abs(values) <= 1e-9 * scale, axis=0)
-    alone_first = [a for a in range(m) if np.all(tiny[a])]
-    rest = [a for a in range(m) if a not in alone_first]
-    # entries at round-off of the matrix's scale are weak zeros, as in ``tiny``: not rank
-    ranks = [numeric_rank(np.where(np.abs(v) <= 1e-9 * sc, 0.0, v)) for v, sc in zip(values, scale)]
+    where = list(nonzero)
+    at = numerics.evaluate([nonzero[k] for k in where], points) if where else np.zeros((len(points), 0))
+    rows = np.array([i for i, _ in where], dtype=int)
+    cols = np.array([j for _, j in where], dtype=int)
+    scale = 1.0 + np.max(np.abs(at), axis=1, initial=0.0)
+    # entries at round-off of the matrix's scale are weak zeros: they make no constraint second class, nor rank
+    big = np.abs(at) > 1e-9 * scale[:, None]
+    touched = np.zeros(m, dtype=bool)
+    touched[rows[np.any(big, axis=0)]] = True
+    alone_first = [a for a in range(m) if not touched[a]]
+    rest = [a for a in range(m) if touched[a]]
+    ranks = [_rank_by_blocks(m, rows, cols, np.where(b, v, 0.0)) for v, b in zip(at, big)]
     if len(set(ranks)) > 1:
         raise SeparableParts(
             f"the rank of the bracket matrix C_ab = {{Phi_a, Phi_b}} differs between regular points of the constraint "
@@ -118,8 +152,14 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
     rank = ranks[0] if ranks else 0
     if not rest:
         return Classification(list(constraints), [], [], 0, 0)
-    S = independent_rows([v[np.ix_(rest, rest)] for v in values], list(range(len(rest))))
-    S = [rest[i] for i in S]
+    # the values of C among the constraints that are not first class alone (dense: the second-class part)
+    position = {a: k for k, a in enumerate(rest)}
+    inside = np.array([i in position and j in position for i, j in where], dtype=bool)
+    values = np.zeros((len(points), len(rest), len(rest)))
+    if np.any(inside):
+        values[:, [position[i] for i in rows[inside]], [position[j] for j in cols[inside]]] = at[:, inside]
+    chosen = independent_rows(list(values), list(range(len(rest))))
+    S = [rest[i] for i in chosen]
     if len(S) != rank:
         raise AnalysisError(
             f"the second-class block found ({len(S)} constraints) does not match the rank {rank} of C_ab = "
@@ -130,8 +170,8 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
     for a in rest:
         if a in S:
             continue
-        sub = [v[np.ix_(S, S)].T for v in values]
-        rhs = [-v[a, S].reshape(-1, 1) for v in values]
+        sub = [v[np.ix_(chosen, chosen)].T for v in values]
+        rhs = [-v[position[a], chosen].reshape(-1, 1) for v in values]
         k = weak_solve(C[S, S].T, -C[a, S].T, sub, rhs, variables=space.variables)
         combo = constraints[a] + sum((k[i, 0] * constraints[s] for i, s in enumerate(S)), sympy.S.Zero)
         first.append(combo)

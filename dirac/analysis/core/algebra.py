@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
+from typing import Any
 
 import sympy
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["tidy", "prints_shorter"]
+__all__ = ["tidy", "prints_shorter", "present_in_order"]
 
 
 class _NotRational(Exception):
@@ -178,6 +179,77 @@ def _poly_to_expr(p, variables: Sequence[sympy.Symbol], others: Sequence[sympy.S
     return sympy.Add(*terms)
 
 
+_POSITIONS: dict[int, tuple[Sequence[sympy.Symbol], dict[sympy.Symbol, int]]] = {}
+
+
+def present_in_order(variables: Sequence[sympy.Symbol], present: set | frozenset) -> list[sympy.Symbol]:
+    """The ``variables`` that are in ``present``, in the order of ``variables``.
+
+    ``O(len(present))`` for a long sequence passed again and again (the phase-space
+    variables): its positions are kept for the last few sequences, recognised by identity.
+    """
+    if len(variables) <= 2 * len(present) + 8:
+        return [v for v in variables if v in present]
+    held = _POSITIONS.get(id(variables))
+    if held is None or held[0] is not variables:
+        if len(_POSITIONS) >= 8:
+            _POSITIONS.clear()
+        held = (variables, {v: k for k, v in enumerate(variables)})
+        _POSITIONS[id(variables)] = held
+    position = held[1]
+    return sorted((v for v in present if v in position), key=position.__getitem__)
+
+
+def _tidy_by_term(work: sympy.Expr, variables: Sequence[sympy.Symbol], others: Sequence[sympy.Symbol], back: dict) -> sympy.Expr | None:
+    """:func:`_poly_to_expr` of the polynomial ``work`` (a long sum), expanded term by term; ``None`` if a term is not one.
+
+    Each term is evaluated in the small ring of its own generators and the monomials are
+    merged by their exponents (kept sparse): a ring of all the generators of a long sum
+    costs ``O(generators)`` per monomial operation (dense exponent tuples), ``O(n^2)`` for
+    ``n`` terms. The result is the expression :func:`_poly_to_expr` gives for the whole.
+    """
+    vpos = {v: k for k, v in enumerate(variables)}
+    opos = {o: k for k, o in enumerate(others)}
+    merged: dict[tuple[tuple, tuple], Any] = {}
+    for term in work.args:
+        if term.is_Rational:
+            key: tuple[tuple, tuple] = ((), ())
+            merged[key] = merged.get(key, sympy.QQ(0)) + sympy.QQ(int(term.p), int(term.q))
+            continue
+        free = term.free_symbols
+        own_v = sorted((v for v in free if v in vpos), key=vpos.__getitem__)
+        own_o = sorted((o for o in free if o in opos), key=opos.__getitem__)
+        gens_all = [*own_v, *own_o]
+        if not gens_all or len(gens_all) < len(free):
+            return None
+        ring = PolyRing(gens_all, sympy.QQ)
+        value = _evaluate(term, dict(zip(gens_all, ring.gens)), ring, allow_division=False)
+        nv = len(own_v)
+        for monom, c in value.terms():
+            key = (
+                tuple((vpos[own_v[i]], e) for i, e in enumerate(monom[:nv]) if e),
+                tuple((opos[own_o[i]], e) for i, e in enumerate(monom[nv:]) if e),
+            )
+            merged[key] = merged.get(key, sympy.QQ(0)) + c
+    groups: dict[tuple, list[sympy.Expr]] = {}
+    for (vkey, okey), c in merged.items():
+        if not c:
+            continue
+        coeff = sympy.Rational(int(c.numerator), int(c.denominator)) * sympy.Mul(*[others[i] ** e for i, e in okey])
+        groups.setdefault(vkey, []).append(coeff)
+    terms = []
+    for vkey, coeffs in groups.items():
+        coeff = sympy.Add(*coeffs).xreplace(back) if back else sympy.Add(*coeffs)
+        if back and len(coeffs) > 1:
+            coeff = _combined(coeff)
+        terms.append(coeff * sympy.Mul(*[variables[i] ** e for i, e in vkey]))
+    return sympy.Add(*terms)
+
+
+#: sums of more terms than this are expanded term by term (:func:`_tidy_by_term`)
+PIECEWISE_TERMS = 64
+
+
 def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = False, rational: bool = True) -> sympy.Expr:
     """Readable exact form: expanded in the phase-space ``variables`` over one denominator.
 
@@ -190,7 +262,7 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
     """
     expr = sympy.sympify(expr)
     present = expr.free_symbols
-    variables = [v for v in variables if v in present]
+    variables = present_in_order(variables, present)
     if not variables:
         out = sympy.cancel(expr) if expr.free_symbols else expr
         return -out if sign and out.could_extract_minus_sign() else out
@@ -201,8 +273,12 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
     ring = PolyRing(gens_all, sympy.QQ)
     gens = dict(zip(gens_all, ring.gens))
     try:
-        value = _evaluate(work, gens, ring, allow_division=False)
-        out = _poly_to_expr(value, variables, others, back)
+        by_term = _tidy_by_term(work, variables, others, back) if work.is_Add and len(work.args) > PIECEWISE_TERMS else None
+        if by_term is not None:
+            out = by_term
+        else:
+            value = _evaluate(work, gens, ring, allow_division=False)
+            out = _poly_to_expr(value, variables, others, back)
     except (_NotRational, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
         if not rational:  # rational normal forms need gcds: too slow for large expressions
             return expr

@@ -16,7 +16,14 @@ from collections.abc import Sequence
 import sympy
 from sympy.polys.rings import PolyElement, PolyRing
 
-__all__ = ["PolynomialPartials"]
+__all__ = ["PolynomialPartials", "SPARSE_HESSIAN"]
+
+#: sums of more terms than this are differentiated term by term (:meth:`PolynomialPartials.partials`)
+PIECEWISE_TERMS = 64
+
+#: from this many velocities :func:`quadratic_parts` returns ``W`` as a ``sympy.SparseMatrix``
+#: (a dense one of a large local system holds ``n^2`` zeros, and scanning it costs ``O(n^2)``)
+SPARSE_HESSIAN = 64
 
 
 class _NotPolynomial(Exception):
@@ -44,6 +51,7 @@ class PolynomialPartials:
         self.variables = tuple(variables)
         self.parameters = tuple(parameters)
         self._variable_set = frozenset(self.variables)
+        self._position = {v: k for k, v in enumerate(self.variables)}
         self._allowed = self._variable_set | set(self.parameters)
 
     def _atoms(self, e: sympy.Expr, found: dict, seen: set) -> None:
@@ -105,7 +113,7 @@ class PolynomialPartials:
             self._atoms(expr, atoms, set())
         except _NotPolynomial:
             return None
-        variables = [v for v in self.variables if v in free]
+        variables = sorted(free & self._variable_set, key=self._position.__getitem__)  # O(size), not O(all variables)
         params = sorted((free - self._variable_set), key=lambda s: s.name)
         symbols = [*variables, *params]
         ring = PolyRing([*symbols, *atoms.values()], sympy.QQ)
@@ -129,19 +137,47 @@ class PolynomialPartials:
         differentiates with sympy. Only the variables that occur in ``expr`` are
         differentiated.
         """
+        if expr.is_Add and len(expr.args) > PIECEWISE_TERMS:
+            return self._partials_by_term(expr, wanted)
         found = self.element(expr)
         if found is None:
             return None
         p, variables, back = found
-        position = {v: k for k, v in enumerate(variables)}
         out: dict[sympy.Symbol, sympy.Expr] = {}
-        for s in wanted:
-            k = position.get(s)
-            if k is None:
-                continue
+        if wanted is not self.variables:  # the ring's variables that are wanted, in the order of ``wanted``
+            position = {v: k for k, v in enumerate(variables)}
+            pairs = [(s, position[s]) for s in wanted if s in position]
+        else:
+            pairs = [(s, k) for k, s in enumerate(variables)]
+        for s, k in pairs:
             d = p.diff(k)
             if d:
                 out[s] = self.to_expr(d, back)
+        return out
+
+
+    def _partials_by_term(self, expr: sympy.Expr, wanted: Sequence[sympy.Symbol]) -> dict[sympy.Symbol, sympy.Expr] | None:
+        """:meth:`partials` of a long sum, term by term, each in the small ring of its own variables.
+
+        A ring of all the variables a long sum contains costs ``O(variables)`` per monomial
+        operation (exponent tuples are dense), so differentiating a Hamiltonian of ``n``
+        terms by each of its variables costs ``O(n^2)``; term by term it costs ``O(n)``. The
+        derivative of each term is expanded, and their sum, collected by ``sympy.Add``, is the
+        expanded derivative of the whole (the same expression).
+        """
+        pieces: dict[sympy.Symbol, list[sympy.Expr]] = {}
+        for term in expr.args:
+            found = self.partials(term, wanted)
+            if found is None:
+                return None
+            for s, d in found.items():
+                pieces.setdefault(s, []).append(d)
+        order = wanted if wanted is not self.variables else self.variables
+        out: dict[sympy.Symbol, sympy.Expr] = {}
+        for s in (s for s in order if s in pieces):
+            total = sympy.Add(*pieces[s])
+            if total != 0:
+                out[s] = total
         return out
 
 
@@ -152,37 +188,83 @@ def quadratic_parts(
 
     ``W_ij = d^2 L / dv_i dv_j``, ``a_i = dL/dv_i`` at ``v = 0``, ``V = -L`` at ``v = 0``
     (the split of :mod:`dirac.analysis.legendre`), computed in the sparse ring: only the
-    non-zero entries of ``W`` are built, so a local Lagrangian with ``n`` velocities costs
-    ``O(n)``, not the ``n^2`` second derivatives of ``sympy.diff``. ``None`` when ``L`` is not
+    non-zero entries of ``W`` are built, a long sum term by term in the small ring of each
+    term's variables, so a local Lagrangian with ``n`` velocities costs ``O(n)``, not the ``n^2``
+    second derivatives of ``sympy.diff``; from ``SPARSE_HESSIAN`` velocities ``W`` is a
+    ``sympy.SparseMatrix``. ``None`` when ``L`` is not
     a polynomial in the coordinates and velocities, or when it is not quadratic in the
     velocities (the caller then takes the general path, with its own error messages).
     """
     forms = PolynomialPartials((*velocities, *coordinates), parameters)
-    found = forms.element(expression)
+    n = len(velocities)
+    column = {v: j for j, v in enumerate(velocities)}
+    pieces = _summands(expression)
+    # a long sum piece by piece, each in the small ring of its own variables (a ring of all the
+    # variables costs O(n) per monomial operation); the whole at once if a piece is not quadratic
+    found = [_split(forms, piece, column) for piece in pieces] if len(pieces) > 1 else [None]
+    parts = [part for part in found if part is not None]
+    if len(parts) < len(found):
+        whole = _split(forms, expression, column)
+        if whole is None:
+            return None
+        parts = [whole]
+    entries: dict[tuple[int, int], list[sympy.Expr]] = {}
+    linear: dict[int, list[sympy.Expr]] = {}
+    static: list[sympy.Expr] = []
+    for part in parts:
+        for key, value in part[0].items():
+            entries.setdefault(key, []).append(value)
+        for i, value in part[1].items():
+            linear.setdefault(i, []).append(value)
+        static.extend(part[2])
+    summed = {key: sympy.Add(*values) for key, values in entries.items()}
+    summed = {key: value for key, value in summed.items() if value != 0}
+    a = [sympy.Add(*linear[i]) if i in linear else sympy.S.Zero for i in range(n)]
+    W = sympy.SparseMatrix(n, n, summed) if n >= SPARSE_HESSIAN else sympy.Matrix(sympy.SparseMatrix(n, n, summed))
+    return W, a, -sympy.Add(*static)
+
+
+def _summands(expr: sympy.Expr) -> list[sympy.Expr]:
+    """The terms of ``expr`` as a sum, distributing a product over its one sum factor (``c (a + b)``)."""
+    if expr.is_Add:
+        return [t for arg in expr.args for t in _summands(arg)]
+    if expr.is_Mul:
+        sums = [f for f in expr.args if f.is_Add]
+        if len(sums) == 1:
+            rest = sympy.Mul(*[f for f in expr.args if f is not sums[0]])
+            return [rest * t for t in _summands(sums[0])]
+    return [expr]
+
+
+def _split(
+    forms: PolynomialPartials, expr: sympy.Expr, column: dict[sympy.Symbol, int]
+) -> tuple[dict[tuple[int, int], sympy.Expr], dict[int, sympy.Expr], list[sympy.Expr]] | None:
+    """``W`` entries, ``a`` entries and the velocity-free part of one polynomial, or ``None``.
+
+    ``None`` when ``expr`` is not a polynomial in the ring's variables or has a monomial of
+    degree above 2 in the velocities (``column`` maps each velocity to its index).
+    """
+    found = forms.element(expr)
     if found is None:
         return None
     p, variables, back = found
     ring = p.ring
-    index = {v: k for k, v in enumerate(variables)}
-    vel = [index.get(v) for v in velocities]
-    vel_positions = [k for k in vel if k is not None]
+    vel = [(k, column[v]) for k, v in enumerate(variables) if v in column]
+    vel_positions = [k for k, _ in vel]
     if any(sum(monom[k] for k in vel_positions) > 2 for monom in p.itermonoms()):
         return None
-    n = len(velocities)
     static = ring.from_dict({m: c for m, c in p.items() if all(m[k] == 0 for k in vel_positions)})
-    W = sympy.zeros(n, n)
-    a: list[sympy.Expr] = [sympy.S.Zero] * n
-    for i, ki in enumerate(vel):
-        if ki is None:
-            continue
+    entries: dict[tuple[int, int], sympy.Expr] = {}
+    linear: dict[int, sympy.Expr] = {}
+    for ki, i in vel:
         first = p.diff(ki)
-        linear = ring.from_dict({m: c for m, c in first.items() if all(m[k] == 0 for k in vel_positions)})
-        a[i] = forms.to_expr(linear, back) if linear else sympy.S.Zero
-        for j, kj in enumerate(vel):
-            if kj is None or j < i:
+        part = ring.from_dict({m: c for m, c in first.items() if all(m[k] == 0 for k in vel_positions)})
+        if part:
+            linear[i] = forms.to_expr(part, back)
+        for kj, j in vel:
+            if j < i:
                 continue
             second = first.diff(kj)
             if second:
-                W[i, j] = W[j, i] = forms.to_expr(second, back)
-    V = -forms.to_expr(static, back) if static else sympy.S.Zero
-    return W, a, V
+                entries[(i, j)] = entries[(j, i)] = forms.to_expr(second, back)
+    return entries, linear, [forms.to_expr(static, back)] if static else []

@@ -20,10 +20,11 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.core.sparse_numeric import independent_rows_one_pass
+from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
@@ -79,7 +80,9 @@ def numeric_rank(matrix: np.ndarray, tol: float = 1e-8, scale: float | None = No
     return int(np.sum(s > tol * max(s[0], scale or 0.0)))
 
 
-def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base: Sequence[np.ndarray] | None = None) -> list[int]:
+def independent_rows(
+    matrices: Sequence[Any], order: Sequence[int], base: Sequence[Any] | None = None, notes: list[str] | None = None
+) -> list[int]:
     """Greedy choice of rows that raise the rank, in the given order of preference.
 
     Parameters
@@ -92,15 +95,32 @@ def independent_rows(matrices: Sequence[np.ndarray], order: Sequence[int], base:
         Rows already chosen (one block per point) that every candidate must be
         independent of.
 
+    notes
+        Where a note is added when sparse rows could not be decided by elimination.
+
     Returns
     -------
     list of int
         Chosen row indices; a row is kept when it raises the rank at a majority of points.
 
-    Large matrices (rows from ``LARGE_ROWS`` or columns from ``LARGE_SYSTEM``) are decided
+    Sparse matrices (``scipy.sparse``, rows of a local system) are decided by sparse
+    elimination (:func:`~dirac.analysis.core.sparse_numeric.independent_rows_eliminated`);
+    where a reduced row is neither clearly zero nor clearly not at some point, by the dense
+    pass below, with a note. Large dense matrices (rows from ``LARGE_ROWS`` or columns from ``LARGE_SYSTEM``) are decided
     in one orthogonalisation pass per point
     (:func:`~dirac.analysis.core.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
     """
+    if len(matrices) and sp.issparse(matrices[0]):
+        eliminated = independent_rows_eliminated(matrices, order, base)
+        if eliminated is not None:
+            return eliminated
+        if notes is not None:
+            notes.append(
+                "independence of rows: sparse elimination met a row neither clearly dependent nor clearly "
+                "independent at a sample point, so that choice was made on the dense path (orthogonalisation)"
+            )
+        matrices = [m.toarray() for m in matrices]
+        base = [b.toarray() if sp.issparse(b) else b for b in base] if base is not None else None
     if len(matrices) and matrices[0].ndim == 2 and (
         len(order) + (len(base[0]) if base is not None else 0) >= LARGE_ROWS or matrices[0].shape[1] >= LARGE_SYSTEM
     ):
@@ -203,6 +223,15 @@ class Numerics:
         """Values of ``exprs`` at each point: array of shape ``(len(points), len(exprs))``."""
         fn = self.function(exprs)
         return np.array([fn(z) for z in points], dtype=float).reshape(len(points), len(exprs))
+
+    def sparse_gradients(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> list[sp.csr_matrix]:
+        """The gradients of ``exprs`` (rows, in the order of the phase-space variables) at each point, as sparse matrices.
+
+        Only the non-zero partial derivatives are compiled and evaluated: ``O(non-zeros)``
+        for the constraints of a local system, instead of ``len(exprs)`` times the dimension.
+        """
+        jacobian = SparseJacobian(self, [sympy.sympify(e) for e in exprs], REGULAR_TOLERANCE, SINGULAR_GRADIENT)
+        return [jacobian(z) for z in points]
 
     def term_scale(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
         """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests)."""

@@ -118,8 +118,12 @@ class PhaseSpace:
 
     @property
     def variables(self) -> tuple[sympy.Symbol, ...]:
-        """``coordinates + momenta``: the order of every numeric phase-space vector."""
-        return self.coordinates + self.momenta
+        """``coordinates + momenta``: the order of every numeric phase-space vector (the same tuple each time)."""
+        cached = self.__dict__.get("_variables")
+        if cached is None or cached[0] is not self.coordinates or cached[1] is not self.momenta:
+            cached = (self.coordinates, self.momenta, self.coordinates + self.momenta)
+            self.__dict__["_variables"] = cached
+        return cached[2]
 
     @property
     def dimension(self) -> int:
@@ -146,10 +150,11 @@ class PhaseSpace:
             return cached
         if self._polynomials is None:
             self._polynomials = PolynomialPartials(self.variables, self.parameters)
-        found = self._polynomials.partials(expr, self.variables)
+        found = self._polynomials.partials(expr, self._polynomials.variables)
         if found is not None:
-            pairs = list(zip(self.coordinates, self.momenta))
-            fast = ({q: found[q] for q, _ in pairs if q in found}, {q: found[p] for q, p in pairs if p in found})
+            coordinate_of = self._coordinate_of()  # (coordinate, whether the variable is a momentum)
+            fast = ({coordinate_of[s][0]: d for s, d in found.items() if not coordinate_of[s][1]},  # ordered as the variables
+                    {coordinate_of[s][0]: d for s, d in found.items() if coordinate_of[s][1]})
             self._gradients[expr] = fast
             return fast
         free = _free_symbols_memo(expr)
@@ -166,6 +171,14 @@ class PhaseSpace:
                     dp[q] = d
         self._gradients[expr] = (dq, dp)
         return dq, dp
+
+    def _coordinate_of(self) -> dict[sympy.Symbol, tuple[sympy.Symbol, bool]]:
+        """Each variable -> its coordinate and whether it is a momentum (``q -> (q, False)``, ``p_q -> (q, True)``)."""
+        found = self.__dict__.get("_coordinates_of")
+        if found is None:
+            found = {**{p: (q, True) for q, p in zip(self.coordinates, self.momenta)}, **{q: (q, False) for q in self.coordinates}}
+            self.__dict__["_coordinates_of"] = found
+        return found
 
     def poisson_bracket(self, f: sympy.Expr, g: sympy.Expr) -> sympy.Expr:
         """Canonical Poisson bracket ``{f, g} = sum_i df/dq_i dg/dp_i - df/dp_i dg/dq_i``.

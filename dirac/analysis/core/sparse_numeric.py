@@ -24,6 +24,7 @@ components of its sparsity graph (dense eigenvalues of each small block).
 
 from __future__ import annotations
 
+import heapq
 import warnings
 from collections.abc import Sequence
 
@@ -32,7 +33,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import MatrixRankWarning, lsqr, splu
 
-__all__ = ["independent_rows_one_pass", "minimum_norm_step", "full_row_rank", "components", "ZERO"]
+__all__ = ["independent_rows_one_pass", "independent_rows_eliminated", "Undecided", "CLEAR", "minimum_norm_step", "full_row_rank", "components", "ZERO"]
 
 #: relative size of the orthogonal part below which a row counts as dependent
 ZERO = 1e-8
@@ -123,6 +124,143 @@ def independent_rows_one_pass(
     return chosen
 
 
+#: a reduced row below ``ZERO`` times the stack's size is dependent, above ``CLEAR`` times it
+#: independent; in between the elimination does not decide (the dense pass does)
+CLEAR = 1e-6
+
+
+class Undecided(Exception):
+    """A row the sparse elimination cannot classify clearly: the dense pass must decide."""
+
+
+class _Echelon:
+    """Rows kept so far at one point, in echelon form: pivot column -> (position, row scaled to pivot 1).
+
+    A row kept at position ``k`` is zero at the pivot columns of the rows kept before it, so a
+    new row is reduced by the pivot rows in the order they were kept (a heap of the pivot
+    columns it touches); the fill stays local for the rows of a local system.
+    """
+
+    def __init__(self) -> None:
+        self.rows: dict[int, tuple[int, dict[int, float]]] = {}
+        self.scale = 0.0
+
+    def reduce(self, row: dict[int, float]) -> dict[int, float]:
+        """``row`` minus the combination of kept rows that clears it at every pivot column."""
+        out = dict(row)
+        heap = [(self.rows[c][0], c) for c in out if c in self.rows]
+        heapq.heapify(heap)
+        while heap:
+            _, c = heapq.heappop(heap)
+            factor = out.pop(c, 0.0)
+            if factor == 0.0:
+                continue
+            for k, x in self.rows[c][1].items():
+                if k == c:
+                    continue
+                if k not in out and k in self.rows:
+                    heapq.heappush(heap, (self.rows[k][0], k))
+                out[k] = out.get(k, 0.0) - factor * x
+        return out
+
+    def decide(self, row: dict[int, float]) -> tuple[bool, dict[int, float]]:
+        """Whether ``row`` is independent of the kept rows (relative to the stack's size), and its reduced form.
+
+        Raises
+        ------
+        Undecided
+            When the reduced row is neither below ``ZERO`` nor above ``CLEAR`` times the size.
+        """
+        values = np.fromiter(row.values(), dtype=float, count=len(row))
+        norm = float(np.linalg.norm(values))
+        if not np.isfinite(norm):
+            return False, row
+        scale = max(self.scale, norm)
+        if scale == 0.0:
+            return False, row
+        reduced = self.reduce(row)
+        size = float(np.linalg.norm(np.fromiter(reduced.values(), dtype=float, count=len(reduced))))
+        if size <= ZERO * scale:
+            return False, reduced  # the part normal to the kept rows is at most the reduced row: dependent
+        if size > CLEAR * scale and np.isfinite(size):
+            return True, reduced
+        raise Undecided
+
+    def add(self, row: dict[int, float], reduced: dict[int, float]) -> None:
+        """Keep ``row``: its reduced form, scaled so that its largest entry (the pivot) is 1."""
+        pivot = max(reduced, key=lambda k: (abs(reduced[k]), -k))
+        value = reduced[pivot]
+        self.rows[pivot] = (len(self.rows), {k: x / value for k, x in reduced.items() if x != 0.0})
+        values = np.fromiter(row.values(), dtype=float, count=len(row))
+        self.scale = max(self.scale, float(np.linalg.norm(values)))
+
+
+def _sparse_rows(matrix: sp.spmatrix | np.ndarray) -> list[dict[int, float]]:
+    """The rows of ``matrix`` as ``{column: value}`` of their non-zero entries."""
+    M = sp.csr_matrix(matrix, dtype=float)
+    M.eliminate_zeros()
+    return [
+        dict(zip(M.indices[M.indptr[i] : M.indptr[i + 1]].tolist(), M.data[M.indptr[i] : M.indptr[i + 1]].tolist()))
+        for i in range(M.shape[0])
+    ]
+
+
+def independent_rows_eliminated(
+    matrices: Sequence[sp.spmatrix | np.ndarray], order: Sequence[int], base: Sequence[sp.spmatrix | np.ndarray] | None = None
+) -> list[int] | None:
+    """Greedy choice of rows that raise the rank, in the given order, at a majority of points, by sparse elimination.
+
+    The choice of :func:`dirac.analysis.core.numeric.independent_rows` for sparse rows: at each
+    point the kept rows are held in echelon form (Gaussian elimination with the largest entry
+    of each reduced row as its pivot, Golub & Van Loan, *Matrix Computations*, Sect. 3.4) and a
+    candidate is reduced by them. The reduced row differs from the candidate by a
+    combination of kept rows, so its norm bounds the part of the candidate normal to them
+    from above: below ``ZERO`` times the size of the stack the row is dependent, as in the
+    orthogonalisation pass; above ``CLEAR`` times the size it is independent. A row in
+    between at some point is not decided here: ``None`` is returned and the caller takes the
+    dense pass. Cost: the fill of the elimination, ``O(non-zeros)`` for the rows of a local system.
+
+    Parameters
+    ----------
+    matrices
+        The same matrix at several surface points (scipy sparse or dense arrays).
+    order
+        Row indices in order of preference.
+    base
+        Rows already chosen, one block per point, that every candidate must be independent of.
+
+    Returns
+    -------
+    list of int or None
+        Chosen row indices, or ``None`` when a decision is not clear at some point.
+    """
+    if not len(matrices):
+        return []
+    echelons = []
+    rows = []
+    try:
+        for k, m in enumerate(matrices):
+            echelon = _Echelon()
+            if base is not None and base[k].shape[0]:
+                for row in _sparse_rows(base[k]):
+                    independent, reduced = echelon.decide(row)
+                    if independent:
+                        echelon.add(row, reduced)
+            echelons.append(echelon)
+            rows.append(_sparse_rows(m))
+        chosen: list[int] = []
+        for i in order:
+            decisions = [echelon.decide(r[i]) for echelon, r in zip(echelons, rows)]
+            if 2 * sum(flag for flag, _ in decisions) > len(matrices):
+                chosen.append(i)
+                for echelon, r, (flag, reduced) in zip(echelons, rows, decisions):
+                    if flag:  # a point that disagrees keeps its rows: the later rank checks catch it
+                        echelon.add(r[i], reduced)
+    except Undecided:
+        return None
+    return chosen
+
+
 def components(pattern: sp.spmatrix) -> list[np.ndarray]:
     """Row sets of the connected components of the sparsity graph of a square ``pattern``."""
     count, labels = connected_components(sp.csr_matrix(pattern != 0), directed=False)
@@ -152,11 +290,50 @@ def full_row_rank(jacobian: sp.spmatrix, tolerance: float) -> bool:
         return False
     Jn = sp.diags(1.0 / norms) @ J
     G = (Jn @ Jn.T).tocsr()
-    for block in components(G):
-        values = np.linalg.eigvalsh(G[block][:, block].toarray())
+    blocks = components(G)
+    alone = np.array([block[0] for block in blocks if len(block) == 1], dtype=int)
+    if len(alone) and np.min(G.diagonal()[alone]) <= tolerance**2:  # a 1 x 1 block is its eigenvalue
+        return False
+    for block in blocks:
+        if len(block) == 1:
+            continue
+        part = G[block][:, block]
+        if len(block) > DENSE_BLOCK:
+            definite = _positive_definite((part - tolerance**2 * sp.identity(len(block))).tocsc())
+            if definite is not None:
+                if not definite:
+                    return False
+                continue
+        values = np.linalg.eigvalsh(part.toarray())
         if values[0] <= tolerance**2:
             return False
     return True
+
+
+#: blocks of ``J J^T`` larger than this are tested by a sparse factorisation, not dense eigenvalues
+DENSE_BLOCK = 200
+
+
+def _positive_definite(A: sp.csc_matrix) -> bool | None:
+    """Whether the symmetric sparse ``A`` is positive definite, by its ``L D L^T`` factorisation.
+
+    Sparse LU with a symmetric fill-reducing ordering and no row pivoting is ``P A P^T =
+    L D L^T`` (``U = D L^T``); by Sylvester's law of inertia ``A`` is positive definite
+    exactly when every ``D_ii > 0`` (Golub & Van Loan, *Matrix Computations*, Sect. 4.2,
+    where the factorisation of a positive definite matrix needs no pivoting and is
+    backward stable). ``None`` when the solver had to pivot off the diagonal (a zero on
+    it): the caller decides densely.
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", MatrixRankWarning)
+            lu = splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    except (RuntimeError, MatrixRankWarning):
+        return False  # exactly singular: not positive definite
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        return None
+    pivots = lu.U.diagonal()
+    return bool(np.all(np.isfinite(pivots)) and np.all(pivots > 0.0))
 
 
 def minimum_norm_step(jacobian: sp.spmatrix, residual: np.ndarray) -> np.ndarray:

@@ -37,6 +37,7 @@ class SparseJacobian:
         # numerics: a dirac.analysis.core.numeric.Numerics (not imported: numeric imports this module)
         space = numerics.phase_space
         position = {s: k for k, s in enumerate(space.variables)}
+        momentum = {q: position[p] for q, p in zip(space.coordinates, space.momenta)}  # dp is keyed by q
         rows: list[int] = []
         cols: list[int] = []
         entries: list[sympy.Expr] = []
@@ -48,7 +49,7 @@ class SparseJacobian:
                 entries.append(d)
             for q, d in dp.items():
                 rows.append(i)
-                cols.append(position[space.momenta[space.coordinates.index(q)]])
+                cols.append(momentum[q])
                 entries.append(d)
         self.shape = (len(constraints), len(space.variables))
         self.rows = np.array(rows, dtype=int)

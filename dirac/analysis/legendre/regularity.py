@@ -29,6 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 import sympy
 
+from dirac.analysis.core.algebra import present_in_order
 from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["square_free_part", "branches", "factors", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
@@ -52,7 +53,7 @@ ROUND_OFF = 1e-9
 
 def _polynomial(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> sympy.Poly | None:
     """``expr`` as a polynomial in the ``variables`` it contains (parameters in the coefficients), or None."""
-    present = [v for v in variables if v in expr.free_symbols]
+    present = present_in_order(variables, expr.free_symbols)
     if not present:
         return None
     terms = len(expr.args) if isinstance(expr, sympy.Add) else 1

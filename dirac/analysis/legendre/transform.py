@@ -37,10 +37,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.algebra import tidy
-from dirac.analysis.core.fast_partials import quadratic_parts
+from dirac.analysis.core.fast_partials import SPARSE_HESSIAN, quadratic_parts
 from dirac.analysis.core.numeric import Numerics, independent_rows
 from dirac.analysis.core.phase_space import PhaseSpace, derivative
 from dirac.analysis.legendre.first_order import FIRST_ORDER_METHOD, first_order_primary
@@ -189,20 +190,27 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     # numerical rank and pivots of W at generic configurations
     time = [lagrangian.time] if lagrangian.is_time_dependent else []  # sampled with q
     args = (*q, *time, *lagrangian.parameters)
-    entries = [(i, j) for i in range(n) for j in range(n) if W[i, j] != 0]  # compiled: the non-zero entries only
-    w_fn = array_function(args, [W[i, j] for i, j in entries], cse=False) if entries else None
+    nonzero = W.todok()  # compiled: the non-zero entries only (W is sparse for many velocities)
+    entries = sorted(nonzero)
+    w_fn = array_function(args, [nonzero[e] for e in entries], cse=False) if entries else None
     rows_w = np.array([i for i, _ in entries], dtype=int)
     cols_w = np.array([j for _, j in entries], dtype=int)
     pvals = [float(parameter_values[s]) for s in lagrangian.parameters]
-    samples = []
+    samples: list = []
     for _ in range(3):
         z = rng.uniform(0.5, 1.5, n + len(time)) * rng.choice([-1.0, 1.0], n + len(time))
-        sample = np.zeros((n, n))
+        values = np.zeros(len(entries))
         if w_fn is not None:
             with np.errstate(all="ignore"):
-                sample[rows_w, cols_w] = np.array(w_fn(*z, *pvals), dtype=float).reshape(-1)
-        samples.append(sample)
-    pivots = independent_rows(samples, list(range(n)))
+                values = np.array(w_fn(*z, *pvals), dtype=float).reshape(-1)
+        if n >= SPARSE_HESSIAN:  # sparse rows: the independent ones chosen by sparse elimination
+            samples.append(sp.csr_matrix((values, (rows_w, cols_w)), shape=(n, n)))
+        else:
+            sample = np.zeros((n, n))
+            sample[rows_w, cols_w] = values
+            samples.append(sample)
+    undecided: list[str] = []  # a note when sparse rows of W had to be decided densely
+    pivots = independent_rows(samples, list(range(n)), notes=undecided)
     rank = len(pivots)
     others = [j for j in range(n) if j not in pivots]
     S = pivots
@@ -286,11 +294,15 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
         if not used_forms and W[S, S].is_diagonal():
             # W_SS diagonal: phi_j = (p - a)_j - sum_s W_js (p - a)_s / W_ss, H_c = sum_s (p - a)_s^2 / (2 W_ss)
             # (only the non-zero W_js enter: O(non-zeros), not O(n^2) matrix products)
-            diagonal = [W[s, s] for s in S]
+            diagonal = {s: W[s, s] for s in S}
+            in_row: dict[int, list[int]] = {}
+            for i, j in entries:
+                if j in diagonal:
+                    in_row.setdefault(i, []).append(j)
             for j in others:
-                terms = [W[j, s] * shifted[s] / w for s, w in zip(S, diagonal) if W[j, s] != 0]
+                terms = [nonzero[(j, s)] * shifted[s] / diagonal[s] for s in in_row.get(j, [])]
                 primary.append(shifted[j] - sympy.Add(*terms))
-            H_c = sympy.Add(*[shifted[s] ** 2 / (2 * w) for s, w in zip(S, diagonal)]) + potential
+            H_c = sympy.Add(*[shifted[s] ** 2 / (2 * w) for s, w in diagonal.items()]) + potential
             velocity = None
             method = f"singular Hessian of rank {rank}: null space from an invertible diagonal {rank}x{rank} block of W"
             used_forms = True
@@ -314,6 +326,8 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
     if tidy_hamiltonian:
         H_c = tidy(H_c, space.variables)
     full_rank = rank
+    if undecided:
+        method += f" ({undecided[0].replace('independence of rows', 'rank of the Hessian')})"
     return LegendreTransform(
         phase_space=space,
         multipliers=lambdas,

@@ -125,3 +125,24 @@ def test_six_stage_reduced_motion(six):
     assert _weakly_equal(six, flow[s["p_y"]], -(1 - g**2 / k) * s["y"])
     point = six.surface_point(seed=5)
     assert np.isclose(point["u"], -g * point["y"] / k)
+
+
+def test_sparse_normal_components_equal_the_dense_projection():
+    """|(1 - P) row| of the sparse projection per connected block against the dense QR projection."""
+    import numpy as np
+    import scipy.sparse as sp
+
+    from dirac.analysis.chain.chain_regularity import _normal_norms
+    from dirac.analysis.legendre.regularity import normal_components
+
+    for trial in range(6):
+        base = (sp.random(40, 90, density=0.03, random_state=trial) + sp.eye(40, 90)).tocsr()
+        if trial % 2:  # a dependent base row (a reducible constraint)
+            base = sp.vstack([base, base.getrow(0) + 2.0 * base.getrow(3)]).tocsr()
+        rows = sp.random(12, 90, density=0.05, random_state=50 + trial).tocsr()
+        rows = sp.vstack([rows, base.getrow(5) - base.getrow(7)]).tocsr()  # in the span: normal part 0
+        found = _normal_norms(base, rows)
+        assert found is not None
+        expected = normal_components(rows.toarray(), base.toarray(), np.ones(rows.shape[0]))
+        assert np.allclose(found, expected, atol=1e-12)
+        assert found[-1] < 1e-12

@@ -45,3 +45,31 @@ def test_surface_points_lie_on_the_surface():
         assert abs(z[0] ** 2 + z[1] ** 2 - 1) < 1e-12
         assert abs(z[0] * z[2] + z[1] * z[3]) < 1e-12
     assert len({tuple(np.round(z, 6)) for z in points}) == 4
+
+
+def test_rank_by_connected_blocks_equals_the_dense_rank():
+    """Block-diagonal matrices (rows and columns permuted alike) of known rank: the blocks' ranks add up."""
+    import numpy as np
+    import scipy.sparse as sp
+
+    from dirac.analysis.classes.classification import _rank_by_blocks
+    from dirac.analysis.core.numeric import numeric_rank
+
+    rng = np.random.default_rng(4)
+    for trial in range(10):
+        blocks, expected = [], 0
+        for _ in range(int(rng.integers(3, 9))):
+            size = int(rng.integers(1, 6))
+            half = rng.normal(size=(size, size))
+            block = half - half.T
+            if size >= 3 and trial % 2:
+                v = rng.normal(size=size)
+                block = block - np.outer(block @ v, v) / (v @ v) - np.outer(v, v @ block) / (v @ v)
+            expected += numeric_rank(block)
+            blocks.append(block)
+        dense = sp.block_diag(blocks).toarray()
+        perm = rng.permutation(dense.shape[0])
+        dense = dense[np.ix_(perm, perm)]
+        rows, cols = np.nonzero(dense)
+        assert _rank_by_blocks(dense.shape[0], rows, cols, dense[rows, cols]) == numeric_rank(dense) == expected
+    assert _rank_by_blocks(5, np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0)) == 0

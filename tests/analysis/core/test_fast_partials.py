@@ -44,3 +44,54 @@ def test_quadratic_parts_refuses_what_is_not_quadratic():
     xd = sympy.Symbol("x_dot", real=True)
     assert quadratic_parts(xd**4 + x, (x,), (xd,), ()) is None
     assert quadratic_parts(sympy.sqrt(1 + xd**2), (x,), (xd,), ()) is None
+
+
+def _long_sum(seed: int) -> tuple[sympy.Expr, tuple[sympy.Symbol, ...]]:
+    """A sum of 120 squares of local differences with parameter coefficients (a lattice energy)."""
+    import random
+
+    rng = random.Random(seed)
+    xs = sympy.symbols("z0:40", real=True)
+    terms = []
+    for _ in range(120):
+        a, b = rng.sample(xs, 2)
+        terms.append(rng.choice([1, -3, g, g / m, sympy.Rational(1, 3), sympy.sqrt(g)]) * (a - b + rng.choice([0, 1, k])) ** 2)
+    return sympy.Add(*terms), xs
+
+
+def test_partials_of_a_long_sum_term_by_term_equal_sympy_diff():
+    expr, xs = _long_sum(1)
+    found = PolynomialPartials(xs, (m, g, k)).partials(expr, xs)
+    assert set(found) == {s for s in xs if expr.has(s)}
+    for s, d in found.items():
+        assert sympy.expand(d - sympy.diff(expr, s)) == 0
+        assert d == sympy.expand(sympy.diff(expr, s))  # expanded, as for a short expression
+
+
+def test_tidy_of_a_long_sum_term_by_term_is_the_whole_expansion():
+    from dirac.analysis.core import algebra
+
+    expr, xs = _long_sum(2)
+    by_term = algebra.tidy(expr, xs, sign=True)
+    assert sympy.expand(by_term - expr) == 0 or sympy.expand(by_term + expr) == 0
+    saved = algebra.PIECEWISE_TERMS
+    try:
+        algebra.PIECEWISE_TERMS = 10**9  # the whole sum in one ring of all its generators
+        assert algebra.tidy(expr, xs, sign=True) == by_term
+    finally:
+        algebra.PIECEWISE_TERMS = saved
+
+
+def test_hessian_of_a_long_lattice_lagrangian_is_sparse_and_equals_sympy_hessian():
+    # L = sum_i (v_i - (c_{i+1} - c_i))^2 / 2 - g/2 sum_i (c_{i+1} - c_i)^2 on a ring of 70 sites
+    n = 70
+    c = sympy.symbols(f"c0:{n}", real=True)
+    v = sympy.symbols(f"v0:{n}", real=True)
+    L = sympy.Add(*[(v[i] - (c[(i + 1) % n] - c[i])) ** 2 for i in range(n)]) / 2 - g / 2 * sympy.Add(
+        *[(c[(i + 1) % n] - c[i]) ** 2 for i in range(n)]
+    )
+    W, a, V = quadratic_parts(L, c, v, (g,))
+    assert isinstance(W, sympy.SparseMatrix) and W.shape == (n, n)
+    assert W == sympy.eye(n)
+    assert all(sympy.expand(a[i] + (c[(i + 1) % n] - c[i])) == 0 for i in range(n))
+    assert sympy.expand(V + L.subs({vi: 0 for vi in v})) == 0
