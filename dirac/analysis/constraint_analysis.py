@@ -95,7 +95,8 @@ class ConstraintAnalysis:
     primary_multipliers
         The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``.
     multipliers
-        ``u_k`` name -> solved expression, for those the algorithm fixes alone.
+        ``u_k`` name -> solved expression, for those the algorithm fixes alone (which
+        ones is decided during the analysis; the exact expressions are solved on first use).
     undetermined_multipliers
         The ``u_k`` not fixed alone (free, or fixed only in combinations).
     multiplier_solution
@@ -103,7 +104,9 @@ class ConstraintAnalysis:
         :class:`~dirac.analysis.classes.multiplier_solution.MultiplierSolution` with
         ``.particular`` (name -> expression), ``.null_vectors`` (list of name ->
         expression), the free ``.free`` (``v_1, ...``), the first-class combinations
-        ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``.
+        ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``. Its
+        numeric decisions are taken during the analysis; the exact ``U`` and ``V_a`` (a
+        symbolic elimination, long for a long chain) are computed the first time they are read.
     stages, constraints
         The chain stage by stage (stage 1 = primary) and flat: an independent set.
     reducible_constraints
@@ -195,7 +198,7 @@ class ConstraintAnalysis:
         self.stages = chain.stages
         self.constraints = chain.constraints
         self.reducible_constraints = list(chain.reducible)
-        self.multipliers = dict(chain.solved_multipliers)
+        self._multipliers: dict[str, sympy.Expr] | None = None  # read from the multiplier solution on first use
         self.undetermined_multipliers = list(chain.undetermined)
         self.multiplier_solution: MultiplierSolution = chain.multiplier_solution or unsolved_multipliers((), [], self.canonical_hamiltonian, [])
         self._points = chain.points
@@ -270,6 +273,18 @@ class ConstraintAnalysis:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
             self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
+
+    @property
+    def multipliers(self) -> dict[str, sympy.Expr]:
+        """Name -> exact expression of each multiplier fixed alone (``u_k`` of ``H_T``), weakly
+        simplified; read from :attr:`multiplier_solution`, whose exact solve runs on first use."""
+        if self._multipliers is None:
+            self._multipliers = dict(self._chain.solved_multipliers)
+        return self._multipliers
+
+    @multipliers.setter
+    def multipliers(self, value: dict[str, sympy.Expr]) -> None:
+        self._multipliers = dict(value)
 
     # ------------------------------------------------------------------ gauge
     @property

@@ -109,8 +109,9 @@ class ConstraintChain:
         The time ``t`` when the system depends on it explicitly (then the partial time
         derivative enters every consistency condition), else ``None``.
 
-    After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
-    expression, only those the chain determines), ``undetermined`` (multiplier symbols
+    After :meth:`run`: ``stages``, ``constraints``, ``fixed_alone`` (names of the multipliers
+    the chain determines), ``solved_multipliers`` (name -> exact expression of those, read
+    from the general solution, which is solved on first use), ``undetermined`` (multiplier symbols
     not fixed alone), ``multiplier_solution`` (the general solution ``u = U + v_a V_a``),
     ``points`` (regular points of the final surface), ``reducible`` (constraints
     that hold but whose gradients depend on the kept ones on the regular part of the
@@ -134,7 +135,7 @@ class ConstraintChain:
     primary: list[sympy.Expr]
     multipliers: tuple[sympy.Symbol, ...]
     stages: list[list[sympy.Expr]] = field(default_factory=list)
-    solved_multipliers: dict[str, sympy.Expr] = field(default_factory=dict)
+    fixed_alone: list[str] = field(default_factory=list)
     undetermined: list[sympy.Symbol] = field(default_factory=list)
     points: list[np.ndarray] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -153,6 +154,14 @@ class ConstraintChain:
         return [c for stage in self.stages for c in stage]
 
     @property
+    def solved_multipliers(self) -> dict[str, sympy.Expr]:
+        """Name -> exact expression of the multipliers fixed alone (from :attr:`multiplier_solution`, solved on first use)."""
+        if not self.fixed_alone or self.multiplier_solution is None:
+            return {}
+        particular = self.multiplier_solution.particular
+        return {name: particular[name] for name in self.fixed_alone}
+
+    @property
     def total_hamiltonian(self) -> sympy.Expr:
         """``H_T = H_c + sum_k u_k phi_k`` ((207), (234))."""
         return self.canonical_hamiltonian + sum((u * phi for u, phi in zip(self.multipliers, self.primary)), sympy.S.Zero)
@@ -167,9 +176,36 @@ class ConstraintChain:
                 b = b + sympy.diff(constraint, self.time)
             for momentum, force in self.forces.items():  # p_dot = -dH/dq + Q: + sum_r dPhi/dp_r Q_r
                 b = b + sympy.diff(constraint, momentum) * force
-            cached = (b, [pb(constraint, phi) for phi in self.primary])
+            row = [sympy.S.Zero] * len(self.primary)
+            for k in self._touching_primaries(constraint):  # the others' brackets are sums of no terms: 0
+                row[k] = pb(constraint, self.primary[k])
+            cached = (b, row)
             self._row_cache[constraint] = cached
         return cached
+
+    def _touching_primaries(self, constraint: sympy.Expr) -> list[int]:
+        """Indices of the primary constraints whose Poisson bracket with ``constraint`` can be non-zero.
+
+        ``{f, phi} = sum_i df/dq_i dphi/dp_i - df/dp_i dphi/dq_i`` has a term only where ``f``
+        depends on ``q_i`` and ``phi`` on ``p_i``, or the other way round (a local system:
+        O(1) primaries per constraint instead of all of them).
+        """
+        index = getattr(self, "_primary_index", None)
+        if index is None or index[0] is not self.primary:
+            by_momentum: dict[sympy.Symbol, list[int]] = {}
+            by_coordinate: dict[sympy.Symbol, list[int]] = {}
+            for k, phi in enumerate(self.primary):
+                dq, dp = self.phase_space.partials(phi)
+                for q in dp:
+                    by_momentum.setdefault(q, []).append(k)
+                for q in dq:
+                    by_coordinate.setdefault(q, []).append(k)
+            index = (self.primary, by_momentum, by_coordinate)
+            self._primary_index = index
+        _, by_momentum, by_coordinate = index
+        dq, dp = self.phase_space.partials(constraint)
+        found = {k for q in dq for k in by_momentum.get(q, ())} | {k for q in dp for k in by_coordinate.get(q, ())}
+        return sorted(found)
 
     def _numeric_rows(self, constraints: list[sympy.Expr], points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         K = len(self.primary)
@@ -565,6 +601,31 @@ class ConstraintChain:
         c = weak_solve(A_sym.T, rhs, [A[np.ix_(P, Q)].T for A in A_num], [A[row, Q].reshape(-1, 1) for A in A_num], variables=self.phase_space.variables)
         return b_row - sum((c[k, 0] * self._rows(constraints[P[k]])[0] for k in needed), sympy.S.Zero)
 
+    @staticmethod
+    def _fixed_alone_at_point(M: np.ndarray) -> np.ndarray:
+        """Which ``u_k`` the rows ``M = A_P`` fix alone at one point: ``e_k`` in their row space.
+
+        ``rank [M; e_k] == rank M`` (numerically, relative to ``max |M|``). When ``M`` has full
+        column rank ``K`` with its smallest singular value above the cut of every
+        ``[M; e_k]`` — adding a row does not lower a singular value (Cauchy interlacing,
+        Golub & Van Loan, Sect. 8.1.2) and raises the largest at most to
+        ``sqrt(s_1^2 + 1)`` — every ``u_k`` is fixed, with one SVD instead of one per ``k``.
+        """
+        K = M.shape[1]
+        s = np.max(np.abs(M)) or 1.0
+        scaled = M / s
+        rank = numeric_rank(scaled)
+        if rank == K:
+            sv = np.linalg.svd(scaled, compute_uv=False)
+            if sv[K - 1] > 1e-8 * np.sqrt(sv[0] ** 2 + 1.0):
+                return np.ones(K, dtype=int)
+        fixed = np.zeros(K, dtype=int)
+        for k in range(K):
+            e = np.zeros(K)
+            e[k] = 1.0
+            fixed[k] = numeric_rank(np.vstack([M, e * s]) / s) == rank
+        return fixed
+
     def _solve_multipliers(self, points, P, Q) -> None:
         """Solve ``b_P + A_PQ u_Q = 0`` for the determined multipliers ((214)-(215) ff.).
 
@@ -573,6 +634,7 @@ class ConstraintChain:
         it is fixed alone.
         """
         K = len(self.primary)
+        self.fixed_alone = []
         constraints = self.constraints
         taken = [s.name for s in (*self.phase_space.variables, *self.phase_space.parameters)]
         self.multiplier_solution = unsolved_multipliers(self.multipliers, self.primary, self.canonical_hamiltonian, taken)
@@ -582,17 +644,10 @@ class ConstraintChain:
             self.undetermined = list(self.multipliers)
             return
         b_num, A_num = self._numeric_rows(constraints, points)
-        determined = []
-        for k in range(K):
-            e = np.zeros(K)
-            e[k] = 1.0
-            votes = 0
-            for A in A_num:
-                M = A[P]
-                s = np.max(np.abs(M)) or 1.0
-                votes += numeric_rank(np.vstack([M, e * s]) / s) == numeric_rank(M / s)
-            if 2 * votes > len(A_num):
-                determined.append(k)
+        votes = np.zeros(K, dtype=int)
+        for A in A_num:
+            votes += self._fixed_alone_at_point(A[P])
+        determined = [k for k in range(K) if 2 * votes[k] > len(A_num)]
         self.undetermined = [self.multipliers[k] for k in range(K) if k not in determined]
         order = determined + [k for k in range(K) if k not in determined]
         self.multiplier_solution = general_multiplier_solution(
@@ -607,6 +662,4 @@ class ConstraintChain:
             self.phase_space.variables,
             taken,
         )
-        for k in determined:
-            name = self.multipliers[k].name
-            self.solved_multipliers[name] = self.multiplier_solution.particular[name]
+        self.fixed_alone = [self.multipliers[k].name for k in determined]
