@@ -198,7 +198,7 @@ class ConstraintAnalysis:
         self.stages = chain.stages
         self.constraints = chain.constraints
         self.reducible_constraints = list(chain.reducible)
-        self._multipliers: dict[str, sympy.Expr] | None = None  # read from the multiplier solution on first use
+        self._multipliers: Mapping[str, sympy.Expr] = chain.solved_multipliers  # names now, exact values on first read
         self.undetermined_multipliers = list(chain.undetermined)
         self.multiplier_solution: MultiplierSolution = chain.multiplier_solution or unsolved_multipliers((), [], self.canonical_hamiltonian, [])
         self._points = chain.points
@@ -275,16 +275,15 @@ class ConstraintAnalysis:
         self.seconds = time.perf_counter() - start
 
     @property
-    def multipliers(self) -> dict[str, sympy.Expr]:
+    def multipliers(self) -> Mapping[str, sympy.Expr]:
         """Name -> exact expression of each multiplier fixed alone (``u_k`` of ``H_T``), weakly
-        simplified; read from :attr:`multiplier_solution`, whose exact solve runs on first use."""
-        if self._multipliers is None:
-            self._multipliers = dict(self._chain.solved_multipliers)
+        simplified. The names are known after the analysis; the expressions are read from
+        :attr:`multiplier_solution`, whose exact solve runs the first time one is read."""
         return self._multipliers
 
     @multipliers.setter
-    def multipliers(self, value: dict[str, sympy.Expr]) -> None:
-        self._multipliers = dict(value)
+    def multipliers(self, value: Mapping[str, sympy.Expr]) -> None:
+        self._multipliers = value
 
     # ------------------------------------------------------------------ gauge
     @property

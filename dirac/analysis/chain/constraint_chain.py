@@ -41,13 +41,15 @@ define the surface on which points are sampled.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
 import numpy as np
 import sympy
 
-from dirac.analysis.chain.chain_regularity import irregular_candidates
+from dirac.analysis.chain.chain_regularity import gradient_values, irregular_candidates
 from dirac.analysis.classes.multiplier_solution import (
+    FixedMultipliers,
     MultiplierSolution,
     general_multiplier_solution,
     unsolved_multipliers,
@@ -154,12 +156,11 @@ class ConstraintChain:
         return [c for stage in self.stages for c in stage]
 
     @property
-    def solved_multipliers(self) -> dict[str, sympy.Expr]:
+    def solved_multipliers(self) -> Mapping[str, sympy.Expr]:
         """Name -> exact expression of the multipliers fixed alone (from :attr:`multiplier_solution`, solved on first use)."""
         if not self.fixed_alone or self.multiplier_solution is None:
             return {}
-        particular = self.multiplier_solution.particular
-        return {name: particular[name] for name in self.fixed_alone}
+        return FixedMultipliers(self.fixed_alone, self.multiplier_solution)
 
     @property
     def total_hamiltonian(self) -> sympy.Expr:
@@ -208,13 +209,20 @@ class ConstraintChain:
         return sorted(found)
 
     def _numeric_rows(self, constraints: list[sympy.Expr], points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """``b_a`` and ``A_ak`` at the points (shapes ``(points, rows)``, ``(points, rows, K)``); only non-zero entries are evaluated."""
         K = len(self.primary)
+        where: list[int] = []
         exprs = []
-        for c in constraints:
+        for i, c in enumerate(constraints):
             b, A = self._rows(c)
-            exprs.append(b)
-            exprs.extend(A)
-        values = self.numerics.evaluate(exprs, points).reshape(len(points), len(constraints), K + 1)
+            for k, e in enumerate((b, *A)):
+                if e != 0:
+                    where.append(i * (K + 1) + k)
+                    exprs.append(e)
+        values = np.zeros((len(points), len(constraints) * (K + 1)))
+        if exprs:
+            values[:, np.array(where, dtype=int)] = self.numerics.evaluate(exprs, points)
+        values = values.reshape(len(points), len(constraints), K + 1)
         return values[:, :, 0], values[:, :, 1:]
 
     # ------------------------------------------------------------------ the algorithm
@@ -583,14 +591,8 @@ class ConstraintChain:
         return [k for k, p in enumerate(P) if not b_zero[p] and not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
 
     def _independent(self, candidates: list[sympy.Expr], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
-        n = len(self.phase_space.variables)
-        grads = [g for c in candidates for g in self.phase_space.gradient(c)]
-        cand = self.numerics.evaluate(grads, points).reshape(len(points), len(candidates), n)
-        if old:
-            og = [g for c in old for g in self.phase_space.gradient(c)]
-            base = list(self.numerics.evaluate(og, points).reshape(len(points), len(old), n))
-        else:
-            base = None
+        cand = gradient_values(self.phase_space, self.numerics, candidates, points)
+        base = list(gradient_values(self.phase_space, self.numerics, old, points)) if old else None
         return independent_rows(list(cand), list(range(len(candidates))), base=base)
 
     def _eliminate(self, row, needed, constraints, P, Q, A_num):

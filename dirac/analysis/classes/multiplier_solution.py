@@ -29,7 +29,7 @@ component is 1). Both are exact expressions, solved weakly on the surface by
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 import sympy
@@ -39,7 +39,7 @@ from dirac.analysis.core.linear_solve import weak_solve, weakly_solvable
 from dirac.analysis.core.numeric import independent_rows
 from dirac.errors import AnalysisError
 
-__all__ = ["MultiplierSolution", "general_multiplier_solution", "unsolved_multipliers"]
+__all__ = ["MultiplierSolution", "FixedMultipliers", "general_multiplier_solution", "unsolved_multipliers"]
 
 
 class MultiplierSolution:
@@ -162,6 +162,36 @@ class MultiplierSolution:
                 return False
             units += 1
         return units == len(self.null_vectors)
+
+
+class FixedMultipliers(Mapping[str, sympy.Expr]):
+    """Name -> exact ``U_k`` of each multiplier fixed alone (``analysis.multipliers``).
+
+    Which multipliers are fixed alone is decided numerically during the analysis, so the
+    names (``in``, ``len``, iteration) are known at once; a value is read from
+    :attr:`MultiplierSolution.particular`, which runs the exact solve the first time.
+    """
+
+    def __init__(self, names: Sequence[str], solution: MultiplierSolution) -> None:
+        self._names = list(names)
+        self._known = set(names)
+        self._solution = solution
+
+    def __getitem__(self, name: str) -> sympy.Expr:
+        if name not in self._known:
+            raise KeyError(name)
+        return self._solution.particular[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __repr__(self) -> str:
+        if self._solution.solved:
+            return repr(dict(self))
+        return "{" + ", ".join(f"{name!r}: <exact solve on first use>" for name in self._names) + "}"
 
 
 def free_parameters(count: int, taken: Sequence[str]) -> tuple[sympy.Symbol, ...]:
