@@ -253,7 +253,8 @@ class ConstraintAnalysis:
                 f"large system ({space.dimension} phase-space variables): surface points found with the sparse "
                 "Jacobian (minimum-norm steps by sparse LU, LSQR where rows depend), regular points tested block by "
                 "block, independence of rows decided in one orthogonalisation pass per point; weak zeros, the rank "
-                "of C and the exact multiplier solve stay on the dense path"
+                "of C and the exact multiplier solve stay on the dense path (that solve runs the first time the "
+                "multipliers are read: analysis.multipliers values, multiplier_solution, the report)"
             )
         if self.time is not None and lagrangian.is_time_dependent:
             self.notes.append(

@@ -182,6 +182,9 @@ class FixedMultipliers(Mapping[str, sympy.Expr]):
             raise KeyError(name)
         return self._solution.particular[name]
 
+    def __contains__(self, name: object) -> bool:
+        return name in self._known
+
     def __iter__(self) -> Iterator[str]:
         return iter(self._names)
 
