@@ -219,10 +219,10 @@ class ConstraintChain:
                 if e != 0:
                     where.append(i * (K + 1) + k)
                     exprs.append(e)
-        values = np.zeros((len(points), len(constraints) * (K + 1)))
+        flat = np.zeros((len(points), len(constraints) * (K + 1)))
         if exprs:
-            values[:, np.array(where, dtype=int)] = self.numerics.evaluate(exprs, points)
-        values = values.reshape(len(points), len(constraints), K + 1)
+            flat[:, np.array(where, dtype=int)] = self.numerics.evaluate(exprs, points)
+        values = flat.reshape(len(points), len(constraints), K + 1)
         return values[:, :, 0], values[:, :, 1:]
 
     # ------------------------------------------------------------------ the algorithm
