@@ -93,10 +93,8 @@ class ConstraintAnalysis:
     canonical_hamiltonian, total_hamiltonian
         ``H_c`` and ``H_T = H_c + u_k phi_k`` ((207), (234)).
     primary_multipliers
-        The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``.
-    multipliers
-        ``u_k`` name -> solved expression, for those the algorithm fixes alone (which
-        ones is decided during the analysis; the exact expressions are solved on first use).
+        The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``
+        (:attr:`multipliers`: the expressions of those fixed alone).
     undetermined_multipliers
         The ``u_k`` not fixed alone (free, or fixed only in combinations).
     multiplier_solution

@@ -59,12 +59,11 @@ class MultiplierSolution:
         The primary constraints ``phi_k`` they multiply.
     canonical_hamiltonian
         ``H_c``.
-    particular
-        ``U``: multiplier name -> expression (``0`` for the multipliers set to zero).
-    null_vectors
-        The ``V_a``: one dict multiplier name -> component per free parameter.
     free
         The free parameters ``v_1, v_2, ...`` (one per null vector).
+
+    The exact ``U`` (:attr:`particular`, ``0`` for the multipliers set to zero) and ``V_a``
+    (:attr:`null_vectors`) are properties, solved on first read.
     """
 
     def __init__(
