@@ -191,9 +191,7 @@ class FixedMultipliers(Mapping[str, sympy.Expr]):
         return len(self._names)
 
     def __repr__(self) -> str:
-        if self._solution.solved:
-            return repr(dict(self))
-        return "{" + ", ".join(f"{name!r}: <exact solve on first use>" for name in self._names) + "}"
+        return repr(dict(self))  # printing asks for the values: solved here if not yet
 
 
 def free_parameters(count: int, taken: Sequence[str]) -> tuple[sympy.Symbol, ...]:
