@@ -93,9 +93,8 @@ class ConstraintAnalysis:
     canonical_hamiltonian, total_hamiltonian
         ``H_c`` and ``H_T = H_c + u_k phi_k`` ((207), (234)).
     primary_multipliers
-        The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``.
-    multipliers
-        ``u_k`` name -> solved expression, for those the algorithm fixes alone.
+        The multipliers ``u_1, u_2, ...`` of the primary constraints in ``H_T``
+        (:attr:`multipliers`: the expressions of those fixed alone).
     undetermined_multipliers
         The ``u_k`` not fixed alone (free, or fixed only in combinations).
     multiplier_solution
@@ -103,7 +102,9 @@ class ConstraintAnalysis:
         :class:`~dirac.analysis.classes.multiplier_solution.MultiplierSolution` with
         ``.particular`` (name -> expression), ``.null_vectors`` (list of name ->
         expression), the free ``.free`` (``v_1, ...``), the first-class combinations
-        ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``.
+        ``.first_class_primary`` and ``.total_hamiltonian`` ``H' + v_a phi_a``. Its
+        numeric decisions are taken during the analysis; the exact ``U`` and ``V_a`` (a
+        symbolic elimination, long for a long chain) are computed the first time they are read.
     stages, constraints
         The chain stage by stage (stage 1 = primary) and flat: an independent set.
     reducible_constraints
@@ -195,7 +196,7 @@ class ConstraintAnalysis:
         self.stages = chain.stages
         self.constraints = chain.constraints
         self.reducible_constraints = list(chain.reducible)
-        self.multipliers = dict(chain.solved_multipliers)
+        self._multipliers: Mapping[str, sympy.Expr] = chain.solved_multipliers  # names now, exact values on first read
         self.undetermined_multipliers = list(chain.undetermined)
         self.multiplier_solution: MultiplierSolution = chain.multiplier_solution or unsolved_multipliers((), [], self.canonical_hamiltonian, [])
         self._points = chain.points
@@ -252,7 +253,8 @@ class ConstraintAnalysis:
                 "block (large blocks by their L D L^T factorisation), independence of constraint gradients decided by "
                 "sparse elimination (by the dense orthogonalisation pass where a row is not clearly decided), brackets "
                 "only between expressions that share a canonical pair, the rank of C over its connected blocks; weak "
-                "zeros and the exact multiplier solve stay on the dense path"
+                "zeros and the exact multiplier solve stay on the dense path (that solve runs the first time the "
+                "multipliers are read: analysis.multipliers values, multiplier_solution, the report)"
             )
         if self.time is not None and lagrangian.is_time_dependent:
             self.notes.append(
@@ -272,6 +274,17 @@ class ConstraintAnalysis:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
             self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
+
+    @property
+    def multipliers(self) -> Mapping[str, sympy.Expr]:
+        """Name -> exact expression of each multiplier fixed alone (``u_k`` of ``H_T``), weakly
+        simplified. The names are known after the analysis; the expressions are read from
+        :attr:`multiplier_solution`, whose exact solve runs the first time one is read."""
+        return self._multipliers
+
+    @multipliers.setter
+    def multipliers(self, value: Mapping[str, sympy.Expr]) -> None:
+        self._multipliers = value
 
     # ------------------------------------------------------------------ gauge
     @property

@@ -246,9 +246,15 @@ def _band_order(matrix: list[list[str | None]]) -> tuple[list[int], int, int]:
 
 
 def _banded_pays(k: int, lower: int, upper: int) -> bool:
-    """The banded solve (about ``k lower (lower + upper)`` products, ``k (2 lower + upper +
-    2)`` entries) beats the dense one (``k^3 / 3``, ``k (k + 1)`` entries) by a margin."""
-    return 3 * (2 * lower + upper + 2) <= k
+    """Whether the banded solve beats the dense one: fewer products, ``k lower (lower + upper)``
+    against ``k^3 / 3`` (Golub & Van Loan, *Matrix Computations*, Sect. 4.3).
+
+    Its source is also shorter: one line per structurally non-zero entry of ``C`` against
+    one per entry of the dense ``k (k + 1)`` scratch, every one of them compiled (numba's
+    and LLVM's time grows faster than the length of the function: the dense scratch of the
+    16-link chain, ``k = 64``, made a 6400-line field that took minutes to compile).
+    """
+    return 3 * lower * (lower + upper) < k * k
 
 
 def _banded_solve(lines: _Lines, matrix: list[list[str | None]], rhs: list[str | None], scratch: str, start: int,

@@ -105,3 +105,26 @@ def test_analysed_kernel_uses_the_same_banded_field():
     module.field(point, 0.0, np.array([9.81]), out)
     reference = _numpy_field(z, H, constraints, point, 9.81)
     assert np.max(np.abs(out - reference)) <= 1e-10 * np.max(np.abs(reference))
+
+
+def test_banded_solve_is_chosen_when_it_needs_fewer_products():
+    """Band ``l = u = 11`` (the analysed chain: four constraints a link, neighbours coupled):
+    at ``k = 64`` the banded solve needs ``k l (l + u) = 15488`` products against the dense
+    ``k^3 / 3 = 87381`` (and writes only the non-zero entries of ``C``, not ``k (k + 1)``);
+    at ``k = 16`` it needs ``3872`` against ``1365`` and the dense one is kept; a full ``C``
+    (``l = u = k - 1``) is always dense."""
+    from dirac.codegen.field_body import _banded_pays
+
+    assert _banded_pays(64, 11, 11)
+    assert not _banded_pays(16, 11, 11)
+    assert not _banded_pays(24, 23, 23)
+
+
+def test_looped_solve_of_a_moderate_chain_is_banded():
+    """The 16-link chain of this module (k = 32) with the looped solve is banded by itself, so
+    its source holds no dense ``k (k + 1)`` scratch (which made such fields take minutes to compile)."""
+    g = sympy.Symbol("g", real=True)
+    z, H, constraints = _chain(16)
+    source = vector_field_source(z, [g], H, constraints, constraints, title="chain", unroll_limit=0)
+    assert "solve_banded(" in source and "solve_scratch(" not in source
+    assert source.count("\n") < len(constraints) * (len(constraints) + 1)

@@ -29,7 +29,36 @@ if TYPE_CHECKING:
     from dirac.analysis.core.numeric import Numerics
     from dirac.analysis.core.phase_space import PhaseSpace
 
-__all__ = ["irregular_candidates"]
+__all__ = ["irregular_candidates", "gradient_values"]
+
+
+def gradient_values(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr], points: list[np.ndarray]) -> np.ndarray:
+    """The gradients of ``constraints`` at ``points``: shape ``(points, constraints, variables)``.
+
+    Only the non-zero partial derivatives (:meth:`PhaseSpace.partials`) are evaluated and
+    scattered into the dense array (a constraint of a local system touches O(1) variables):
+    the same values as evaluating :meth:`PhaseSpace.gradient` entry by entry.
+    """
+    n = len(space.variables)
+    position = {s: k for k, s in enumerate(space.variables)}
+    momentum_position = {q: position[p] for q, p in zip(space.coordinates, space.momenta)}
+    rows: list[int] = []
+    cols: list[int] = []
+    entries: list[sympy.Expr] = []
+    for i, c in enumerate(constraints):
+        dq, dp = space.partials(c)
+        for q, d in dq.items():
+            rows.append(i)
+            cols.append(position[q])
+            entries.append(d)
+        for q, d in dp.items():
+            rows.append(i)
+            cols.append(momentum_position[q])
+            entries.append(d)
+    out = np.zeros((len(points), len(constraints), n))
+    if entries:
+        out[:, np.array(rows, dtype=int), np.array(cols, dtype=int)] = numerics.evaluate(entries, points)
+    return out
 
 
 def _basis(base: np.ndarray) -> np.ndarray | None:
@@ -157,8 +186,8 @@ def irregular_candidates(
     n = len(space.variables)
     kept = np.array([i in chosen for i in range(len(candidates))], dtype=bool)
     everything = old + reducible + [candidates[i] for i in chosen]
-    stacked = numerics.evaluate([g for c in everything for g in space.gradient(c)], points).reshape(len(points), len(everything), n)
-    rows = numerics.evaluate([g for c in candidates for g in space.gradient(c)], points).reshape(len(points), len(candidates), n)
+    stacked = gradient_values(space, numerics, everything, points)
+    rows = gradient_values(space, numerics, candidates, points)
     n_old = len(old) + len(reducible)
     rough = np.zeros((len(points), len(candidates)))
     bases: list[tuple[np.ndarray | None, np.ndarray | None]] = []

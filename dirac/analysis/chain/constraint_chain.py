@@ -41,13 +41,15 @@ define the surface on which points are sampled.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
 import numpy as np
 import sympy
 
-from dirac.analysis.chain.chain_regularity import irregular_candidates
+from dirac.analysis.chain.chain_regularity import gradient_values, irregular_candidates
 from dirac.analysis.classes.multiplier_solution import (
+    FixedMultipliers,
     MultiplierSolution,
     general_multiplier_solution,
     unsolved_multipliers,
@@ -109,8 +111,9 @@ class ConstraintChain:
         The time ``t`` when the system depends on it explicitly (then the partial time
         derivative enters every consistency condition), else ``None``.
 
-    After :meth:`run`: ``stages``, ``constraints``, ``solved_multipliers`` (name -> exact
-    expression, only those the chain determines), ``undetermined`` (multiplier symbols
+    After :meth:`run`: ``stages``, ``constraints``, ``fixed_alone`` (names of the multipliers
+    the chain determines), ``solved_multipliers`` (name -> exact expression of those, read
+    from the general solution, which is solved on first use), ``undetermined`` (multiplier symbols
     not fixed alone), ``multiplier_solution`` (the general solution ``u = U + v_a V_a``),
     ``points`` (regular points of the final surface), ``reducible`` (constraints
     that hold but whose gradients depend on the kept ones on the regular part of the
@@ -134,7 +137,7 @@ class ConstraintChain:
     primary: list[sympy.Expr]
     multipliers: tuple[sympy.Symbol, ...]
     stages: list[list[sympy.Expr]] = field(default_factory=list)
-    solved_multipliers: dict[str, sympy.Expr] = field(default_factory=dict)
+    fixed_alone: list[str] = field(default_factory=list)
     undetermined: list[sympy.Symbol] = field(default_factory=list)
     points: list[np.ndarray] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -151,6 +154,13 @@ class ConstraintChain:
     def constraints(self) -> list[sympy.Expr]:
         """All constraints, stage by stage."""
         return [c for stage in self.stages for c in stage]
+
+    @property
+    def solved_multipliers(self) -> Mapping[str, sympy.Expr]:
+        """Name -> exact expression of the multipliers fixed alone (from :attr:`multiplier_solution`, solved on first use)."""
+        if not self.fixed_alone or self.multiplier_solution is None:
+            return {}
+        return FixedMultipliers(self.fixed_alone, self.multiplier_solution)
 
     @property
     def total_hamiltonian(self) -> sympy.Expr:
@@ -198,7 +208,9 @@ class ConstraintChain:
         return sorted(found)
 
     def _numeric_rows(self, constraints: list[sympy.Expr], points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """``b_a`` and ``A_ak`` at the points (shapes ``(points, rows)``, ``(points, rows, K)``); only non-zero entries are evaluated."""
         K = len(self.primary)
+        where: list[int] = []
         exprs = []
         where = []  # flat positions of the entries that are not identically zero (most, at scale, are)
         for a, c in enumerate(constraints):
@@ -588,13 +600,8 @@ class ConstraintChain:
             cand_sparse = self.numerics.sparse_gradients(candidates, points)
             base_sparse = self.numerics.sparse_gradients(old, points) if old else None
             return independent_rows(cand_sparse, list(range(len(candidates))), base=base_sparse, notes=self.regularity_notes)
-        grads = [g for c in candidates for g in self.phase_space.gradient(c)]
-        cand = self.numerics.evaluate(grads, points).reshape(len(points), len(candidates), n)
-        if old:
-            og = [g for c in old for g in self.phase_space.gradient(c)]
-            base = list(self.numerics.evaluate(og, points).reshape(len(points), len(old), n))
-        else:
-            base = None
+        cand = gradient_values(self.phase_space, self.numerics, candidates, points)
+        base = list(gradient_values(self.phase_space, self.numerics, old, points)) if old else None
         return independent_rows(list(cand), list(range(len(candidates))), base=base)
 
     def _eliminate(self, row, needed, constraints, P, Q, A_num):
@@ -605,6 +612,31 @@ class ConstraintChain:
         c = weak_solve(A_sym.T, rhs, [A[np.ix_(P, Q)].T for A in A_num], [A[row, Q].reshape(-1, 1) for A in A_num], variables=self.phase_space.variables)
         return b_row - sum((c[k, 0] * self._rows(constraints[P[k]])[0] for k in needed), sympy.S.Zero)
 
+    @staticmethod
+    def _fixed_alone_at_point(M: np.ndarray) -> np.ndarray:
+        """Which ``u_k`` the rows ``M = A_P`` fix alone at one point: ``e_k`` in their row space.
+
+        ``rank [M; e_k] == rank M`` (numerically, relative to ``max |M|``). When ``M`` has full
+        column rank ``K`` with its smallest singular value above the cut of every
+        ``[M; e_k]`` — adding a row does not lower a singular value (Cauchy interlacing,
+        Golub & Van Loan, Sect. 8.1.2) and raises the largest at most to
+        ``sqrt(s_1^2 + 1)`` — every ``u_k`` is fixed, with one SVD instead of one per ``k``.
+        """
+        K = M.shape[1]
+        s = np.max(np.abs(M)) or 1.0
+        scaled = M / s
+        rank = numeric_rank(scaled)
+        if rank == K:
+            sv = np.linalg.svd(scaled, compute_uv=False)
+            if sv[K - 1] > 1e-8 * np.sqrt(sv[0] ** 2 + 1.0):
+                return np.ones(K, dtype=int)
+        fixed = np.zeros(K, dtype=int)
+        for k in range(K):
+            e = np.zeros(K)
+            e[k] = 1.0
+            fixed[k] = numeric_rank(np.vstack([M, e * s]) / s) == rank
+        return fixed
+
     def _solve_multipliers(self, points, P, Q) -> None:
         """Solve ``b_P + A_PQ u_Q = 0`` for the determined multipliers ((214)-(215) ff.).
 
@@ -613,6 +645,7 @@ class ConstraintChain:
         it is fixed alone.
         """
         K = len(self.primary)
+        self.fixed_alone = []
         constraints = self.constraints
         taken = [s.name for s in (*self.phase_space.variables, *self.phase_space.parameters)]
         self.multiplier_solution = unsolved_multipliers(self.multipliers, self.primary, self.canonical_hamiltonian, taken)
@@ -622,17 +655,10 @@ class ConstraintChain:
             self.undetermined = list(self.multipliers)
             return
         b_num, A_num = self._numeric_rows(constraints, points)
-        determined = []
-        for k in range(K):
-            e = np.zeros(K)
-            e[k] = 1.0
-            votes = 0
-            for A in A_num:
-                M = A[P]
-                s = np.max(np.abs(M)) or 1.0
-                votes += numeric_rank(np.vstack([M, e * s]) / s) == numeric_rank(M / s)
-            if 2 * votes > len(A_num):
-                determined.append(k)
+        votes = np.zeros(K, dtype=int)
+        for A in A_num:
+            votes += self._fixed_alone_at_point(A[P])
+        determined = [k for k in range(K) if 2 * votes[k] > len(A_num)]
         self.undetermined = [self.multipliers[k] for k in range(K) if k not in determined]
         order = determined + [k for k in range(K) if k not in determined]
         self.multiplier_solution = general_multiplier_solution(
@@ -647,6 +673,4 @@ class ConstraintChain:
             self.phase_space.variables,
             taken,
         )
-        for k in determined:
-            name = self.multipliers[k].name
-            self.solved_multipliers[name] = self.multiplier_solution.particular[name]
+        self.fixed_alone = [self.multipliers[k].name for k in determined]

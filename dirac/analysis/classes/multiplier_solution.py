@@ -29,23 +29,27 @@ component is 1). Both are exact expressions, solved weakly on the surface by
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 import sympy
 
 from dirac.analysis.core.algebra import tidy
-from dirac.analysis.core.linear_solve import weak_solve
+from dirac.analysis.core.linear_solve import weak_solve, weakly_solvable
 from dirac.analysis.core.numeric import independent_rows
 from dirac.errors import AnalysisError
 
-__all__ = ["MultiplierSolution", "general_multiplier_solution", "unsolved_multipliers"]
+__all__ = ["MultiplierSolution", "FixedMultipliers", "general_multiplier_solution", "unsolved_multipliers"]
 
 
-@dataclass
 class MultiplierSolution:
     """``u = U + v_a V_a``: the general solution of ``b + A u ≈ 0`` (Henneaux–Teitelboim (1.32)).
+
+    The exact ``U`` and ``V_a`` may be computed on first use: :func:`general_multiplier_solution`
+    decides everything numeric at once (which rows and columns are independent, that the
+    system is solvable at every sample point) and passes the exact solve as ``solve``, run
+    the first time :attr:`particular` or :attr:`null_vectors` is read (for a long chain it
+    is a symbolic elimination whose result nothing in the analysis itself needs).
 
     Attributes
     ----------
@@ -55,20 +59,58 @@ class MultiplierSolution:
         The primary constraints ``phi_k`` they multiply.
     canonical_hamiltonian
         ``H_c``.
-    particular
-        ``U``: multiplier name -> expression (``0`` for the multipliers set to zero).
-    null_vectors
-        The ``V_a``: one dict multiplier name -> component per free parameter.
     free
         The free parameters ``v_1, v_2, ...`` (one per null vector).
+
+    The exact ``U`` (:attr:`particular`, ``0`` for the multipliers set to zero) and ``V_a``
+    (:attr:`null_vectors`) are properties, solved on first read.
     """
 
-    multipliers: tuple[sympy.Symbol, ...]
-    primary: list[sympy.Expr]
-    canonical_hamiltonian: sympy.Expr
-    particular: dict[str, sympy.Expr]
-    null_vectors: list[dict[str, sympy.Expr]]
-    free: tuple[sympy.Symbol, ...] = field(default_factory=tuple)
+    def __init__(
+        self,
+        multipliers: tuple[sympy.Symbol, ...],
+        primary: list[sympy.Expr],
+        canonical_hamiltonian: sympy.Expr,
+        particular: dict[str, sympy.Expr] | None,
+        null_vectors: list[dict[str, sympy.Expr]] | None,
+        free: tuple[sympy.Symbol, ...] = (),
+        solve: Callable[[], tuple[dict[str, sympy.Expr], list[dict[str, sympy.Expr]]]] | None = None,
+    ) -> None:
+        if (particular is None or null_vectors is None) and solve is None:
+            raise ValueError("a multiplier solution needs its particular solution and null vectors, or a solve that gives them")
+        self.multipliers = multipliers
+        self.primary = primary
+        self.canonical_hamiltonian = canonical_hamiltonian
+        self.free = tuple(free)
+        self._particular = particular
+        self._null_vectors = null_vectors
+        self._solve = solve if (particular is None or null_vectors is None) else None
+
+    def __repr__(self) -> str:
+        state = "solved" if self.solved else "exact solve on first use"
+        return f"MultiplierSolution({len(self.multipliers)} multipliers, {len(self.free)} free, {state})"
+
+    @property
+    def solved(self) -> bool:
+        """Whether the exact ``U`` and ``V_a`` have been computed (they are on first use)."""
+        return self._solve is None
+
+    def _exact(self) -> tuple[dict[str, sympy.Expr], list[dict[str, sympy.Expr]]]:
+        if self._solve is not None:
+            self._particular, self._null_vectors = self._solve()
+            self._solve = None
+        assert self._particular is not None and self._null_vectors is not None
+        return self._particular, self._null_vectors
+
+    @property
+    def particular(self) -> dict[str, sympy.Expr]:
+        """``U``: multiplier name -> exact expression, weakly simplified on the surface."""
+        return self._exact()[0]
+
+    @property
+    def null_vectors(self) -> list[dict[str, sympy.Expr]]:
+        """The ``V_a`` (one dict multiplier name -> exact component per free parameter)."""
+        return self._exact()[1]
 
     @property
     def first_class_primary(self) -> list[sympy.Expr]:
@@ -121,6 +163,37 @@ class MultiplierSolution:
         return units == len(self.null_vectors)
 
 
+class FixedMultipliers(Mapping[str, sympy.Expr]):
+    """Name -> exact ``U_k`` of each multiplier fixed alone (``analysis.multipliers``).
+
+    Which multipliers are fixed alone is decided numerically during the analysis, so the
+    names (``in``, ``len``, iteration) are known at once; a value is read from
+    :attr:`MultiplierSolution.particular`, which runs the exact solve the first time.
+    """
+
+    def __init__(self, names: Sequence[str], solution: MultiplierSolution) -> None:
+        self._names = list(names)
+        self._known = set(names)
+        self._solution = solution
+
+    def __getitem__(self, name: str) -> sympy.Expr:
+        if name not in self._known:
+            raise KeyError(name)
+        return self._solution.particular[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._known
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __repr__(self) -> str:
+        return repr(dict(self))  # printing asks for the values: solved here if not yet
+
+
 def free_parameters(count: int, taken: Sequence[str]) -> tuple[sympy.Symbol, ...]:
     """``v_1, ..., v_count`` (``v_free_1, ...`` when a variable or parameter is already named ``v_k``)."""
     base = "v"
@@ -158,6 +231,10 @@ def general_multiplier_solution(
 ) -> MultiplierSolution:
     """Solve ``b_P + A_P u ≈ 0`` in general form ``u = U + v_a V_a``.
 
+    The numeric decisions (the columns ``Q``, that ``A_PQ`` is invertible at every sample
+    point) are taken now, and a system that fails them is refused now; the exact
+    ``U`` and ``V_a`` are computed on first use (:class:`MultiplierSolution`).
+
     Parameters
     ----------
     multipliers, primary, canonical_hamiltonian
@@ -187,21 +264,27 @@ def general_multiplier_solution(
             "independent multiplier columns at its points: the rank of {Phi_a, phi_k} is not the same everywhere "
             "on the surface (parts of different structure); analyse each part as a system of its own"
         )
-    A_PQ = a_rows[:, Q]
     A_num_Q = [A[:, Q] for A in A_num]
-    particular = {name: sympy.S.Zero for name in names}
-    sol = weak_solve(A_PQ, -b_rows, A_num_Q, [-b for b in B_num], variables=variables)
-    for r, k in enumerate(Q):
-        particular[names[k]] = sol[r, 0]
-    null_vectors: list[dict[str, sympy.Expr]] = []
-    if F:
-        N = weak_solve(A_PQ, -a_rows[:, F], A_num_Q, [-A[:, F] for A in A_num], variables=variables)
-        for c, j in enumerate(F):
-            vec = {name: sympy.S.Zero for name in names}
-            vec[names[j]] = sympy.S.One
-            for r, k in enumerate(Q):
-                vec[names[k]] = tidy(N[r, c], variables) if N[r, c] != 0 else sympy.S.Zero
-            null_vectors.append(vec)
+    weakly_solvable(A_num_Q, B_num)  # a system singular at a sample point is refused now, not on first use
+
+    def solve() -> tuple[dict[str, sympy.Expr], list[dict[str, sympy.Expr]]]:
+        """The exact ``U`` and ``V_a`` (run on first use)."""
+        A_PQ = a_rows[:, Q]
+        particular = {name: sympy.S.Zero for name in names}
+        sol = weak_solve(A_PQ, -b_rows, A_num_Q, [-b for b in B_num], variables=variables)
+        for r, k in enumerate(Q):
+            particular[names[k]] = sol[r, 0]
+        null_vectors: list[dict[str, sympy.Expr]] = []
+        if F:
+            N = weak_solve(A_PQ, -a_rows[:, F], A_num_Q, [-A[:, F] for A in A_num], variables=variables)
+            for c, j in enumerate(F):
+                vec = {name: sympy.S.Zero for name in names}
+                vec[names[j]] = sympy.S.One
+                for r, k in enumerate(Q):
+                    vec[names[k]] = tidy(N[r, c], variables) if N[r, c] != 0 else sympy.S.Zero
+                null_vectors.append(vec)
+        return particular, null_vectors
+
     return MultiplierSolution(
-        multipliers, list(primary), canonical_hamiltonian, particular, null_vectors, free_parameters(len(F), taken)
+        multipliers, list(primary), canonical_hamiltonian, None, None, free_parameters(len(F), taken), solve=solve
     )

@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import maximum_bipartite_matching
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.errors import AnalysisError
 
-__all__ = ["weak_solve", "block_order"]
+__all__ = ["weak_solve", "weakly_solvable", "block_order"]
 
 RELATIVE_ZERO = 1e-9
 
@@ -103,6 +103,44 @@ def block_order(pattern: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
     return match, blocks
 
 
+def weakly_solvable(
+    a_num: Sequence[np.ndarray], b_num: Sequence[np.ndarray] | np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[list[int]]]:
+    """Check that ``A X = B`` is solvable at every sample point; its weak-zero pattern and the solutions there.
+
+    The numeric half of :func:`weak_solve`, which :func:`weak_solve` runs first: a caller
+    that defers the exact solve runs it at once, so that a refusal is never deferred.
+
+    Returns
+    -------
+    a_zero, x_values, match, blocks
+        The weakly zero entries of ``A`` (``k x k``), ``X`` at each point (``points x k x c``)
+        and the block lower-triangular order of the pattern (:func:`block_order`).
+
+    Raises
+    ------
+    AnalysisError
+        When ``A`` is singular at a sample point, or structurally singular once its weakly
+        zero entries are dropped.
+    """
+    a_vals = np.asarray(a_num, dtype=float)
+    k = a_vals.shape[-1]
+    a_vals = a_vals.reshape(-1, k, k)
+    b_vals = np.asarray(b_num, dtype=float).reshape(len(a_vals), k, -1)
+    a_zero = _zero_mask(a_vals)
+    try:
+        x_vals = np.array([np.linalg.solve(a, b) for a, b in zip(a_vals, b_vals)])
+    except np.linalg.LinAlgError:
+        raise AnalysisError(
+            f"a {k}x{k} system the analysis solves on the constraint surface is singular at one of its sample "
+            "points, though independent at others: the surface has parts of different structure (a constraint "
+            "whose branches cross, or a rank that changes on it); write the constraints so that each part is a "
+            "system of its own"
+        ) from None
+    match, blocks = block_order(~a_zero)  # structurally singular: refused here
+    return a_zero, x_vals, match, blocks
+
+
 def weak_solve(
     a_sym: sympy.Matrix,
     b_sym: sympy.Matrix,
@@ -141,23 +179,12 @@ def weak_solve(
     start = time.monotonic()
     k = a_sym.shape[0]
     cols = b_sym.shape[1]
-    a_vals = np.asarray(a_num, dtype=float).reshape(-1, k, k)
     b_vals = np.asarray(b_num, dtype=float).reshape(-1, k, cols)
-    a_zero = _zero_mask(a_vals)
+    a_zero, x_vals, match, blocks = weakly_solvable(a_num, b_vals)
     b_zero = _zero_mask(b_vals)
-    try:
-        x_vals = np.array([np.linalg.solve(a, b) for a, b in zip(a_vals, b_vals)])
-    except np.linalg.LinAlgError:
-        raise AnalysisError(
-            f"a {k}x{k} system the analysis solves on the constraint surface is singular at one of its sample "
-            "points, though independent at others: the surface has parts of different structure (a constraint "
-            "whose branches cross, or a rank that changes on it); write the constraints so that each part is a "
-            "system of its own"
-        ) from None
     x_zero = _zero_mask(x_vals)
     A = sympy.Matrix(k, k, lambda i, j: sympy.S.Zero if a_zero[i, j] else a_sym[i, j])
     B = sympy.Matrix(k, cols, lambda i, j: sympy.S.Zero if b_zero[i, j] else b_sym[i, j])
-    match, blocks = block_order(~a_zero)
     X = sympy.zeros(k, cols)
     for block in blocks:
         unknowns = [int(match[i]) for i in block]

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from fractions import Fraction
 
 import numpy as np
 import sympy
@@ -165,6 +166,84 @@ def _irreducible_on_a_plane(poly: sympy.Poly, seed: int = 20240607) -> bool:
     return len(found) == 1 and found[0][1] == 1
 
 
+def _rational_terms(expr: sympy.Expr, variables: Sequence[sympy.Symbol], seed: int = 20240607) -> dict[tuple[int, ...], Fraction] | None:
+    """An expanded polynomial as ``{exponents in the variables it contains: rational coefficient}``.
+
+    Parameters in the coefficients take random integer values (seeded, 2..13, as in
+    :func:`_irreducible_on_a_plane`). ``None`` for anything that is not a sum of products of
+    numbers and integer powers of symbols (then the caller takes the general path).
+    """
+    terms = expr.args if isinstance(expr, sympy.Add) else (expr,)
+    position = {v: k for k, v in enumerate(variables)}
+    rng = np.random.default_rng(seed)
+    values = {p: Fraction(int(rng.integers(2, 14))) for p in sorted(expr.free_symbols - position.keys(), key=str)}
+    out: dict[tuple[int, ...], Fraction] = {}
+    for term in terms:
+        exponents = [0] * len(variables)
+        coeff = Fraction(1)
+        for factor in (term.args if isinstance(term, sympy.Mul) else (term,)):
+            base, exp = (factor.base, factor.exp) if isinstance(factor, sympy.Pow) else (factor, sympy.S.One)
+            if not exp.is_Integer:
+                return None
+            if base.is_Rational:
+                coeff *= Fraction(int(base.p), int(base.q)) ** int(exp)
+            elif base in position and exp > 0:
+                exponents[position[base]] += int(exp)
+            elif base in values:
+                coeff *= values[base] ** int(exp)
+            else:
+                return None
+        key = tuple(exponents)
+        out[key] = out.get(key, Fraction(0)) + coeff
+    return {m: c for m, c in out.items() if c}
+
+
+def _rank(rows: list[list[Fraction]]) -> int:
+    """Exact rank of a small rational matrix (Gaussian elimination)."""
+    rows = [list(r) for r in rows]
+    rank = 0
+    for col in range(len(rows[0]) if rows else 0):
+        pivot = next((r for r in range(rank, len(rows)) if rows[r][col]), None)
+        if pivot is None:
+            continue
+        rows[rank], rows[pivot] = rows[pivot], rows[rank]
+        for r in range(rank + 1, len(rows)):
+            if rows[r][col]:
+                f = rows[r][col] / rows[rank][col]
+                rows[r] = [a - f * b for a, b in zip(rows[r], rows[rank])]
+        rank += 1
+    return rank
+
+
+def _irreducible_quadric(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> bool:
+    """Whether a polynomial of total degree 2 is shown irreducible by the rank of its quadric (exact, cheap).
+
+    ``f = z^T S z`` with ``z = (v_1, ..., v_n, 1)`` and ``S`` symmetric (the homogenised
+    quadric). A product of two polynomials of degree 1, even over the complex numbers,
+    has ``rank S <= 2``; so ``rank S >= 3`` proves ``f`` irreducible (the classification of
+    quadrics; e.g. Hodge & Pedoe, *Methods of Algebraic Geometry*, Vol. II, Ch. XIII). The
+    parameters take random integer values: the rank at a random value is at most the generic
+    one, so the proof holds for generic parameters (as for :func:`_irreducible_on_a_plane`).
+    ``False`` means "not shown" (another degree, or rank at most 2): factor in full.
+    """
+    symbols = expr.free_symbols
+    present = [v for v in variables if v in symbols]
+    terms = _rational_terms(expr, present)
+    if not terms or max(sum(m) for m in terms) != 2:
+        return False
+    n = len(present)
+    S = [[Fraction(0)] * (n + 1) for _ in range(n + 1)]
+    for monom, c in terms.items():
+        used = [k for k, e in enumerate(monom) for _ in range(e)] + [n] * (2 - sum(monom))
+        i, j = used
+        if i == j:
+            S[i][i] += c
+        else:
+            S[i][j] += c / 2
+            S[j][i] += c / 2
+    return _rank(S) >= 3
+
+
 def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int) -> list[sympy.Expr]:
     """The distinct irreducible factors of a polynomial constraint that can vanish (the branches of ``expr = 0``).
 
@@ -172,12 +251,14 @@ def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int)
     ``max_terms`` terms. Multiplicities are dropped (the zero set of ``f^k g`` is that of
     ``f g``), factors free of the variables or without a real zero are left out. A
     polynomial linear in some variable with a coefficient free of the variables is
-    irreducible and is not factored (:func:`_linear_with_constant_coefficient`), nor is one
+    irreducible and is not factored (:func:`_linear_with_constant_coefficient`), nor is a
+    quadric of rank at least 3 (:func:`_irreducible_quadric`, no polynomial arithmetic:
+    rods and their time derivatives), nor one
     whose restriction to a random plane is irreducible (:func:`_irreducible_on_a_plane`);
     the others go through multivariate factorisation (``sympy.factor_list``).
     """
     terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
-    if terms > max_terms:
+    if terms > max_terms or _irreducible_quadric(expr, variables):
         return [expr]
     poly = _polynomial(expr, variables)
     if poly is None or poly.total_degree() < 2 or _linear_with_constant_coefficient(poly) or _irreducible_on_a_plane(poly):

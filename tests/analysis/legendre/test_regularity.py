@@ -168,3 +168,26 @@ def test_expanded_product_met_in_the_chain_is_refused_with_its_branches():
     L = dirac.Lagrangian.from_strings("branches", ["x", "y", "z"], "x_dot*z_dot + y*(x*z + z)")
     with pytest.raises(AnalysisError, match=r"x\*z \+ z = 0 is irregular.*branches z = 0 and x \+ 1 = 0"):
         dirac.analyze(L)
+
+
+def test_quadrics_of_rank_three_or_more_are_irreducible_without_factorisation():
+    """``f = z^T S z``, ``z = (v, 1)``: a product of two linear factors (even complex) has
+    ``rank S <= 2``, so rank >= 3 proves ``f`` irreducible (by hand: ``x^2 + y^2 - l^2`` has
+    ``S = diag(1, 1, -l^2)``, rank 3; ``(x - y)(p - q) + z w``, rank 4; ``x y + 1``, rank 3).
+    Rank <= 2 is "not shown" and goes to factorisation: ``x^2 - y^2 = (x - y)(x + y)``
+    (rank 2) is split, ``x^2 + y^2`` (rank 2, irreducible over the rationals) is not."""
+    from dirac.analysis.legendre.regularity import _irreducible_quadric, factors
+
+    x, y, z, w, p, q, l, m = sympy.symbols("x y z w p q l m", real=True)
+    V = [x, y, z, w, p, q]
+    assert _irreducible_quadric(x**2 + y**2 - l**2, V)
+    assert _irreducible_quadric(sympy.expand((x - y) * (p - q) + z * w), V)
+    assert _irreducible_quadric(x * y + 1, V)
+    assert not _irreducible_quadric(x**2 - y**2, V)
+    assert not _irreducible_quadric(x**2 + y**2, V)
+    assert not _irreducible_quadric(sympy.expand(x * y * z), V)  # degree 3: not this test
+    assert set(factors(x**2 - y**2, V, 60)) == {x - y, x + y}
+    assert factors(x**2 + y**2, V, 60) == [x**2 + y**2]
+    # with a parameter in the coefficients: (x + y - l)(x - y + 2)/m has rank 2 and is split
+    split = factors(sympy.expand((x + y - l) * (x - y + 2) / m), V, 60)
+    assert {sympy.expand(f) for f in split} == {x + y - l, x - y + 2}
