@@ -65,14 +65,20 @@ def legendre():
     return legendre_transform(light_cone_lagrangian(), np.random.default_rng(1), {})
 
 
-def test_the_two_components_of_the_surface_are_refused_not_mixed():
+def test_both_components_of_the_surface_are_listed_not_mixed():
     """The surface has two components of different structure (rank C = 4 where A_- != 0,
-    6 on A_- = 0, see the module docstring): the classification must not take its counts
-    from a mixture of points of both; it refuses and says why."""
-    with pytest.raises(AnalysisError, match="differs between regular points") as caught:
-        dirac.analyze(light_cone_lagrangian())
-    # the refusal names both parts and the assumption that picks each
-    assert "am1**2 + am2**2 + am3**2 != 0" in str(caught.value) and "am1 = am2 = am3 = 0" in str(caught.value)
+    6 on A_- = 0, see the module docstring): the counts must not come from a mixture of
+    points of both. Without an assumption each part is analysed on its own and listed, the
+    top-level counts are those of the first part, and a warning says so."""
+    with pytest.warns(dirac.errors.DiracWarning, match="2 parts of different structure"):
+        analysis = dirac.analyze(light_cone_lagrangian())
+    parts = analysis.to_json()["components"]
+    assert [p["condition"] for p in parts] == ["am1**2 + am2**2 + am3**2 != 0", "am1 = am2 = am3 = 0"]
+    published = parts[0]
+    assert (len(published["first_class"]), len(published["second_class"]), published["physical_degrees_of_freedom"]) == (8, 4, 2)
+    assert (len(analysis.first_class), len(analysis.second_class)) == (8, 4)
+    # the part A_- = 0 is listed with its own outcome: counts, or the reason it was refused
+    assert "error" in parts[1] or "physical_degrees_of_freedom" in parts[1]
 
 
 def test_primary_constraints(legendre):
@@ -100,9 +106,9 @@ def test_published_counts(light_cone):
 
 
 def test_the_part_a_minus_zero_is_refused_not_a_traceback():
-    """Guards the check in ``general_multiplier_solution`` that the consistency rows independent
-    on the surface have as many independent multiplier columns: with ``A_- = 0`` imposed as
-    holonomic constraints they did not (ranks that differ between parts), and reshaping the
-    numeric block raised a ``ValueError``. It is an ``AnalysisError`` naming the mismatch now."""
-    with pytest.raises(AnalysisError, match="independent multiplier columns"):
+    """``A_- = 0`` imposed (stage 2, no multipliers): its stage-3 conditions vanish on the whole
+    of ``A_1 = A_2 = 0`` and the sample points fall there, where their gradients vanish. The
+    analysis refuses with an ``AnalysisError`` (no ``ValueError`` from mismatched ranks, no
+    counts taken at the singular points)."""
+    with pytest.raises(AnalysisError, match="irregular|independent multiplier columns"):
         dirac.analyze(light_cone_lagrangian(), assume=["am1 = 0", "am2 = 0", "am3 = 0"])
