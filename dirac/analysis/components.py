@@ -32,8 +32,7 @@ import sympy
 
 from dirac.analysis.constraint_analysis import ConstraintAnalysis, at_given_values
 from dirac.analysis.constraint_analysis import analyze as analyze_one_part
-from dirac.analysis.report import STRUCTURE_KEYS, structure_summary
-from dirac.analysis.report import to_json as report_json
+from dirac.analysis.report import structure_json, structure_summary
 from dirac.errors import DiracError, SeparableParts, warn
 from dirac.model.lagrangian import Lagrangian
 from dirac.model.lagrangian import Lagrangian as _Lagrangian
@@ -56,8 +55,9 @@ class Component:
         """``{"condition", "stages", "first_class", "second_class", "physical_degrees_of_freedom"}`` or ``{"condition", "error"}``."""
         if self.analysis is None:
             return {"condition": self.condition, "error": self.error}
-        full = report_json(self.analysis)  # not analysis.to_json(): the first part is the top-level analysis
-        return {"condition": self.condition, **{k: full[k] for k in STRUCTURE_KEYS}}
+        # only the structure (not analysis.to_json(): the first part is the top-level analysis, and a
+        # part's gauge generators or multipliers are not asked for here)
+        return {"condition": self.condition, **structure_json(self.analysis)}
 
     def summary(self) -> str:
         """One line: stage sizes and counts, or the refusal."""

@@ -54,7 +54,13 @@ from dirac.analysis.classes.multiplier_solution import (
 )
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
-from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
+from dirac.analysis.core.numeric import (
+    Numerics,
+    SingularSurface,
+    columns_invertible_everywhere,
+    independent_rows,
+    numeric_rank,
+)
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.regularity import (
@@ -79,6 +85,8 @@ SAMPLE_POINTS = 4
 #: regular-point and rank checks at the sample points. Holonomic constraints of the
 #: Lagrangian (met once) are factored up to ``MAX_FACTOR_TERMS`` terms.
 FACTOR_TERMS = 24
+#: a variable at most this large at every sample point spans a suspected singular locus (:meth:`ConstraintChain._off_singular_locus`)
+LOCUS_SIZE = 1e-2
 
 
 class _Split(Exception):
@@ -235,6 +243,8 @@ class ConstraintChain:
             pivot_cols = independent_rows([m[pivots_rows].T for m in A_num], list(range(K))) if pivots_rows else []
             if len(pivot_cols) != len(pivots_rows):  # row and column ranks differ: not one rank at every point
                 self._check_consistent_rank(A_num, pivots_rows)
+                pivot_cols = columns_invertible_everywhere(A_num, pivots_rows)
+            if len(pivot_cols) != len(pivots_rows):
                 raise AnalysisError(
                     f"the consistency matrix {{Phi_a, phi_k}} has {len(pivots_rows)} independent rows but "
                     f"{len(pivot_cols)} independent multiplier columns at the sample points (stage {len(self.stages) + 1}): "
@@ -426,10 +436,49 @@ class ConstraintChain:
             new_points = self._new_points(constraints, candidates)
             chosen = self._independent(candidates, constraints, new_points)
             irregular = self._irregular(candidates, chosen, constraints, new_points)
+            if irregular and not self.numerics.hold and self._off_singular_locus(candidates, constraints, irregular, new_points):
+                return self._settle(candidates, constraints, limit)
             if not irregular:
                 return candidates, chosen
             candidates = [self._regularised(c) if i in irregular else c for i, c in enumerate(candidates)]
         raise AnalysisError("the constraint chain could not regularise its new constraints")  # pragma: no cover
+
+    def _off_singular_locus(
+        self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], irregular: list[int], points: list[np.ndarray]
+    ) -> bool:
+        """Whether the candidates found irregular are regular at points that hold some of their variables.
+
+        Projections onto homogeneous conditions (``A_2 x (A_1 x A_2) = 0`` among others) fall
+        onto the origin of their variables, where such conditions and their gradients
+        vanish: irregular there, regular on the rest of the surface. The variables of those
+        candidates that are near zero at every one of their ``points`` span the suspected
+        locus; projections that hold two of them at random start values avoid it
+        (:meth:`~dirac.analysis.core.numeric.Numerics._held_variables`). When the candidates
+        are regular at such points, every later projection of this analysis holds them
+        and a note says so; otherwise nothing changes.
+        """
+        involved = set().union(*(candidates[i].free_symbols for i in irregular)) & set(self.phase_space.variables)
+        variables = list(self.phase_space.variables)
+        indices = sorted(variables.index(v) for v in involved)
+        values = np.abs(np.asarray(points)[:, indices]) if points else np.ones((1, len(indices)))
+        small = [i for i, column in zip(indices, values.T) if np.all(column <= LOCUS_SIZE)]
+        self.numerics.hold = tuple(small if len(small) >= 3 else indices)
+        try:
+            points = self._new_points(constraints, candidates)
+            chosen = self._independent(candidates, constraints, points)
+            still = self._irregular(candidates, chosen, constraints, points)
+        except AnalysisError:
+            still = irregular
+        if not self.numerics.hold or set(still) & set(irregular):
+            self.numerics.hold = ()
+            return False
+        shown = ", ".join(f"{candidates[i]} = 0" for i in irregular[:2]) + (" ..." if len(irregular) > 2 else "")
+        self.regularity_notes.append(
+            f"stage {len(self.stages) + 1}: the sample points first fell where the gradients of new constraints "
+            f"vanish ({shown}); every later point was found holding two of their variables at random values, "
+            "which keeps the points on the regular part of the surface"
+        )
+        return True
 
     def _new_points(self, constraints: list[sympy.Expr], candidates: list[sympy.Expr]) -> list[np.ndarray]:
         """Regular points of the old surface on which the candidates vanish too."""
