@@ -32,7 +32,7 @@ from typing import Any
 
 import sympy
 
-from dirac.analysis.report import STRUCTURE_KEYS, structure_summary
+from dirac.analysis.report import structure_json, structure_summary
 from dirac.errors import DiracError
 from dirac.model.lagrangian import Lagrangian
 
@@ -71,8 +71,7 @@ class ParameterCase:
         """
         if self.analysis is None:
             return {"condition": self.condition, "depth": self.depth, "error": self.error}
-        full = self.analysis.to_json()
-        return {"condition": self.condition, "depth": self.depth, **{k: full[k] for k in STRUCTURE_KEYS}}
+        return {"condition": self.condition, "depth": self.depth, **structure_json(self.analysis)}
 
     def summary(self) -> str:
         """``"2 first class, 0 second class, 0 degrees of freedom"`` (or the refusal)."""

@@ -13,9 +13,10 @@ Two refusals of the analysis name parts that can be told apart
   points of the surface. The points are grouped by rank; the phase-space variables that
   vanish at every point of one group and not at every point of the others name the part
   (light-cone SU(2) Yang–Mills mechanics: ``A_-^a = 0`` at every point where the rank is 6).
-  These parts are not analysed one by one automatically (the part where the variables
-  vanish can take very long): the refusal names both parts and the assumption that picks
-  each (``sum v**2 != 0``, or each ``v = 0``; :mod:`dirac.analysis.chain.assumptions`).
+  Each part is analysed with the assumption that picks it (``sum v**2 != 0``: sample points
+  away from the other part; each ``v = 0``: imposed as constraints, so that the chain keeps
+  the motions that stay in the part; :mod:`dirac.analysis.chain.assumptions`). A part whose
+  own analysis is refused is listed with the reason.
 
 Where no separating condition is found, the refusal stands (it names the parts).
 """
@@ -31,8 +32,7 @@ import sympy
 
 from dirac.analysis.constraint_analysis import ConstraintAnalysis, at_given_values
 from dirac.analysis.constraint_analysis import analyze as analyze_one_part
-from dirac.analysis.report import STRUCTURE_KEYS, structure_summary
-from dirac.analysis.report import to_json as report_json
+from dirac.analysis.report import structure_json, structure_summary
 from dirac.errors import DiracError, SeparableParts, warn
 from dirac.model.lagrangian import Lagrangian
 from dirac.model.lagrangian import Lagrangian as _Lagrangian
@@ -55,8 +55,9 @@ class Component:
         """``{"condition", "stages", "first_class", "second_class", "physical_degrees_of_freedom"}`` or ``{"condition", "error"}``."""
         if self.analysis is None:
             return {"condition": self.condition, "error": self.error}
-        full = report_json(self.analysis)  # not analysis.to_json(): the first part is the top-level analysis
-        return {"condition": self.condition, **{k: full[k] for k in STRUCTURE_KEYS}}
+        # only the structure (not analysis.to_json(): the first part is the top-level analysis, and a
+        # part's gauge generators or multipliers are not asked for here)
+        return {"condition": self.condition, **structure_json(self.analysis)}
 
     def summary(self) -> str:
         """One line: stage sizes and counts, or the refusal."""
@@ -131,18 +132,15 @@ def analyze_components(lagrangian: Lagrangian, error: SeparableParts, analyse: C
         parts = separating_assumptions(error)
         if parts is None:
             raise error
-        # not analysed one by one here (the part where the variables vanish can take very long):
-        # the refusal names the parts and the assumption that picks each
-        named = "; ".join(f"{condition} (assume {', '.join(repr(a) for a in assume)})" for condition, assume in parts)
-        raise SeparableParts(
-            f"{error}; the parts are {named}: pick one with assume=[...] (dirac analyze --assume)",
-            points=error.points,
-            ranks=error.ranks,
-            variables=error.variables,
-        ) from error
+        for condition, assume in parts:
+            analysis, why = _analyse(analyse, lagrangian, assume)
+            components.append(Component(condition, analysis, why))
     analysed = [c for c in components if c.analysis is not None]
     if not analysed:
-        raise error
+        shown = "; ".join(f"{c.condition}: {c.error}" for c in components)
+        raise SeparableParts(f"{error}; no part could be analysed on its own ({shown})", points=error.points,
+                             ranks=error.ranks, variables=error.variables, holonomic=error.holonomic,
+                             branches=error.branches) from error
     first = analysed[0].analysis
     shown = "; ".join(f"{c.condition}: {c.summary()}" for c in components)
     kind = "crossing branches" if error.holonomic is not None else "parts of different structure"
@@ -178,8 +176,9 @@ def analyze(
     ConstraintAnalysis
         Where the constraint surface has crossing branches (and no assumption is given),
         the analysis of the first branch, with every branch in ``.components`` and a
-        warning; a surface whose parts differ in rank is refused naming the parts and the
-        assumption that picks each.
+        warning; likewise for a surface whose parts differ in rank (each part analysed
+        with the assumption that picks it, a part that cannot be analysed listed with the
+        reason).
 
     Examples
     --------

@@ -8,7 +8,6 @@ paper's (1); Sect. X for the rigid body (78), Sect. XI for (228)).
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
@@ -145,13 +144,7 @@ class ConstraintAnalysis:
                 clock[0] = now
 
         nonzero_text = [str(a) for a in assume if "!=" in str(a)]
-        equalities = parse_assumptions(
-            [str(a) for a in assume if "!=" not in str(a)], {**lagrangian.symbols, **{c.name: c for c in lagrangian.coordinates}}
-        )
-        if any(e.expression.free_symbols & set(lagrangian.velocities) for e in equalities):
-            raise InputError("an assumption EXPR = 0 is added as a holonomic constraint: EXPR may use coordinates and parameters, not velocities")
-        if equalities:
-            lagrangian = dataclasses.replace(lagrangian, constraints=(*lagrangian.constraints, *(e.expression for e in equalities)))
+        equality_text = [str(a) for a in assume if "!=" not in str(a)]
         self.assumptions = tuple(str(a) for a in assume)
         lagrangian, regularised = regular_holonomic(lagrangian)
         self.lagrangian = lagrangian
@@ -177,7 +170,11 @@ class ConstraintAnalysis:
         forced_in_time = lagrangian.time is not None and any(lagrangian.time in e.free_symbols for e in self.forces.values())
         self.time = lagrangian.time if (lagrangian.is_time_dependent or forced_in_time) else None
         self._numerics = Numerics(space, self._generic, seed=seed, time=self.time)
-        nonzero = parse_assumptions(nonzero_text, {**space.symbols, **{p.name: p for p in lagrangian.parameters}})
+        assumable = {**space.symbols, **{p.name: p for p in lagrangian.parameters}}
+        if self.time is not None:
+            assumable[self.time.name] = self.time
+        nonzero = parse_assumptions(nonzero_text, assumable)
+        equalities = parse_assumptions(equality_text, assumable)
         self._numerics.avoid = [a.expression for a in nonzero]
         chain = ConstraintChain(
             space, self._numerics, legendre.canonical_hamiltonian, legendre.primary, self.primary_multipliers, time=self.time
@@ -186,6 +183,7 @@ class ConstraintAnalysis:
         expanded = [tidy(chi, space.variables, sign=True) for chi in lagrangian.constraints]
         chain.written = {e: chi for e, chi in zip(expanded, lagrangian.constraints) if isinstance(chi, sympy.Mul)}
         chain.holonomic = {e: k for k, e in enumerate(expanded, start=1)}
+        chain.imposed = [e.expression for e in equalities]
         chain.run()
         self._chain = chain
         done(f"constraint chain: {_count(len(chain.stages), 'stage')} "
@@ -237,7 +235,8 @@ class ConstraintAnalysis:
             *regularised,
             *chain.regularity_notes,
             *(f"assumed {a}: every point of the surface where ranks were decided is away from {a.expression} = 0" for a in nonzero),
-            *(f"assumed {e}: added as the holonomic constraint {e.expression} = 0" for e in equalities),
+            *(f"assumed {e}: imposed as a constraint of stage 2 (no multiplier of its own, the Lagrangian unchanged); "
+              "the later stages keep only the part of the surface on which the motion keeps it" for e in equalities),
         ]
         if self.forces:
             self.notes.append(

@@ -19,7 +19,7 @@ from dirac.model.lagrangian import Lagrangian, latex_names
 if TYPE_CHECKING:  # the report reads a solution; it needs no solver
     from dirac.analysis.classes.multiplier_solution import MultiplierSolution
 
-__all__ = ["AnalysisResult", "to_json", "to_text", "to_latex", "STRUCTURE_KEYS", "structure_summary"]
+__all__ = ["AnalysisResult", "to_json", "to_text", "to_latex", "STRUCTURE_KEYS", "structure_json", "structure_summary"]
 
 
 class AnalysisResult(Protocol):
@@ -94,6 +94,18 @@ SUBEXPRESSION_PREFIX = "cse_"
 
 #: the JSON keys that describe the structure of one case or one part of the surface (docs/file_formats.md)
 STRUCTURE_KEYS = ("stages", "first_class", "second_class", "physical_degrees_of_freedom")
+
+
+def structure_json(analysis: AnalysisResult) -> dict:
+    """The :data:`STRUCTURE_KEYS` of :func:`to_json` alone (for a case or a part: nothing else is computed)."""
+    return {
+        "stages": [
+            {"stage": k, "constraints": [expression_text(c) for c in stage]} for k, stage in enumerate(analysis.stages, start=1)
+        ],
+        "first_class": [expression_text(c) for c in analysis.first_class],
+        "second_class": [expression_text(c) for c in analysis.second_class],
+        "physical_degrees_of_freedom": analysis.physical_degrees_of_freedom,
+    }
 
 
 def structure_summary(analysis: AnalysisResult) -> str:

@@ -48,8 +48,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=[],
         metavar="CONDITION",
         help='analyse the part of the phase space where CONDITION holds (repeatable): "EXPR != 0" keeps the points '
-        'where ranks are decided away from EXPR = 0, "EXPR = 0" adds EXPR (a function of the coordinates) as a '
-        'holonomic constraint; e.g. --assume "am1**2 + am2**2 + am3**2 != 0"',
+        'where ranks are decided away from EXPR = 0, "EXPR = 0" imposes EXPR (a phase-space function) as a '
+        'constraint without a multiplier; e.g. --assume "am1**2 + am2**2 + am3**2 != 0"',
     )
     parser.add_argument(
         "--cases",

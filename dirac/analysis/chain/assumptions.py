@@ -4,8 +4,13 @@ Where the constraint surface has parts of different structure (the light-cone Ya
 surface: ``A_- != 0`` and ``A_- = 0``), ranks decided at random points of the surface mix
 the parts. An assumption ``EXPR != 0`` keeps the sample points away from ``EXPR = 0``
 (:attr:`dirac.analysis.core.numeric.Numerics.avoid`), so every rank is that of the part
-where ``EXPR != 0``; ``EXPR = 0`` adds ``EXPR`` as a holonomic constraint (a function of
-the coordinates and parameters).
+where ``EXPR != 0``. ``EXPR = 0`` (a function of the phase-space variables and parameters)
+is imposed as a constraint of stage 2, without a multiplier of its own
+(:attr:`dirac.analysis.chain.constraint_chain.ConstraintChain.imposed`): the Lagrangian is
+unchanged, and the later stages keep the part of the surface on which the motion keeps
+``EXPR = 0`` (Dirac's consistency conditions applied to the restriction). Adding it as a
+holonomic constraint instead would add a reaction force along its gradient: another
+system.
 """
 
 from __future__ import annotations

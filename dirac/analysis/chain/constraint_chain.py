@@ -56,7 +56,13 @@ from dirac.analysis.classes.multiplier_solution import (
 )
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
-from dirac.analysis.core.numeric import Numerics, SingularSurface, independent_rows, numeric_rank
+from dirac.analysis.core.numeric import (
+    Numerics,
+    SingularSurface,
+    columns_invertible_everywhere,
+    independent_rows,
+    numeric_rank,
+)
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.regularity import (
@@ -81,6 +87,8 @@ SAMPLE_POINTS = 4
 #: regular-point and rank checks at the sample points. Holonomic constraints of the
 #: Lagrangian (met once) are factored up to ``MAX_FACTOR_TERMS`` terms.
 FACTOR_TERMS = 24
+#: a variable at most this large at every sample point spans a suspected singular locus (:meth:`ConstraintChain._off_singular_locus`)
+LOCUS_SIZE = 1e-2
 
 
 class _Split(Exception):
@@ -129,6 +137,10 @@ class ConstraintChain:
     momentum ``p_r`` of a coordinate to the generalized force ``Q_r`` in phase-space
     variables: Lagrange's equations with forces give ``p_dot = -dH/dq + Q``, so every
     consistency condition gains ``sum_r dPhi/dp_r Q_r`` and the multipliers are solved with it.
+    ``imposed`` are phase-space functions an assumption ``EXPR = 0`` sets to zero
+    (:mod:`dirac.analysis.chain.assumptions`): they join the chain as stage 2, before the
+    consistency conditions of the primary constraints, without multipliers of their own, so
+    that the chain finds the part of the surface on which the motion keeps them zero.
     """
 
     phase_space: PhaseSpace
@@ -149,6 +161,7 @@ class ConstraintChain:
     holonomic: dict[sympy.Expr, int] = field(default_factory=dict)
     choices: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
     forces: dict[sympy.Symbol, sympy.Expr] = field(default_factory=dict)
+    imposed: list[sympy.Expr] = field(default_factory=list)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -258,6 +271,8 @@ class ConstraintChain:
         if primary and len(base_grads) < len(primary):
             raise AnalysisError("the primary constraints are not independent; the analysis cannot proceed")
         limit = max_stages or (self.phase_space.dimension + 2)
+        if self.imposed:
+            points = self._impose(points, limit)
         K = len(self.primary)
         pivots_rows: list[int] = []
         pivot_cols: list[int] = []
@@ -273,6 +288,15 @@ class ConstraintChain:
             order += [i for i in range(len(constraints)) if not b_zero[i] and not a_row_zero[i]]
             pivots_rows = independent_rows(list(A_num), order) if K else []
             pivot_cols = independent_rows([m[pivots_rows].T for m in A_num], list(range(K))) if pivots_rows else []
+            if len(pivot_cols) != len(pivots_rows):  # row and column ranks differ: not one rank at every point
+                self._check_consistent_rank(A_num, pivots_rows)
+                pivot_cols = columns_invertible_everywhere(list(A_num), pivots_rows)
+            if len(pivot_cols) != len(pivots_rows):
+                raise AnalysisError(
+                    f"the consistency matrix {{Phi_a, phi_k}} has {len(pivots_rows)} independent rows but "
+                    f"{len(pivot_cols)} independent multiplier columns at the sample points (stage {len(self.stages) + 1}): "
+                    "its rank is not decided cleanly on this surface; analyse its parts as systems of their own"
+                )
             direct: list[sympy.Expr] = []
             deferred: list[tuple[int, list[int]]] = []  # (row, pivot positions it must be reduced by)
             for i in range(len(constraints)):
@@ -304,6 +328,27 @@ class ConstraintChain:
             self._check_consistent_rank(A_num, pivots_rows)
         self._solve_multipliers(points, pivots_rows, pivot_cols)
         return self
+
+    def _impose(self, points: list[np.ndarray], limit: int) -> list[np.ndarray]:
+        """Add the :attr:`imposed` functions as the next stage; the points of the smaller surface.
+
+        An imposed function that vanishes on the surface already (or depends on the others)
+        adds nothing; one that cannot vanish there is refused.
+        """
+        imposed = [tidy(c, self.phase_space.variables, sign=True) for c in self.imposed]
+        try:
+            candidates, chosen = self._settle(self._nonzero(imposed, points), self.constraints, limit)
+        except InconsistentSystemError:
+            shown = ", ".join(f"{c} = 0" for c in imposed)
+            raise InconsistentSystemError(
+                f"the assumption(s) {shown} cannot hold on the primary constraint surface: no part of the phase space "
+                "satisfies them"
+            ) from None
+        if not chosen:
+            return points
+        self.stages.append([candidates[i] for i in chosen])
+        self._keep_reducible(candidates, chosen)
+        return self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
 
     def _nonzero(self, candidates: list[sympy.Expr], points: list[np.ndarray]) -> list[sympy.Expr]:
         """The candidates that are not weakly zero, tidied (constraints: the sign is free)."""
@@ -411,7 +456,7 @@ class ConstraintChain:
         return ConstraintChain(
             self.phase_space, self.numerics, self.canonical_hamiltonian, list(self.primary), self.multipliers,
             time=self.time, written=dict(self.written), holonomic=dict(self.holonomic), choices=choices,
-            forces=dict(self.forces),
+            forces=dict(self.forces), imposed=list(self.imposed),
         )
 
     def _structure(self) -> tuple[tuple[int, ...], int, tuple[str, ...], int]:
@@ -439,10 +484,49 @@ class ConstraintChain:
             new_points = self._new_points(constraints, candidates)
             chosen = self._independent(candidates, constraints, new_points)
             irregular = self._irregular(candidates, chosen, constraints, new_points)
+            if irregular and not self.numerics.hold and self._off_singular_locus(candidates, constraints, irregular, new_points):
+                return self._settle(candidates, constraints, limit)
             if not irregular:
                 return candidates, chosen
             candidates = [self._regularised(c) if i in irregular else c for i, c in enumerate(candidates)]
         raise AnalysisError("the constraint chain could not regularise its new constraints")  # pragma: no cover
+
+    def _off_singular_locus(
+        self, candidates: list[sympy.Expr], constraints: list[sympy.Expr], irregular: list[int], points: list[np.ndarray]
+    ) -> bool:
+        """Whether the candidates found irregular are regular at points that hold some of their variables.
+
+        Projections onto homogeneous conditions (``A_2 x (A_1 x A_2) = 0`` among others) fall
+        onto the origin of their variables, where such conditions and their gradients
+        vanish: irregular there, regular on the rest of the surface. The variables of those
+        candidates that are near zero at every one of their ``points`` span the suspected
+        locus; projections that hold two of them at random start values avoid it
+        (:meth:`~dirac.analysis.core.numeric.Numerics._held_variables`). When the candidates
+        are regular at such points, every later projection of this analysis holds them
+        and a note says so; otherwise nothing changes.
+        """
+        involved = set().union(*(candidates[i].free_symbols for i in irregular)) & set(self.phase_space.variables)
+        variables = list(self.phase_space.variables)
+        indices = sorted(variables.index(v) for v in involved)
+        values = np.abs(np.asarray(points)[:, indices]) if points else np.ones((1, len(indices)))
+        small = [i for i, column in zip(indices, values.T) if np.all(column <= LOCUS_SIZE)]
+        self.numerics.hold = tuple(small if len(small) >= 3 else indices)
+        try:
+            points = self._new_points(constraints, candidates)
+            chosen = self._independent(candidates, constraints, points)
+            still = self._irregular(candidates, chosen, constraints, points)
+        except AnalysisError:
+            still = irregular
+        if not self.numerics.hold or set(still) & set(irregular):
+            self.numerics.hold = ()
+            return False
+        shown = ", ".join(f"{candidates[i]} = 0" for i in irregular[:2]) + (" ..." if len(irregular) > 2 else "")
+        self.regularity_notes.append(
+            f"stage {len(self.stages) + 1}: the sample points first fell where the gradients of new constraints "
+            f"vanish ({shown}); every later point was found holding two of their variables at random values, "
+            "which keeps the points on the regular part of the surface"
+        )
+        return True
 
     def _new_points(self, constraints: list[sympy.Expr], candidates: list[sympy.Expr]) -> list[np.ndarray]:
         """Regular points of the old surface on which the candidates vanish too."""
@@ -475,8 +559,9 @@ class ConstraintChain:
         if part is None:
             raise AnalysisError(
                 f"the stage-{len(self.stages) + 1} constraint {constraint} = 0 is irregular: its gradient vanishes "
-                "where it holds (independent of the earlier constraints only by round-off), and it is not a power "
-                "of a simpler polynomial; write the surface with constraints whose gradients are independent on it "
+                "at every point found where it holds (independent of the earlier constraints only by round-off), and "
+                "it is not a power of a simpler polynomial (the points may also lie on a singular part of a surface "
+                "that is regular elsewhere); write the surface with constraints whose gradients are independent on it "
                 "(e.g. x = 0 and y = 0 instead of x**2 + y**2 = 0)" + branch_hint(self.constraints, self.phase_space.variables)
             )
         self._refuse_crossing(part, self.constraints)

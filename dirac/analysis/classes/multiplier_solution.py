@@ -34,9 +34,9 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 import numpy as np
 import sympy
 
-from dirac.analysis.core.algebra import tidy
-from dirac.analysis.core.linear_solve import weak_solve, weakly_solvable
-from dirac.analysis.core.numeric import independent_rows
+from dirac.analysis.core.algebra import prints_shorter, tidy
+from dirac.analysis.core.linear_solve import TIDY_LIMIT, weak_solve, weakly_solvable
+from dirac.analysis.core.numeric import columns_invertible_everywhere, independent_rows
 from dirac.errors import AnalysisError
 
 __all__ = ["MultiplierSolution", "FixedMultipliers", "general_multiplier_solution", "unsolved_multipliers"]
@@ -257,6 +257,8 @@ def general_multiplier_solution(
     A_num = [np.asarray(A, dtype=float).reshape(-1, K) for A in a_num]
     B_num = [np.asarray(b, dtype=float).reshape(-1, 1) for b in b_num]
     Q = independent_rows([A.T for A in A_num], list(order))
+    if len(Q) < a_rows.shape[0]:  # the columns that carry the rank differ between points
+        Q = columns_invertible_everywhere(A_num, list(range(a_rows.shape[0])), list(order)) or Q
     F = [k for k in range(K) if k not in Q]
     if len(Q) != a_rows.shape[0]:  # rows independent on the surface, columns not: ranks decided inconsistently
         raise AnalysisError(
@@ -281,7 +283,8 @@ def general_multiplier_solution(
                 vec = {name: sympy.S.Zero for name in names}
                 vec[names[j]] = sympy.S.One
                 for r, k in enumerate(Q):
-                    vec[names[k]] = tidy(N[r, c], variables) if N[r, c] != 0 else sympy.S.Zero
+                    entry = N[r, c]
+                    vec[names[k]] = tidy(entry, variables, rational=prints_shorter(entry, TIDY_LIMIT // 4)) if entry != 0 else sympy.S.Zero
                 null_vectors.append(vec)
         return particular, null_vectors
 

@@ -80,6 +80,35 @@ def numeric_rank(matrix: np.ndarray, tol: float = 1e-8, scale: float | None = No
     return int(np.sum(s > tol * max(s[0], scale or 0.0)))
 
 
+#: at most this many column sets are tried by :func:`columns_invertible_everywhere`
+COLUMN_SETS = 5000
+
+
+def columns_invertible_everywhere(matrices: Sequence[np.ndarray], rows: Sequence[int], order: Sequence[int] | None = None) -> list[int]:
+    """Columns ``Q`` with ``m[rows, Q]`` square and invertible at every point, or ``[]``.
+
+    :func:`independent_rows` keeps a column when it raises the rank at a majority of the
+    points. When the rows have full rank at every point but the columns that carry it differ
+    from point to point (half the points need one column, half another), the majority
+    choice finds too few. Here the column sets of the right size are tried in
+    lexicographic order of ``order`` (the preference; all columns by default; at most
+    ``COLUMN_SETS`` sets) and the first one of full rank at every point is returned, so that
+    the multipliers are solved from the same columns everywhere.
+    """
+    from itertools import combinations, islice
+
+    rows = list(rows)
+    if not rows or not len(matrices):
+        return []
+    blocks = [np.asarray(m)[rows] for m in matrices]
+    scales = [(np.max(np.abs(b)) or 1.0) for b in blocks]
+    preference = list(order) if order is not None else list(range(blocks[0].shape[1]))
+    for columns in islice(combinations(preference, len(rows)), COLUMN_SETS):
+        if all(numeric_rank(b[:, list(columns)] / s) == len(rows) for b, s in zip(blocks, scales)):
+            return list(columns)
+    return []
+
+
 def independent_rows(
     matrices: Sequence[Any], order: Sequence[int], base: Sequence[Any] | None = None, notes: list[str] | None = None
 ) -> list[int]:
@@ -181,6 +210,8 @@ class Numerics:
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
+        #: indices of variables that projections hold two of at their start values (:meth:`_held_variables`)
+        self.hold: tuple[int, ...] = ()
 
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
@@ -315,6 +346,23 @@ class Numerics:
         scales = self.term_scale(self.avoid, [z])[0]
         return bool(np.any(np.abs(values) <= AVOID_TOLERANCE * scales))
 
+    def _held_variables(self, free: np.ndarray) -> np.ndarray:
+        """Variables held at their random start values in this projection (none unless :attr:`hold`).
+
+        Gauss–Newton steps on homogeneous conditions (``A_2 x (A_1 x A_2) = 0``) shrink the
+        point towards the origin of their variables, where such conditions are singular. With
+        :attr:`hold` (indices of those variables, set by the chain once its points fell on
+        such a locus) each projection holds two of them, chosen at random, at their start
+        values, so that the point lands on the regular part of the surface; it passes the
+        same tests as any other point.
+        """
+        if len(self.hold) < 3:
+            return np.empty(0, dtype=int)
+        choices = np.intersect1d(np.asarray(self.hold, dtype=int), free)
+        if choices.size < 3:
+            return np.empty(0, dtype=int)
+        return self.rng.choice(choices, size=2, replace=False)
+
     def surface_points(
         self,
         constraints: Sequence[sympy.Expr],
@@ -368,6 +416,7 @@ class Numerics:
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
             for i, v in fixed.items():
                 z[i] = v
+            step_free = np.setdiff1d(free, self._held_variables(free))
             if jacobian is None:
                 points.append(z)
                 continue
@@ -383,12 +432,12 @@ class Numerics:
                 J = jacobian(z)
                 if not jacobian.finite(J):
                     break
-                step = jacobian.step(J[:, free], r)
+                step = jacobian.step(J[:, step_free], r)
                 norm = np.linalg.norm(step)
                 if norm > 10.0:  # keep steps bounded far from the surface
                     step *= 10.0 / norm
                 z = z.copy()
-                z[free] += step
+                z[step_free] += step
             if ok and regular and jacobian.singular(z, regular):
                 singular += 1
                 continue

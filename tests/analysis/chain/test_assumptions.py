@@ -43,11 +43,28 @@ def test_nonzero_assumption_keeps_points_away():
     assert a.to_json()["assumptions"] == ["x != 0"]
 
 
-def test_equality_assumption_is_a_holonomic_constraint(run_cli):
+def test_equality_assumption_keeps_the_motions_that_stay_on_it(run_cli):
+    """``x = 0`` on the pendulum (m = l = 1) is imposed without a multiplier: the motion stays on
+    ``x = 0`` only at rest at the bottom or the top. By hand: x = 0, then x_dot = p_x = 0, then the
+    rod y**2 = 1 with y p_y = 0 and lambda = -g y / 2 (from p_x_dot = -2 lambda x = 0 and
+    p_y_dot = -2 lambda y - g = 0): 6 second-class constraints in the 6-dimensional phase space,
+    0 degrees of freedom, the Lagrangian unchanged (no multiplier for x)."""
     status, out, _ = run_cli("analyze", "pendulum", "--param", "m=1", "--param", "g=9.81", "--param", "l=1",
                              "--assume", "x = 0", "--json")
     data = json.loads(out)
-    assert status == 0 and (len(data["second_class"]), data["physical_degrees_of_freedom"]) == (8, 0)
+    assert status == 0 and (len(data["first_class"]), len(data["second_class"]), data["physical_degrees_of_freedom"]) == (0, 6, 0)
+    assert data["stages"][1]["constraints"] == ["x"]
+    a = dirac.analyze(dirac.load_system("pendulum", m=1.0, g=9.81, l=1.0), assume=["x = 0"])
+    assert len(a.phase_space) == 6  # no new multiplier
+    point = a.surface_point()
+    assert abs(point["x"]) < 1e-10 and abs(abs(point["y"]) - 1) < 1e-10
+    assert abs(point["p_x"]) < 1e-10 and abs(point["p_y"]) < 1e-10
+    assert abs(point["lambda_1"] + 9.81 * point["y"] / 2) < 1e-8
+
+
+def test_equality_assumption_that_cannot_hold_is_refused():
+    with pytest.raises(dirac.errors.InconsistentSystemError, match="cannot hold"):
+        dirac.analyze(dirac.load_system("pendulum", m=1.0, g=9.81, l=1.0), assume=["p_lambda_1 - 1 = 0"])
 
 
 def test_cli_unknown_name_is_one_error_line(run_cli):
