@@ -14,6 +14,7 @@ from rigid_body_analyses import cached_analysis, eps, hat
 
 import dirac
 from dirac.analysis.legendre.transform import legendre_transform
+from dirac.codegen.scalar_backend import scalar_function
 from dirac.errors import DiracWarning, InputError
 from dirac_systems import rigid_body_momentum
 
@@ -184,3 +185,39 @@ def test_dirac_vector_field_is_euler_poisson_on_the_surface(request):
         for i, j in ((1, 1), (2, 3), (3, 1)):
             value = analysis.dirac_bracket(s[f"R_{i}{j}"], H, at=point)
             assert value == pytest.approx(Rdot[i - 1, j - 1], abs=1e-9)
+
+
+@pytest.mark.slow
+def test_multipliers_are_the_rates_of_lambda_on_the_surface(request):
+    """The particular multipliers U of H_T at hand-built surface points: the velocities
+    v of P vanish (fixed by d(R^T R)/dt = 0), and the multiplier of pi_ab = p_lambda_ab is
+    lambda_ab_dot, from lambda_ab = (M.Omega) delta_ab - (Omega_a M_b + Omega_b M_a)/2
+    with Euler's M_dot = M x Omega (250) and Omega = I^{-1} M, so that (M.Omega)_dot = 0.
+    Every U_k must be finite there: an exact solve whose pivot vanishes on the surface
+    gives 0/0 at these points."""
+    analysis = cached_analysis(request.config, "rigid_body_momentum")
+    solution = analysis.multiplier_solution
+    primary = [sympy.sympify(c) for c in analysis.stages[0]]
+    s = analysis.symbols
+    rate_of = {}  # multiplier name -> lambda index whose rate it is, for the primary p_lambda_k
+    for u, phi in zip(solution.multipliers, solution.primary):
+        assert phi in primary
+        rate_of[u.name] = next((k for k in range(1, 7) if phi == s[f"p_lambda_{k}"]), None)
+    assert sorted(k for k in rate_of.values() if k is not None) == list(range(1, 7))
+    args = [*analysis.phase_space, *I]
+    # the engine's compiler of analysis expressions (shared sub-trees once; lambdify prints these trees whole)
+    U = scalar_function(args, [solution.particular[name] for name in rate_of])
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        R_, M_ = random_rotation(rng), rng.normal(size=3)
+        inertia = INERTIA * rng.uniform(0.5, 1.5)
+        point = hand_point(R_, M_, inertia)
+        omega = M_ / inertia
+        M_dot = np.cross(M_, omega)
+        omega_dot = M_dot / inertia
+        lam_dot = -(np.outer(omega_dot, M_) + np.outer(omega, M_dot) + np.outer(M_, omega_dot) + np.outer(M_dot, omega)) / 2
+        values = np.array(U(*[point[a.name] for a in args]), dtype=float)
+        assert np.all(np.isfinite(values))
+        for value, k in zip(values, rate_of.values()):
+            expected = 0.0 if k is None else lam_dot[PAIRS[k - 1][0] - 1, PAIRS[k - 1][1] - 1]
+            assert value == pytest.approx(expected, abs=1e-8 * (1 + np.max(np.abs(lam_dot))))

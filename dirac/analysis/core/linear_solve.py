@@ -139,6 +139,60 @@ def weakly_solvable(
         ) from None
     match, blocks = block_order(~a_zero)  # structurally singular: refused here
     return a_zero, x_vals, match, blocks
+def _lu_solve(a: sympy.Matrix, b: sympy.Matrix, values: np.ndarray) -> sympy.Matrix | None:
+    """``a^{-1} b`` by symbolic LU elimination with pivots chosen at the surface points.
+
+    The arithmetic of :meth:`sympy.Matrix.LUsolve` (Doolittle elimination, forward and
+    back substitution, row by row), so the same expressions for the same pivots. Only the
+    pivot search differs: sympy takes the first candidate of a column that its
+    assumptions cannot show to be zero (``is_zero``, costly on large entries, and blind to
+    an entry that vanishes on the constraint surface only); here it is the first candidate
+    that is non-zero at every point of ``values`` (the block at the surface points, shape
+    ``(points, k, k)``, eliminated alongside), so no pivot vanishes on the surface.
+    Products with an exact zero, which sympy forms and then discards, are skipped.
+    ``None`` when some column has no such candidate.
+    """
+    k = a.shape[0]
+    lu = [[a[i, j] for j in range(k)] for i in range(k)]
+    num = np.array(values, dtype=float).copy()
+    rows = list(range(k))
+    zero = sympy.S.Zero
+    for col in range(k - 1):
+        scale = np.max(np.abs(num[:, col:, col:]), axis=(1, 2))
+        scale[scale == 0] = 1.0
+        pivot = next((r for r in range(col, k) if lu[r][col] != 0
+                      and np.all(np.abs(num[:, r, col]) > RELATIVE_ZERO * scale)), None)
+        if pivot is None:
+            return None
+        if pivot != col:
+            lu[col], lu[pivot] = lu[pivot], lu[col]
+            num[:, [col, pivot]] = num[:, [pivot, col]]
+            rows[col], rows[pivot] = rows[pivot], rows[col]
+        for r in range(col + 1, k):
+            factor = lu[r][col] / lu[col][col] if lu[r][col] != 0 else zero
+            lu[r][col] = factor
+            ratio = num[:, r, col] / num[:, col, col]
+            num[:, r, col + 1 :] -= ratio[:, None] * num[:, col, col + 1 :]
+            if factor == 0:
+                continue
+            for c in range(col + 1, k):
+                if lu[col][c] != 0:
+                    lu[r][c] = lu[r][c] - factor * lu[col][c]
+    last = np.max(np.abs(num[:, k - 1 :, k - 1 :]), axis=(1, 2))
+    if lu[k - 1][k - 1] == 0 or not np.all(np.abs(num[:, k - 1, k - 1]) > RELATIVE_ZERO * np.where(last == 0, 1.0, last)):
+        return None
+    x = [[b[r, c] for c in range(b.shape[1])] for r in rows]
+    for i in range(k):  # forward substitution (unit lower triangle)
+        for j in range(i):
+            if lu[i][j] != 0:
+                x[i] = [xi - lu[i][j] * xj if xj != 0 else xi for xi, xj in zip(x[i], x[j])]
+    for i in range(k - 1, -1, -1):  # back substitution
+        for j in range(i + 1, k):
+            if lu[i][j] != 0:
+                x[i] = [xi - lu[i][j] * xj if xj != 0 else xi for xi, xj in zip(x[i], x[j])]
+        inverse = lu[i][i] ** -1
+        x[i] = [inverse * xi for xi in x[i]]
+    return sympy.Matrix(x)
 
 
 def weak_solve(
@@ -180,7 +234,8 @@ def weak_solve(
     k = a_sym.shape[0]
     cols = b_sym.shape[1]
     b_vals = np.asarray(b_num, dtype=float).reshape(-1, k, cols)
-    a_zero, x_vals, match, blocks = weakly_solvable(a_num, b_vals)
+    a_vals = np.asarray(a_num, dtype=float).reshape(-1, k, k)
+    a_zero, x_vals, match, blocks = weakly_solvable(list(a_vals), b_vals)
     b_zero = _zero_mask(b_vals)
     x_zero = _zero_mask(x_vals)
     A = sympy.Matrix(k, k, lambda i, j: sympy.S.Zero if a_zero[i, j] else a_sym[i, j])
@@ -210,7 +265,10 @@ def weak_solve(
         if len(block) == 1:
             sol = rhs / sub[0, 0]
         else:
-            sol = sub.LUsolve(rhs)
+            values = np.where(a_zero[np.ix_(block, unknowns)], 0.0, a_vals[:, block][:, :, unknowns])
+            sol = _lu_solve(sub, rhs, values)
+            if sol is None:  # no pivot order that is non-zero at every point: sympy's own search
+                sol = sub.LUsolve(rhs)
         for r, u in enumerate(unknowns):
             for c in range(cols):
                 if x_zero[u, c]:

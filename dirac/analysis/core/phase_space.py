@@ -17,9 +17,13 @@ from dirac.analysis.core.fast_partials import PolynomialPartials
 __all__ = ["PhaseSpace", "derivative"]
 
 
-def _free_symbols_memo(expr: sympy.Expr) -> dict[sympy.Basic, frozenset]:
-    """Free symbols of every node of ``expr``, each shared sub-tree computed once."""
-    memo: dict[sympy.Basic, frozenset] = {}
+def _free_symbols_memo(expr: sympy.Expr, memo: dict[sympy.Basic, frozenset] | None = None) -> dict[sympy.Basic, frozenset]:
+    """Free symbols of every node of ``expr``, each shared sub-tree computed once.
+
+    ``memo`` (filled in place and returned) may already hold other expressions' nodes:
+    the sub-trees they share with ``expr`` are not walked again.
+    """
+    memo = {} if memo is None else memo
 
     def walk(node: sympy.Basic) -> frozenset:
         hit = memo.get(node)
@@ -37,7 +41,12 @@ def _free_symbols_memo(expr: sympy.Expr) -> dict[sympy.Basic, frozenset]:
     return memo
 
 
-def derivative(expr: sympy.Expr, x: sympy.Symbol, free: dict[sympy.Basic, frozenset] | None = None) -> sympy.Expr:
+def derivative(
+    expr: sympy.Expr,
+    x: sympy.Symbol,
+    free: dict[sympy.Basic, frozenset] | None = None,
+    cache: dict[sympy.Basic, sympy.Expr] | None = None,
+) -> sympy.Expr:
     """``d expr / d x`` by the sum, product and power rules on the expression tree.
 
     The same rules as sympy's ``_eval_derivative`` of ``Add``, ``Mul`` and ``Pow``, so
@@ -56,9 +65,14 @@ def derivative(expr: sympy.Expr, x: sympy.Symbol, free: dict[sympy.Basic, frozen
         The symbol.
     free
         Free symbols per node of ``expr`` (from one walk; computed when not given).
+    cache
+        Derivatives by ``x`` of nodes met before (filled in place): sub-trees shared with
+        expressions differentiated earlier (the pieces of ``H_c`` in every consistency
+        condition) are differentiated once. The derivative of a node is a function of the
+        node alone, so the result is the same with or without it.
     """
     free = _free_symbols_memo(expr) if free is None else free
-    cache: dict[sympy.Basic, sympy.Expr] = {}
+    cache = {} if cache is None else cache
 
     def symbols_of(node: sympy.Basic) -> frozenset:
         hit = free.get(node)
@@ -115,6 +129,10 @@ class PhaseSpace:
     parameters: tuple[sympy.Symbol, ...] = ()
     _gradients: dict[sympy.Expr, tuple[dict, dict]] = field(default_factory=dict, repr=False)
     _polynomials: PolynomialPartials | None = field(default=None, repr=False)
+    #: free symbols of every node met, and derivatives of nodes by each variable (shared by
+    #: all expressions differentiated by the tree rules: :func:`derivative`)
+    _free: dict[sympy.Basic, frozenset] = field(default_factory=dict, repr=False)
+    _derivatives: dict[sympy.Symbol, dict[sympy.Basic, sympy.Expr]] = field(default_factory=dict, repr=False)
 
     @property
     def variables(self) -> tuple[sympy.Symbol, ...]:
@@ -157,16 +175,16 @@ class PhaseSpace:
                     {coordinate_of[s][0]: d for s, d in found.items() if coordinate_of[s][1]})
             self._gradients[expr] = fast
             return fast
-        free = _free_symbols_memo(expr)
+        free = _free_symbols_memo(expr, self._free)
         dq: dict = {}
         dp: dict = {}
         for q, p in zip(self.coordinates, self.momenta):
             if q in free[expr]:
-                d = derivative(expr, q, free)
+                d = derivative(expr, q, free, self._derivatives.setdefault(q, {}))
                 if d != 0:
                     dq[q] = d
             if p in free[expr]:
-                d = derivative(expr, p, free)
+                d = derivative(expr, p, free, self._derivatives.setdefault(p, {}))
                 if d != 0:
                     dp[q] = d
         self._gradients[expr] = (dq, dp)

@@ -29,6 +29,7 @@ from fractions import Fraction
 
 import numpy as np
 import sympy
+from sympy.polys.rings import PolyRing
 
 from dirac.analysis.core.algebra import present_in_order
 from dirac.model.lagrangian import Lagrangian
@@ -120,9 +121,14 @@ def _linear_with_constant_coefficient(poly: sympy.Poly) -> bool:
     Such a polynomial is irreducible: in a product ``A B`` one factor has degree 0 in ``v``
     and divides ``c``, so it is a constant (``p_x + 3 x^2 - z``, most constraints met).
     """
-    n = len(poly.gens)
-    for k, v in enumerate(poly.gens):
-        if poly.degree(v) == 1 and [m for m in poly.monoms() if m[k] == 1] == [tuple(int(j == k) for j in range(n))]:
+    return _linear_in_a_generator(poly.monoms(), len(poly.gens))
+
+
+def _linear_in_a_generator(monoms: Sequence[tuple[int, ...]], n: int) -> bool:
+    """:func:`_linear_with_constant_coefficient` from the monomials (in the ``n`` generators) of the polynomial."""
+    for k in range(n):
+        with_k = [m for m in monoms if m[k]]
+        if with_k == [tuple(int(j == k) for j in range(n))]:
             return True
     return False
 
@@ -130,7 +136,11 @@ def _linear_with_constant_coefficient(poly: sympy.Poly) -> bool:
 _PLANE = sympy.polys.rings.ring("s,t", sympy.QQ)[0]
 
 
-def _irreducible_on_a_plane(poly: sympy.Poly, seed: int = 20240607) -> bool:
+#: seed of the random plane (and parameter values) of :func:`_irreducible_on_a_plane`
+_PLANE_SEED = 20240607
+
+
+def _irreducible_on_a_plane(poly: sympy.Poly, seed: int = _PLANE_SEED) -> bool:
     """Whether ``poly`` is shown irreducible by its restriction to a random plane (cheap, one-sided).
 
     Substitutes random integers for the parameters in the coefficients and
@@ -143,26 +153,37 @@ def _irreducible_on_a_plane(poly: sympy.Poly, seed: int = 20240607) -> bool:
     polynomial improbable). ``False`` means "not shown": factor in full.
     """
     rng = np.random.default_rng(seed)
-    s, t = _PLANE.gens
-    images = [int(rng.integers(-9, 10)) + int(rng.integers(1, 10)) * s + int(rng.integers(-9, 10)) * t for _ in poly.gens]
+    images = _plane_images(rng, len(poly.gens))
     expr = poly.as_expr()
     params = sorted(expr.free_symbols - set(poly.gens), key=str)
-    total = _PLANE.zero
     try:
         if params:
             expr = expr.subs({p: sympy.Integer(int(rng.integers(2, 14))) for p in params})
         numeric = sympy.Poly(expr, *poly.gens, domain=sympy.QQ)
-        for monom, coeff in numeric.terms():
-            term = _PLANE(coeff)
-            for image, e in zip(images, monom):
-                if e:
-                    term *= image**e
-            total += term
-        if total.is_zero or max(sum(m) for m in total.monoms()) != poly.total_degree():
-            return False
-        _, found = total.factor_list()
+        return _irreducible_restriction(numeric.terms(), images, poly.total_degree())
     except (ZeroDivisionError, sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, TypeError, ValueError):
         return False
+
+
+def _plane_images(rng: np.random.Generator, count: int) -> list:
+    """``v_i = a_i + b_i s + c_i t`` (random integers) for ``count`` generators, in the ring of the plane."""
+    s, t = _PLANE.gens
+    return [int(rng.integers(-9, 10)) + int(rng.integers(1, 10)) * s + int(rng.integers(-9, 10)) * t for _ in range(count)]
+
+
+def _irreducible_restriction(terms, images: list, degree: int) -> bool:
+    """Whether the polynomial with rational ``terms`` ``(monomial, coefficient)``, restricted to the plane
+    ``images``, keeps its total ``degree`` and is irreducible there (see :func:`_irreducible_on_a_plane`)."""
+    total = _PLANE.zero
+    for monom, coeff in terms:
+        term = _PLANE(coeff)
+        for image, e in zip(images, monom):
+            if e:
+                term *= image**e
+        total += term
+    if total.is_zero or max(sum(m) for m in total.monoms()) != degree:
+        return False
+    _, found = total.factor_list()
     return len(found) == 1 and found[0][1] == 1
 
 
@@ -242,6 +263,114 @@ def _irreducible_quadric(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) ->
             S[i][j] += c / 2
             S[j][i] += c / 2
     return _rank(S) >= 3
+class _NoScreen(Exception):
+    """The quick irreducibility screen does not apply: the full path decides."""
+
+
+def _sparse_polynomial(expr: sympy.Expr, present: Sequence[sympy.Symbol], params: Sequence[sympy.Symbol]):
+    """``expr`` in the sparse ring ``QQ(params)[present]``, by one walk of its tree.
+
+    The same polynomial as ``sympy.Poly(expr, *present)`` (exact arithmetic: coefficients
+    are reduced rational functions of the parameters); raises :class:`_NoScreen` for any
+    other node (a function, a non-integer power, a variable in a denominator).
+    """
+    domain = sympy.QQ.frac_field(*params) if params else sympy.QQ
+    ring = PolyRing(list(present), domain)
+    gens = dict(zip(present, ring.gens))
+    if params:
+        field_gens = dict(zip(params, domain.gens))
+        gens.update({p: ring.ground_new(g) for p, g in field_gens.items()})
+    cache: dict = {}
+
+    def walk(e: sympy.Expr):
+        hit = cache.get(e)
+        if hit is not None:
+            return hit
+        if e in gens:
+            out = gens[e]
+        elif e.is_Rational:
+            out = ring.ground_new(domain.convert(sympy.QQ(int(e.p), int(e.q))))
+        elif e.is_Add:
+            out = ring.zero
+            for a in e.args:
+                out = out + walk(a)
+        elif e.is_Mul:
+            out = ring.one
+            for a in e.args:
+                out = out * walk(a)
+        elif e.is_Pow and e.exp.is_Integer:
+            base = walk(e.base)
+            k = int(e.exp)
+            if k >= 0:
+                out = base**k
+            elif base.is_ground and not base.is_zero:  # a power of a parameter expression: a field element
+                out = ring.ground_new(domain.one / base.LC) ** (-k)
+            else:
+                raise _NoScreen
+        else:
+            raise _NoScreen
+        cache[e] = out
+        return out
+
+    return walk(expr)
+
+
+def _at(p, point: Sequence[int]):
+    """The value in ``QQ`` of a polynomial ``p`` over ``QQ`` at the integer ``point``."""
+    total = sympy.QQ(0)
+    for monom, coeff in p.terms():
+        term = coeff
+        for v, e in zip(point, monom):
+            if e:
+                term *= v**e
+        total += term
+    return total
+
+
+def _screened_irreducible(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> bool:
+    """Whether the cheap tests of :func:`factors` already show ``expr`` irreducible (or no product).
+
+    The decisions of ``poly.total_degree() < 2``, :func:`_linear_with_constant_coefficient`
+    and :func:`_irreducible_on_a_plane` for ``poly = _polynomial(expr, variables)``, taken on
+    the same polynomial in a sparse ring (no ``Poly`` construction, no ``subs``): the same
+    random plane and parameter values, the same exact arithmetic. ``False`` when they do not
+    decide it, or when the expression is outside what the ring represents (the full path
+    then decides, as before).
+    """
+    free = expr.free_symbols
+    present = [v for v in variables if v in free]
+    if not present:
+        return False
+    params = sorted(free - set(present), key=lambda s: s.name)
+    try:
+        p = _sparse_polynomial(expr, present, params)
+    except (_NoScreen, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+        return False
+    if not p:
+        return False
+    monoms = list(p.itermonoms())
+    degree = max(sum(m) for m in monoms)
+    if degree < 2 or _linear_in_a_generator(monoms, len(present)):
+        return True
+    # _irreducible_on_a_plane: the same random draws, in the same order
+    rng = np.random.default_rng(_PLANE_SEED)
+    images = _plane_images(rng, len(present))
+    terms = list(p.terms())
+    if params:  # random integers for the parameters the coefficients contain, in the order of their names
+        shown: set[sympy.Symbol] = set()
+        for _, c in terms:
+            for m in (*c.numer.itermonoms(), *c.denom.itermonoms()):
+                shown.update(params[i] for i, e in enumerate(m) if e)
+        values = {q: int(rng.integers(2, 14)) for q in sorted(shown, key=str)}
+        point = [values.get(q, 0) for q in params]
+        try:
+            terms = [(m, _at(c.numer, point) / _at(c.denom, point)) for m, c in terms]
+        except ZeroDivisionError:
+            return False
+    try:
+        return _irreducible_restriction(terms, images, degree)
+    except (ZeroDivisionError, sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, TypeError, ValueError):
+        return False
 
 
 def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int) -> list[sympy.Expr]:
@@ -259,6 +388,8 @@ def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int)
     """
     terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
     if terms > max_terms or _irreducible_quadric(expr, variables):
+        return [expr]
+    if _screened_irreducible(expr, variables):
         return [expr]
     poly = _polynomial(expr, variables)
     if poly is None or poly.total_degree() < 2 or _linear_with_constant_coefficient(poly) or _irreducible_on_a_plane(poly):
