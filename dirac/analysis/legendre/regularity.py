@@ -384,8 +384,16 @@ def factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol], max_terms: int)
     quadric of rank at least 3 (:func:`_irreducible_quadric`, no polynomial arithmetic:
     rods and their time derivatives), nor one
     whose restriction to a random plane is irreducible (:func:`_irreducible_on_a_plane`);
-    the others go through multivariate factorisation (``sympy.factor_list``).
+    the others go through multivariate factorisation (``sympy.factor_list``). A quotient
+    ``N / D`` with ``D`` depending on the variables (a constraint the Legendre map left with
+    a denominator) has the branches of ``N = 0`` where ``D`` does not vanish: the factors of
+    ``N`` are returned when it has several.
     """
+    if isinstance(expr, sympy.Mul) and any(isinstance(a, sympy.Pow) and a.exp.is_negative for a in expr.args):
+        numerator, denominator = sympy.fraction(expr)
+        if denominator.free_symbols & set(variables) and numerator != expr:
+            parts = factors(sympy.expand(numerator), variables, max_terms)
+            return parts if len(parts) > 1 else [expr]
     terms = len(expr.args) if isinstance(expr, sympy.Add) else 1
     if terms > max_terms or _irreducible_quadric(expr, variables):
         return [expr]

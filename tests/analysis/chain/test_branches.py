@@ -148,3 +148,27 @@ def test_disjoint_branches_of_the_same_structure_keep_the_union():
     ix = a.phase_space.index(a.symbols["x"])
     assert np.allclose(np.abs([p[ix] for p in a._points]), 1.0)
     assert any("same structure" in n for n in a.notes)
+
+
+def test_crossing_branches_of_a_constraint_with_a_denominator_are_refused():
+    """``L = -q1'^2 - q3 q1' q2' - q2'^2 - 2 q1' - 2 q1 q2'`` with ``q1 = 0`` (found by the
+    random-Lagrangian invariants). By hand, with ``P = (p1 + 2, p2 + 2 q1)`` and
+    ``W = [[-2, -q3], [-q3, -2]]``: ``H_c = (-P1^2 + q3 P1 P2 - P2^2)/(4 - q3^2) + lambda q1``, and
+    ``p3_dot = 0`` demands ``psi = -(2 P1 - q3 P2)(q3 P1 - 2 P2)/(4 - q3^2)^2 = 0``: two branches
+    that meet at ``P = 0``. On the first ``q1_dot = (q3 P2 - 2 P1)/(4 - q3^2)`` vanishes, on the
+    second it does not (another stage): the structure differs, so no single answer is right.
+    The quotient used to pass as irreducible (only polynomials were factored) and the chain
+    answered for the first branch while the surface held both (H_T not tangent on the second).
+    The refusal names both branches."""
+    lagrangian = dirac.Lagrangian.from_strings(
+        "random", ["q1", "q2", "q3"], "-q1_dot**2 - q3*q1_dot*q2_dot - q2_dot**2 - 2*q1_dot - 2*q1*q2_dot", ["q1"]
+    )
+    with pytest.raises(AnalysisError, match="union of the branches") as caught:
+        dirac.analyze(lagrangian)
+    p1, p2, q1, q3 = sympy.symbols("p_q1 p_q2 q1 q3", real=True)
+    names = {"p_q1": p1, "p_q2": p2, "q1": q1, "q3": q3}
+    P1, P2 = p1 + 2, p2 + 2 * q1
+    listed = str(caught.value).split("union of the branches ", 1)[1].split(", which meet")[0].split(" and ")
+    shown = [sympy.sympify(text.removesuffix(" = 0"), locals=names) for text in listed]
+    for branch in (2 * P1 - q3 * P2, q3 * P1 - 2 * P2):
+        assert any(sympy.expand(e - branch) == 0 or sympy.expand(e + branch) == 0 for e in shown)
