@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import sympy
+from sympy.core.add import _addsort
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
@@ -321,3 +322,31 @@ def _minus_sign_first(expr: sympy.Expr) -> bool:
         return expr.could_extract_minus_sign()
     first = expr.as_ordered_terms()[0]
     return bool(sympy.default_sort_key(first) < sympy.default_sort_key(-first))
+
+
+def negated(expr: sympy.Expr) -> sympy.Expr:
+    """``-expr``, for a sum built from its negated terms without collecting them again.
+
+    ``-(t_1 + ... + t_k)`` distributes the sign and re-collects like terms; the terms of
+    a canonical sum are already collected and stay distinct when negated (``-t`` keeps
+    the non-numeric part of ``t``), so sorting the negated terms in sympy's canonical
+    order (numeric term first) gives the identical sum. Sums with a product holding a
+    sum, non-commutative or infinite parts are negated by sympy.
+    """
+    if not expr.is_Add or not expr.is_commutative:
+        return -expr
+    terms: list[sympy.Expr] = []
+    constant: sympy.Expr | None = None
+    for t in expr.args:
+        if t.is_Number:
+            if not t.is_finite:
+                return -expr
+            constant = -t
+        elif t.is_Symbol or t.is_Pow or (t.is_Mul and not any(a.is_Add for a in t.args)):
+            terms.append(-t)
+        else:
+            return -expr
+    _addsort(terms)
+    if constant is not None:
+        terms.insert(0, constant)
+    return sympy.Add._from_args(terms, True)

@@ -37,3 +37,17 @@ def test_tidy_with_sign_makes_the_leading_term_positive_on_a_tie():
     # x - y and y - x: one negative and one positive term; sympy prefers x - y
     assert tidy(y - x, [x, y], sign=True) == x - y
     assert tidy(x - y, [x, y], sign=True) == x - y
+
+
+def test_negated_is_sympy_negation():
+    from dirac.analysis.core.algebra import negated
+
+    rnd = random.Random(5)
+    for _ in range(800):
+        e = sympy.Add(*[
+            sympy.Rational(rnd.randint(-4, 4), rnd.randint(1, 3))
+            * rnd.choice([1, m, 1 / m, g / m, sympy.sqrt(g), sympy.Float(1.5), m + g])
+            * x ** rnd.randint(0, 2) * y ** rnd.randint(0, 2) * z ** rnd.randint(0, 1)
+            for _ in range(rnd.randint(1, 6))
+        ])
+        assert sympy.srepr(negated(e)) == sympy.srepr(-e)
