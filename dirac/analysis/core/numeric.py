@@ -280,7 +280,7 @@ class Numerics:
         values = np.abs(self.evaluate(terms, points)) if terms else np.zeros((len(points), 0))
         scale = np.ones((len(points), len(exprs)))
         # unbuffered, in the order of the terms: the same sums as adding them one by one
-        np.add.at(scale, (slice(None), np.asarray(owner, dtype=np.intp)), values)
+        np.add.at(scale.T, np.asarray(owner, dtype=np.intp), values.T)
         return scale
 
     def weakly_zero(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
