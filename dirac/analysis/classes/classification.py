@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 import sympy
 
+from dirac.analysis.core.algebra import negated
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
@@ -57,7 +58,7 @@ def bracket_matrix(space: PhaseSpace, constraints: list[sympy.Expr]) -> sympy.Ma
         value = space.poisson_bracket(constraints[a], constraints[b])
         if value != 0:
             entries[(a, b)] = value
-            entries[(b, a)] = -value
+            entries[(b, a)] = negated(value)  # the same expression as -value
     if not m:
         return sympy.zeros(0, 0)
     sparse = sympy.SparseMatrix(m, m, entries)

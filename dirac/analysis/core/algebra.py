@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import sympy
+from sympy.core.add import _addsort
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
@@ -295,6 +296,57 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
         if den.could_extract_minus_sign():
             num, den = -num, -den
         out = num / sympy.factor(den) if den != 1 else num
-    if sign and out.could_extract_minus_sign():
+    if sign and _minus_sign_first(out):
         out = -out
     return out
+
+
+def _minus_sign_first(expr: sympy.Expr) -> bool:
+    """``expr.could_extract_minus_sign()``, its tie-break read off the first ordered term.
+
+    For a sum with as many negative as positive terms sympy compares
+    ``expr.sort_key()`` with ``(-expr).sort_key()``: the keys of the ordered terms, one
+    by one. The terms of ``-expr`` are the negated terms of ``expr`` in the same order
+    (the order is by monomial, which negation keeps), and the keys of ``t`` and ``-t``
+    differ only in the numeric coefficient, so the first pair decides: the keys of the
+    first term and of its negative. The same answer without building ``-expr`` and
+    sorting it; anything but a sum of terms with rational coefficients asks sympy.
+    """
+    if not expr.is_Add:
+        return expr.could_extract_minus_sign()
+    negative = sum(1 for a in expr.args if a.could_extract_minus_sign())
+    positive = len(expr.args) - negative
+    if positive != negative:
+        return positive < negative
+    if not all(a.as_coeff_Mul()[0].is_Rational for a in expr.args):
+        return expr.could_extract_minus_sign()
+    first = expr.as_ordered_terms()[0]
+    return bool(sympy.default_sort_key(first) < sympy.default_sort_key(-first))
+
+
+def negated(expr: sympy.Expr) -> sympy.Expr:
+    """``-expr``, for a sum built from its negated terms without collecting them again.
+
+    ``-(t_1 + ... + t_k)`` distributes the sign and re-collects like terms; the terms of
+    a canonical sum are already collected and stay distinct when negated (``-t`` keeps
+    the non-numeric part of ``t``), so sorting the negated terms in sympy's canonical
+    order (numeric term first) gives the identical sum. Sums with a product holding a
+    sum, non-commutative or infinite parts are negated by sympy.
+    """
+    if not expr.is_Add or not expr.is_commutative:
+        return -expr
+    terms: list[sympy.Expr] = []
+    constant: sympy.Expr | None = None
+    for t in expr.args:
+        if t.is_Number:
+            if not t.is_finite:
+                return -expr
+            constant = -t
+        elif t.is_Symbol or t.is_Pow or (t.is_Mul and not any(a.is_Add for a in t.args)):
+            terms.append(-t)
+        else:
+            return -expr
+    _addsort(terms)
+    if constant is not None:
+        terms.insert(0, constant)
+    return sympy.Add._from_args(terms, True)

@@ -219,9 +219,12 @@ class Numerics:
         zero = sympy.S.Zero  # most entries of a large gradient or bracket matrix: no conversion
         exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
         self._compile([e for e in exprs if e is not zero])
-        # (batch, index in it) of a compiled expression, (None, value) of a number
+        # (batch, index in it) of a compiled expression, (None, value) of a number; every
+        # expression that is not a number is in the index after ``_compile`` (``is_number``
+        # walks the whole tree, so it is asked only of what the index does not hold)
+        index = self._index
         plan: list[tuple[int | None, Any]] = [
-            (None, 0.0) if e is zero else (self._index[e] if not e.is_number else (None, float(e))) for e in exprs
+            (None, 0.0) if e is zero else (index.get(e) or (None, float(e))) for e in exprs
         ]
         batches = sorted({b for b, _ in plan if b is not None})
 
@@ -232,7 +235,8 @@ class Numerics:
         return fn
 
     def _compile(self, exprs: Sequence[sympy.Expr]) -> None:
-        missing = list(dict.fromkeys(e for e in exprs if not e.is_number and e not in self._index))
+        index = self._index
+        missing = list(dict.fromkeys(e for e in exprs if e not in index and not e.is_number))
         if not missing:
             return
         raw: Callable
@@ -275,8 +279,8 @@ class Numerics:
             owner.extend([k] * len(parts))
         values = np.abs(self.evaluate(terms, points)) if terms else np.zeros((len(points), 0))
         scale = np.ones((len(points), len(exprs)))
-        for j, k in enumerate(owner):
-            scale[:, k] += values[:, j]
+        # unbuffered, in the order of the terms: the same sums as adding them one by one
+        np.add.at(scale.T, np.asarray(owner, dtype=np.intp), values.T)
         return scale
 
     def weakly_zero(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:

@@ -95,3 +95,24 @@ def test_hessian_of_a_long_lattice_lagrangian_is_sparse_and_equals_sympy_hessian
     assert W == sympy.eye(n)
     assert all(sympy.expand(a[i] + (c[(i + 1) % n] - c[i])) == 0 for i in range(n))
     assert sympy.expand(V + L.subs({vi: 0 for vi in v})) == 0
+
+
+def test_canonical_expr_is_the_expression_sympy_builds():
+    """The fast conversion gives sympy's own ``as_expr`` (same arguments, same order), also for constants and signs."""
+    import random
+
+    from sympy.polys.rings import PolyRing
+
+    from dirac.analysis.core.fast_partials import canonical_expr
+
+    x, y, m = sympy.symbols("x y m")
+    ring = PolyRing([x, y, m, sympy.Dummy("a0")], sympy.QQ)
+    rnd = random.Random(7)
+    for _ in range(300):
+        p = ring.zero
+        for _ in range(rnd.randint(0, 6)):
+            monomial = ring.one
+            for gen in ring.gens:
+                monomial *= gen ** rnd.choice([0, 0, 1, 2, 3])
+            p += sympy.QQ(rnd.randint(-5, 5), rnd.randint(1, 4)) * monomial
+        assert sympy.srepr(canonical_expr(p)) == sympy.srepr(p.as_expr())
