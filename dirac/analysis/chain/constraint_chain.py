@@ -299,8 +299,9 @@ class ConstraintChain:
                 )
             direct: list[sympy.Expr] = []
             deferred: list[tuple[int, list[int]]] = []  # (row, pivot positions it must be reduced by)
+            pivot_set = set(pivots_rows)
             for i in range(len(constraints)):
-                if i in pivots_rows or (b_zero[i] and a_row_zero[i]):
+                if i in pivot_set or (b_zero[i] and a_row_zero[i]):
                     continue
                 needed = [] if a_row_zero[i] else self._needed(i, pivots_rows, pivot_cols, A_num, b_zero)
                 if needed:

@@ -82,6 +82,8 @@ def numeric_rank(matrix: np.ndarray, tol: float = 1e-8, scale: float | None = No
 
 #: at most this many column sets are tried by :func:`columns_invertible_everywhere`
 COLUMN_SETS = 5000
+#: ... and only among at most this many columns (a search, not a method for large systems)
+COLUMN_SEARCH = 24
 
 
 def columns_invertible_everywhere(matrices: Sequence[np.ndarray], rows: Sequence[int], order: Sequence[int] | None = None) -> list[int]:
@@ -92,8 +94,9 @@ def columns_invertible_everywhere(matrices: Sequence[np.ndarray], rows: Sequence
     from point to point (half the points need one column, half another), the majority
     choice finds too few. Here the column sets of the right size are tried in
     lexicographic order of ``order`` (the preference; all columns by default; at most
-    ``COLUMN_SETS`` sets) and the first one of full rank at every point is returned, so that
-    the multipliers are solved from the same columns everywhere.
+    ``COLUMN_SETS`` sets, among at most ``COLUMN_SEARCH`` columns) and the first one of full
+    rank at every point is returned, so that the multipliers are solved from the same
+    columns everywhere.
     """
     from itertools import combinations, islice
 
@@ -103,6 +106,8 @@ def columns_invertible_everywhere(matrices: Sequence[np.ndarray], rows: Sequence
     blocks = [np.asarray(m)[rows] for m in matrices]
     scales = [(np.max(np.abs(b)) or 1.0) for b in blocks]
     preference = list(order) if order is not None else list(range(blocks[0].shape[1]))
+    if len(preference) > COLUMN_SEARCH:
+        return []
     for columns in islice(combinations(preference, len(rows)), COLUMN_SETS):
         if all(numeric_rank(b[:, list(columns)] / s) == len(rows) for b, s in zip(blocks, scales)):
             return list(columns)

@@ -247,8 +247,7 @@ def _irreducible_quadric(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) ->
     one, so the proof holds for generic parameters (as for :func:`_irreducible_on_a_plane`).
     ``False`` means "not shown" (another degree, or rank at most 2): factor in full.
     """
-    symbols = expr.free_symbols
-    present = [v for v in variables if v in symbols]
+    present = present_in_order(variables, expr.free_symbols)
     terms = _rational_terms(expr, present)
     if not terms or max(sum(m) for m in terms) != 2:
         return False
@@ -338,7 +337,7 @@ def _screened_irreducible(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -
     then decides, as before).
     """
     free = expr.free_symbols
-    present = [v for v in variables if v in free]
+    present = present_in_order(variables, free)
     if not present:
         return False
     params = sorted(free - set(present), key=lambda s: s.name)
