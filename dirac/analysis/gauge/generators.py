@@ -230,7 +230,7 @@ def sharing_pairs(space: PhaseSpace, left: Sequence[sympy.Expr], right: Sequence
         dq, dp = space.partials(e)
         for q in set(dq) | set(dp):
             touching.setdefault(q, []).append(j)
-    out = []
+    out: list[tuple[int, int]] = []
     for i, e in enumerate(left):
         dq, dp = space.partials(e)
         found = {j for q in set(dq) | set(dp) for j in touching.get(q, ())}
