@@ -53,7 +53,7 @@ from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import independent_rows
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
-from dirac.analysis.gauge.local_span import gradient_sizes, in_span_by_blocks, sparse_gradients
+from dirac.analysis.gauge.local_span import BlockBasis, gradient_sizes, in_span_by_blocks, sparse_gradients
 
 __all__ = [
     "FirstClassHamiltonian",
@@ -377,6 +377,8 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     gammas = split.primary_first_class
     second = list(analysis.second_class)
     closing_basis = _gradients(space, numerics, gammas + second, points)
+    if _large(space):  # its sparse blocks found once, for every closing test
+        closing_basis = BlockBasis(closing_basis)
     constraints = list(analysis.constraints)
     limit = len(analysis.stages) + 1
     structure = GaugeStructure(second_class_present=bool(second), gauge_fixed=bool(analysis.gauge_conditions))

@@ -28,7 +28,7 @@ from scipy.sparse.csgraph import connected_components
 
 from dirac.analysis.core.phase_space import PhaseSpace
 
-__all__ = ["sparse_gradients", "in_span_by_blocks", "gradient_sizes"]
+__all__ = ["BlockBasis", "sparse_gradients", "in_span_by_blocks", "gradient_sizes"]
 
 
 def sparse_gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> list[sp.csr_matrix]:
@@ -67,44 +67,61 @@ def gradient_sizes(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], poi
     return out
 
 
-def in_span_by_blocks(vectors: Sequence[sp.csr_matrix], basis: Sequence[sp.csr_matrix], tolerance: float) -> np.ndarray:
+class BlockBasis:
+    """The rows of ``basis`` (one sparse matrix per point) with the connected blocks of their sparsity graph.
+
+    Computed once and reused by every span test against the same basis.
+    """
+
+    def __init__(self, basis: Sequence[sp.spmatrix]) -> None:
+        self.matrices: list[sp.csr_matrix] = []
+        self.row_label: list[np.ndarray] = []
+        self.col_label: list[np.ndarray] = []
+        self.big: list[float] = []
+        for base in basis:
+            base = sp.csr_matrix(base)
+            base.eliminate_zeros()
+            b, n = base.shape
+            pattern = (base != 0).astype(np.int8)
+            graph = sp.bmat([[sp.csr_matrix((b, b), dtype=np.int8), pattern], [pattern.T, sp.csr_matrix((n, n), dtype=np.int8)]]).tocsr()
+            _, labels = connected_components(graph, directed=False)
+            self.matrices.append(base)
+            self.row_label.append(labels[:b])
+            self.col_label.append(labels[b:])
+            self.big.append(float(abs(base).max()) if base.nnz else 0.0)
+
+
+def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatrix] | BlockBasis, tolerance: float) -> np.ndarray:
     """Which rows of ``vectors`` lie in the row span of ``basis`` at every point (one sparse matrix per point).
 
     The residual test is the dense one of :func:`dirac.analysis.gauge.generators._in_span`,
     ``|v - P v| <= tolerance (1 + |v|) (1 + max |basis|)`` with ``P`` the least-squares
-    projection onto the span, computed per connected block of the rows' sparsity graph
-    (module docstring).
+    projection onto the span. Each vector is projected on the basis blocks it touches
+    (module docstring); vectors touching the same blocks share one least-squares solve.
     """
+    blocks = basis if isinstance(basis, BlockBasis) else BlockBasis(basis)
     k = vectors[0].shape[0] if len(vectors) else 0
     inside = np.ones(k, dtype=bool)
-    for vec, base in zip(vectors, basis):
+    for vec, base, row_label, col_label, big in zip(vectors, blocks.matrices, blocks.row_label, blocks.col_label, blocks.big):
         vec = sp.csr_matrix(vec)
-        base = sp.csr_matrix(base)
         vec.eliminate_zeros()
-        base.eliminate_zeros()
-        b = base.shape[0]
-        big = float(abs(base).max()) if base.nnz else 0.0
-        stacked = sp.vstack([base, vec]).tocsr()
-        # bipartite graph rows <-> columns: rows sharing a variable are connected
-        pattern = (stacked != 0).astype(np.int8)
-        graph = sp.bmat([[None, pattern], [pattern.T, None]]).tocsr()
-        _, labels = connected_components(graph, directed=False)
-        row_label = labels[: b + k]
-        col_label = labels[b + k :]
-        for label in np.unique(row_label[b:]):
-            vec_rows = np.flatnonzero(row_label[b:] == label)
-            if not inside[vec_rows].any():
+        groups: dict[tuple[int, ...], list[int]] = {}
+        for j in range(k):
+            if not inside[j]:
                 continue
-            base_rows = np.flatnonzero(row_label[:b] == label)
-            columns = np.flatnonzero(col_label == label)
-            V = vec[vec_rows][:, columns].toarray() if len(columns) else np.zeros((len(vec_rows), 0))
-            if len(base_rows) and len(columns):
-                Bt = base[base_rows][:, columns].toarray().T
+            cols = vec.indices[vec.indptr[j] : vec.indptr[j + 1]]
+            groups.setdefault(tuple(sorted(set(col_label[cols].tolist()))), []).append(j)
+        for touched, members in groups.items():
+            rows = np.flatnonzero(np.isin(row_label, touched)) if touched else np.zeros(0, dtype=int)
+            columns = np.flatnonzero(np.isin(col_label, touched)) if touched else np.zeros(0, dtype=int)
+            V = vec[members][:, columns].toarray() if len(columns) else np.zeros((len(members), 0))
+            if len(rows) and len(columns):
+                Bt = base[rows][:, columns].toarray().T
                 coeff = np.linalg.lstsq(Bt, V.T, rcond=None)[0]
                 residual = V - (Bt @ coeff).T
             else:
                 residual = V
             size = 1.0 + np.linalg.norm(V, axis=1)
             bad = np.linalg.norm(residual, axis=1) > tolerance * size * (1.0 + big)
-            inside[vec_rows[bad]] = False
+            inside[np.array(members)[bad]] = False
     return inside
