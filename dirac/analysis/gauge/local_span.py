@@ -78,6 +78,8 @@ class BlockBasis:
         self.row_label: list[np.ndarray] = []
         self.col_label: list[np.ndarray] = []
         self.big: list[float] = []
+        self.rows_of: list[dict[int, np.ndarray]] = []
+        self.columns_of: list[dict[int, np.ndarray]] = []
         for base in basis:
             base = sp.csr_matrix(base)
             base.eliminate_zeros()
@@ -89,6 +91,22 @@ class BlockBasis:
             self.row_label.append(labels[:b])
             self.col_label.append(labels[b:])
             self.big.append(float(abs(base).max()) if base.nnz else 0.0)
+            self.rows_of.append(_members(labels[:b]))
+            self.columns_of.append(_members(labels[b:]))
+
+    def gather(self, k: int, touched: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+        """Rows and columns of the blocks ``touched`` at point ``k`` (work proportional to their size)."""
+        empty = np.zeros(0, dtype=int)
+        rows = [self.rows_of[k].get(t, empty) for t in touched]
+        cols = [self.columns_of[k].get(t, empty) for t in touched]
+        return (np.sort(np.concatenate(rows)) if rows else empty, np.sort(np.concatenate(cols)) if cols else empty)
+
+
+def _members(labels: np.ndarray) -> dict[int, np.ndarray]:
+    """Label -> sorted indices carrying it."""
+    order = np.argsort(labels, kind="stable")
+    cuts = np.flatnonzero(np.diff(labels[order])) + 1
+    return {int(labels[block[0]]): block for block in np.split(order, cuts) if len(block)}
 
 
 def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatrix] | BlockBasis, tolerance: float) -> np.ndarray:
@@ -102,7 +120,7 @@ def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatri
     blocks = basis if isinstance(basis, BlockBasis) else BlockBasis(basis)
     k = vectors[0].shape[0] if len(vectors) else 0
     inside = np.ones(k, dtype=bool)
-    for vec, base, row_label, col_label, big in zip(vectors, blocks.matrices, blocks.row_label, blocks.col_label, blocks.big):
+    for point, (vec, base, col_label, big) in enumerate(zip(vectors, blocks.matrices, blocks.col_label, blocks.big)):
         vec = sp.csr_matrix(vec)
         vec.eliminate_zeros()
         groups: dict[tuple[int, ...], list[int]] = {}
@@ -112,8 +130,7 @@ def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatri
             cols = vec.indices[vec.indptr[j] : vec.indptr[j + 1]]
             groups.setdefault(tuple(sorted(set(col_label[cols].tolist()))), []).append(j)
         for touched, members in groups.items():
-            rows = np.flatnonzero(np.isin(row_label, touched)) if touched else np.zeros(0, dtype=int)
-            columns = np.flatnonzero(np.isin(col_label, touched)) if touched else np.zeros(0, dtype=int)
+            rows, columns = blocks.gather(point, touched)
             V = vec[members][:, columns].toarray() if len(columns) else np.zeros((len(members), 0))
             if len(rows) and len(columns):
                 Bt = base[rows][:, columns].toarray().T
