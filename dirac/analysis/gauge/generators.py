@@ -406,7 +406,7 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
             coefficients = _expansion(space, numerics, evolve(R), expansion_basis, points)
             if coefficients is not None:
                 c = coefficients[len(gammas) : 2 * len(gammas)]
-                following += sum((ca * ga for ca, ga in zip(c, gammas)), sympy.S.Zero)
+                following += sum((ca * ga for ca, ga in zip(c, gammas) if ca != 0), sympy.S.Zero)  # zeros skipped: O(chain) not O(gammas)
             chain.append(tidy(following, space.variables))
         if not closed:
             structure.unclosed.append(gamma)
