@@ -90,6 +90,12 @@ FACTOR_TERMS = 24
 #: a variable at most this large at every sample point spans a suspected singular locus (:meth:`ConstraintChain._off_singular_locus`)
 LOCUS_SIZE = 1e-2
 
+#: length (characters) above which a stage's reducibility note is given briefly (counts, the relation, a few shown)
+LONG_NOTE = 2000
+
+#: constraints shown in a brief reducibility note
+REDUCIBLE_SHOWN = 4
+
 
 class _Split(Exception):
     """A new constraint is the union of branches that do not meet: each is followed on its own."""
@@ -665,12 +671,52 @@ class ConstraintChain:
         if not dropped:
             return
         self.reducible.extend(dropped)
-        self.regularity_notes.append(
+        note = (
             f"stage {len(self.stages)}: the constraints {', '.join(str(c) for c in candidates)} are reducible: on the "
             f"regular part of their surface {', '.join(str(c) for c in dropped)} depend(s) on the others "
             f"(independent set kept: {', '.join(str(candidates[i]) for i in chosen)}); the dependent ones still "
             "define the surface and every sample point satisfies them"
         )
+        self.regularity_notes.append(note if len(note) <= LONG_NOTE else self._brief_reducible_note(candidates, chosen, dropped))
+
+    def _brief_reducible_note(self, candidates: list[sympy.Expr], chosen: list[int], dropped: list[sympy.Expr]) -> str:
+        """The reducibility note of a large stage: counts, the relation when it is the plain sum, a few constraints."""
+        shown = ", ".join(str(c) for c in candidates[:REDUCIBLE_SHOWN])
+        relation = self._exact_relation(candidates, chosen, dropped) or f"{len(dropped)} relation(s) among them"
+        return (
+            f"stage {len(self.stages)}: the {len(candidates)} constraints {shown}, ... are reducible ({relation}); on the "
+            f"regular part of their surface {len(dropped)} of them ({', '.join(str(c) for c in dropped[:REDUCIBLE_SHOWN])}"
+            f"{', ...' if len(dropped) > REDUCIBLE_SHOWN else ''}) depend(s) on the {len(chosen)} others, which are kept; "
+            "the dependent ones still define the surface and every sample point satisfies them "
+            "(all of them: the analysis' reducible_constraints)"
+        )
+
+    def _exact_relation(self, candidates: list[sympy.Expr], chosen: list[int], dropped: list[sympy.Expr]) -> str:
+        """``d + sum_i r_i c_i = 0`` for the one dependent constraint ``d`` of a stage, when it holds identically
+        with rational ``r_i`` (linear constraints with constant coefficients, such as Gauss laws); else ``""``.
+
+        The ``r_i`` are read off the gradients at one random point (least squares over the kept
+        constraints' sparse gradients), rounded to small rationals and then verified exactly by
+        expansion: a relation is stated only when ``sympy.expand`` proves it.
+        """
+        if len(dropped) != 1 or not chosen:
+            return ""
+        from scipy.sparse.linalg import lsqr
+
+        kept = [candidates[i] for i in chosen]
+        point = [self.numerics.random_point()]
+        [rows] = self.numerics.sparse_gradients(kept, point)
+        [row] = self.numerics.sparse_gradients(dropped, point)
+        coefficients = lsqr(rows.T.tocsr(), -row.toarray().ravel(), atol=1e-14, btol=1e-14)[0]
+        r = [sympy.Rational(round(float(c) * 12), 12) for c in coefficients]
+        if sympy.expand(dropped[0] + sympy.Add(*(ri * c for ri, c in zip(r, kept)))) != 0:
+            return ""
+        used = sum(1 for ri in r if ri != 0) + 1
+        which = f"all {used}" if used == len(candidates) else f"{used} of them"
+        if all(ri in (0, 1, -1) for ri in r):
+            return f"one relation, proved exactly: a signed sum (coefficients +1 or -1) of {which} vanishes identically"
+        values = sorted({abs(ri) for ri in r if ri != 0} | {sympy.S.One}, key=float)
+        return f"one relation, proved exactly: a combination of {which} with coefficients of size {', '.join(map(str, values))} vanishes identically"
 
     def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> list[int]:
         """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by."""

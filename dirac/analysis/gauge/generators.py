@@ -52,6 +52,8 @@ from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import independent_rows
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
+from dirac.analysis.gauge.local_span import BlockBasis, gradient_sizes, in_span_by_blocks, sparse_gradients
 
 __all__ = [
     "FirstClassHamiltonian",
@@ -141,9 +143,18 @@ def first_class_hamiltonian(analysis: Any) -> FirstClassHamiltonian:
     if K == 0:
         return FirstClassHamiltonian(H_c, [], [], [], {}, {})
     pb = space.poisson_bracket
-    A = sympy.Matrix(m, K, lambda i, a: pb(constraints[i], primary[a]))
-    zero = numerics.weakly_zero(list(A), points)
-    A = sympy.Matrix(m, K, lambda i, a: sympy.S.Zero if zero[i * K + a] else A[i, a])
+    # {Phi_i, phi_a} only where the two share a canonical pair (every other bracket is identically 0)
+    pairs = sharing_pairs(space, constraints, primary)
+    brackets = {(i, a): pb(constraints[i], primary[a]) for i, a in pairs}
+    brackets = {key: e for key, e in brackets.items() if e != 0}
+    keys = list(brackets)
+    zero = numerics.weakly_zero([brackets[key] for key in keys], points) if keys else []
+    brackets = {key: e for key, e, z in zip(keys, brackets.values(), zero) if not z}
+    if not brackets:  # A ~ 0: every multiplier is free, gamma_f = phi_f, H' = H_c
+        return FirstClassHamiltonian(
+            H_c, [tidy(phi, space.variables) for phi in primary], list(range(K)), [], {}, {f: {} for f in range(K)}
+        )
+    A = sympy.Matrix(m, K, lambda i, a: brackets.get((i, a), sympy.S.Zero))
     time = getattr(analysis, "time", None)  # d Phi/dt = {Phi, H_T} + d_t Phi for a time-dependent system
     b = sympy.Matrix([pb(c, H_c) + (sympy.diff(c, time) if time is not None else 0) for c in constraints])
     A_num = numerics.evaluate(list(A), points).reshape(len(points), m, K)
@@ -211,10 +222,31 @@ class GaugeGenerator:
         return sum((e * g for e, g in zip(self.parameter_symbols(), self.terms)), sympy.S.Zero)
 
 
+def sharing_pairs(space: PhaseSpace, left: Sequence[sympy.Expr], right: Sequence[sympy.Expr]) -> list[tuple[int, int]]:
+    """Index pairs ``(i, j)`` whose expressions share a canonical pair (a ``q_k`` or ``p_k`` each):
+    every other bracket ``{left_i, right_j}`` vanishes identically. In the order ``i``, then ``j``."""
+    touching: dict[sympy.Symbol, list[int]] = {}
+    for j, e in enumerate(right):
+        dq, dp = space.partials(e)
+        for q in set(dq) | set(dp):
+            touching.setdefault(q, []).append(j)
+    out: list[tuple[int, int]] = []
+    for i, e in enumerate(left):
+        dq, dp = space.partials(e)
+        found = {j for q in set(dq) | set(dp) for j in touching.get(q, ())}
+        out.extend((i, j) for j in sorted(found))
+    return out
+
+
 def transformation(space: PhaseSpace, G: sympy.Expr) -> dict[sympy.Symbol, sympy.Expr]:
-    """``delta z = {z, G}`` for every phase-space variable ``z`` (zero ones left out)."""
+    """``delta z = {z, G}`` for every phase-space variable ``z`` (zero ones left out; only the
+    variables whose conjugate ``G`` contains can move)."""
     out = {}
-    for z in space.variables:
+    dq, dp = space.partials(G)
+    moved = set(dq) | set(dp)
+    momentum = dict(zip(space.coordinates, space.momenta))
+    candidates = {z for q in moved for z in (q, momentum[q])}
+    for z in (z for z in space.variables if z in candidates):
         d = sympy.expand(space.poisson_bracket(z, G))
         if d != 0:
             out[z] = d
@@ -293,8 +325,16 @@ class GaugeStructure:
         )
 
 
-def _gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
-    """``grad expr`` at each point: array (points, len(exprs), dim)."""
+def _large(space: PhaseSpace) -> bool:
+    """Whether span tests go by sparse blocks (:mod:`~dirac.analysis.gauge.local_span`)."""
+    return len(space.variables) >= LARGE_SYSTEM
+
+
+def _gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> Any:
+    """``grad expr`` at each point: array (points, len(exprs), dim); for a large system a list of sparse
+    matrices, one per point (:func:`~dirac.analysis.gauge.local_span.sparse_gradients`)."""
+    if _large(space):
+        return sparse_gradients(space, numerics, exprs, points)
     n = len(space.variables)
     if not exprs:
         return np.zeros((len(points), 0, n))
@@ -302,8 +342,11 @@ def _gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], points:
     return numerics.evaluate(flat, points).reshape(len(points), len(exprs), n)
 
 
-def _in_span(vectors: np.ndarray, basis: np.ndarray) -> np.ndarray:
-    """Which rows of ``vectors`` (points, k, n) lie in the row span of ``basis`` (points, b, n) at every point."""
+def _in_span(vectors: Any, basis: Any) -> np.ndarray:
+    """Which rows of ``vectors`` (points, k, n) lie in the row span of ``basis`` (points, b, n) at every point
+    (sparse gradients of a large system: by connected blocks, :func:`~dirac.analysis.gauge.local_span.in_span_by_blocks`)."""
+    if isinstance(vectors, list):
+        return in_span_by_blocks(vectors, basis, SPAN_TOLERANCE)
     inside = np.ones(vectors.shape[1], dtype=bool)
     for vec, base in zip(vectors, basis):
         for j, v in enumerate(vec):
@@ -334,6 +377,8 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     gammas = split.primary_first_class
     second = list(analysis.second_class)
     closing_basis = _gradients(space, numerics, gammas + second, points)
+    if _large(space):  # its sparse blocks found once, for every closing test
+        closing_basis = BlockBasis(closing_basis)
     constraints = list(analysis.constraints)
     limit = len(analysis.stages) + 1
     structure = GaugeStructure(second_class_present=bool(second), gauge_fixed=bool(analysis.gauge_conditions))
@@ -361,7 +406,7 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
             coefficients = _expansion(space, numerics, evolve(R), expansion_basis, points)
             if coefficients is not None:
                 c = coefficients[len(gammas) : 2 * len(gammas)]
-                following += sum((ca * ga for ca, ga in zip(c, gammas)), sympy.S.Zero)
+                following += sum((ca * ga for ca, ga in zip(c, gammas) if ca != 0), sympy.S.Zero)  # zeros skipped: O(chain) not O(gammas)
             chain.append(tidy(following, space.variables))
         if not closed:
             structure.unclosed.append(gamma)
@@ -377,8 +422,11 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
         structure.generators.append(generator)
     all_terms = [g for gen in structure.generators for g in gen.terms]
     if all_terms:
-        flat = _gradients(space, numerics, all_terms, points)
-        size = np.max(np.abs(flat), axis=2)  # (points, terms)
+        if _large(space):
+            size = gradient_sizes(space, numerics, all_terms, points)
+        else:
+            flat = _gradients(space, numerics, all_terms, points)
+            size = np.max(np.abs(flat), axis=2)  # (points, terms)
         structure.irregular_terms = [g for g, s in zip(all_terms, np.all(size <= IRREGULAR_GRADIENT, axis=0)) if s]
     first = list(analysis.first_class)
     spanned = _in_span(_gradients(space, numerics, first, points), _gradients(space, numerics, all_terms + second, points))
@@ -447,10 +495,12 @@ def _chain_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], H1:
 def _first_class_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], constraints, points) -> str:
     """Every ``G_k`` is weakly zero and has weakly zero brackets with every constraint;
     returns what fails, or ``""``."""
-    exprs = list(terms) + [space.poisson_bracket(g, c) for g in terms for c in constraints]
+    pairs = sharing_pairs(space, terms, constraints)  # every other bracket vanishes identically
+    owner = list(range(len(terms))) + [k for k, _ in pairs]
+    exprs = list(terms) + [space.poisson_bracket(terms[k], constraints[j]) for k, j in pairs]
     zero = numerics.weakly_zero(exprs, points)
     if np.all(zero):
         return ""
     bad = next(i for i, z in enumerate(zero) if not z)
-    term = terms[bad if bad < len(terms) else (bad - len(terms)) // max(len(constraints), 1)]
+    term = terms[owner[bad]]
     return f"its term {term} is not a first-class constraint on the surface"
