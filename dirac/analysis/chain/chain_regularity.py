@@ -40,21 +40,7 @@ def gradient_values(space: PhaseSpace, numerics: Numerics, constraints: list[sym
     the same values as evaluating :meth:`PhaseSpace.gradient` entry by entry.
     """
     n = len(space.variables)
-    position = {s: k for k, s in enumerate(space.variables)}
-    momentum_position = {q: position[p] for q, p in zip(space.coordinates, space.momenta)}
-    rows: list[int] = []
-    cols: list[int] = []
-    entries: list[sympy.Expr] = []
-    for i, c in enumerate(constraints):
-        dq, dp = space.partials(c)
-        for q, d in dq.items():
-            rows.append(i)
-            cols.append(position[q])
-            entries.append(d)
-        for q, d in dp.items():
-            rows.append(i)
-            cols.append(momentum_position[q])
-            entries.append(d)
+    rows, cols, entries = space.gradient_entries(constraints)
     out = np.zeros((len(points), len(constraints), n))
     if entries:
         out[:, np.array(rows, dtype=int), np.array(cols, dtype=int)] = numerics.evaluate(entries, points)

@@ -7,7 +7,7 @@ bracket ``{q_i, p_j} = delta_ij`` used throughout Sect. X ((207)-(209)).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import sympy
@@ -214,6 +214,40 @@ class PhaseSpace:
         """Full gradient of ``expr`` in the order of :attr:`variables`."""
         dq, dp = self.partials(expr)
         return [dq.get(q, sympy.S.Zero) for q in self.coordinates] + [dp.get(q, sympy.S.Zero) for q in self.coordinates]
+
+    def gradient_entries(self, exprs: Sequence[sympy.Expr]) -> tuple[list[int], list[int], list[sympy.Expr]]:
+        """The non-zero entries of the gradients of ``exprs``: ``(rows, columns, derivatives)``.
+
+        Row ``i`` is ``exprs[i]``, columns are positions in :attr:`variables` (a coordinate's
+        derivative, then its momentum's); only the partial derivatives that
+        :meth:`partials` finds are listed, ``O(non-zeros)`` for the constraints of a local
+        system.
+        """
+        position = self._positions()
+        momentum = {q: position[p] for q, p in zip(self.coordinates, self.momenta)}  # dp is keyed by q
+        rows: list[int] = []
+        cols: list[int] = []
+        entries: list[sympy.Expr] = []
+        for i, e in enumerate(exprs):
+            dq, dp = self.partials(e)
+            for q, d in dq.items():
+                rows.append(i)
+                cols.append(position[q])
+                entries.append(d)
+            for q, d in dp.items():
+                rows.append(i)
+                cols.append(momentum[q])
+                entries.append(d)
+        return rows, cols, entries
+
+    def _positions(self) -> dict[sympy.Symbol, int]:
+        """Variable -> its position in :attr:`variables` (built once per tuple of variables)."""
+        variables = self.variables
+        held = self.__dict__.get("_position_index")
+        if held is None or held[0] is not variables:
+            held = (variables, {v: k for k, v in enumerate(variables)})
+            self.__dict__["_position_index"] = held
+        return held[1]
 
     def check_names(self, values: Mapping[str, float] | Iterable[str], what: str) -> None:
         """Raise :class:`~dirac.errors.InputError` for a name that is not a variable or parameter."""

@@ -36,21 +36,7 @@ class SparseJacobian:
     ) -> None:
         # numerics: a dirac.analysis.core.numeric.Numerics (not imported: numeric imports this module)
         space = numerics.phase_space
-        position = {s: k for k, s in enumerate(space.variables)}
-        momentum = {q: position[p] for q, p in zip(space.coordinates, space.momenta)}  # dp is keyed by q
-        rows: list[int] = []
-        cols: list[int] = []
-        entries: list[sympy.Expr] = []
-        for i, c in enumerate(constraints):
-            dq, dp = space.partials(c)
-            for q, d in dq.items():
-                rows.append(i)
-                cols.append(position[q])
-                entries.append(d)
-            for q, d in dp.items():
-                rows.append(i)
-                cols.append(momentum[q])
-                entries.append(d)
+        rows, cols, entries = space.gradient_entries(constraints)
         self.shape = (len(constraints), len(space.variables))
         self.rows = np.array(rows, dtype=int)
         self.cols = np.array(cols, dtype=int)

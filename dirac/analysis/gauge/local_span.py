@@ -37,21 +37,7 @@ def sparse_gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], p
     Only the non-zero partial derivatives are compiled and evaluated.
     """
     variables = space.variables
-    column = {v: k for k, v in enumerate(variables)}
-    momentum = dict(zip(space.coordinates, space.momenta))
-    rows: list[int] = []
-    cols: list[int] = []
-    entries: list[sympy.Expr] = []
-    for i, e in enumerate(exprs):
-        dq, dp = space.partials(e)
-        for q, d in dq.items():
-            rows.append(i)
-            cols.append(column[q])
-            entries.append(d)
-        for q, d in dp.items():
-            rows.append(i)
-            cols.append(column[momentum[q]])
-            entries.append(d)
+    rows, cols, entries = space.gradient_entries(exprs)
     values = numerics.evaluate(entries, points) if entries else np.zeros((len(points), 0))
     shape = (len(exprs), len(variables))
     return [sp.csr_matrix((values[k], (rows, cols)), shape=shape) for k in range(len(points))]
