@@ -122,6 +122,7 @@ def _irregular_sparse(
     rows = numerics.sparse_gradients(candidates, points)
     n_old = len(old) + len(reducible)
     sizes = np.zeros((len(points), len(candidates)))
+    rough = np.zeros_like(sizes)
     for p in range(len(points)):
         for flag, base in ((True, stacked[p][:n_old]), (False, stacked[p])):
             selected = np.flatnonzero(kept == flag)
@@ -131,12 +132,8 @@ def _irregular_sparse(
             if norms is None:
                 return None
             sizes[p, selected] = norms
-    rough = np.zeros_like(sizes)
-    for p in range(len(points)):
-        for flag, base in ((True, stacked[p][:n_old]), (False, stacked[p])):
-            selected = np.flatnonzero(kept == flag)
             largest = float(np.max(np.abs(base.data), initial=0.0)) if base.nnz else 0.0
-            rough[p, selected] = sizes[p, selected] / (1.0 + largest)
+            rough[p, selected] = norms / (1.0 + largest)
     found = []
     for i, c in enumerate(candidates):
         if np.max(rough[:, i]) > 1e-2:  # clearly regular: skip the finer test

@@ -27,6 +27,7 @@ from __future__ import annotations
 import heapq
 import warnings
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -56,7 +57,7 @@ class _Basis:
             out -= Q.T @ (Q @ out)
         return out
 
-    def raises_rank(self, row: np.ndarray) -> tuple[bool, np.ndarray]:
+    def decide(self, row: np.ndarray) -> tuple[bool, np.ndarray]:
         """Whether ``row`` is independent of the basis (relative to the stack's size), and its orthogonal part."""
         norm = float(np.linalg.norm(row))
         if not np.isfinite(norm):
@@ -109,18 +110,29 @@ def independent_rows_one_pass(
         rows_base = base[k] if base is not None and len(base[k]) else np.zeros((0, n))
         basis = _Basis(n, len(rows_base) + len(order))
         for row in rows_base:
-            independent, part = basis.raises_rank(row)
+            independent, part = basis.decide(row)
             if independent:
                 basis.add(row, part)
         bases.append(basis)
+    return _majority_choice(bases, matrices, order)
+
+
+def _majority_choice(states: Sequence[Any], rows: Sequence[Any], order: Sequence[int]) -> list[int]:
+    """The greedy choice shared by the one-pass and the sparse elimination: row ``i`` (in
+    ``order``) is kept when it raises the rank at a majority of the points.
+
+    ``states[k]`` holds the rows kept at point ``k`` (``decide(row) -> (independent, reduced)``,
+    ``add(row, reduced)``); ``rows[k][i]`` is row ``i`` there. A point that disagrees with the
+    majority keeps its rows as they are: the later rank checks catch it.
+    """
     chosen: list[int] = []
-    for row in order:
-        decisions = [basis.raises_rank(m[row]) for basis, m in zip(bases, matrices)]
-        if 2 * sum(flag for flag, _ in decisions) > len(matrices):
-            chosen.append(row)
-            for basis, m, (flag, part) in zip(bases, matrices, decisions):
-                if flag:  # a point that disagrees keeps its basis: the later rank checks catch it
-                    basis.add(m[row], part)
+    for i in order:
+        decisions = [state.decide(r[i]) for state, r in zip(states, rows)]
+        if 2 * sum(flag for flag, _ in decisions) > len(states):
+            chosen.append(i)
+            for state, r, (flag, reduced) in zip(states, rows, decisions):
+                if flag:
+                    state.add(r[i], reduced)
     return chosen
 
 
@@ -248,17 +260,9 @@ def independent_rows_eliminated(
                         echelon.add(row, reduced)
             echelons.append(echelon)
             rows.append(_sparse_rows(m))
-        chosen: list[int] = []
-        for i in order:
-            decisions = [echelon.decide(r[i]) for echelon, r in zip(echelons, rows)]
-            if 2 * sum(flag for flag, _ in decisions) > len(matrices):
-                chosen.append(i)
-                for echelon, r, (flag, reduced) in zip(echelons, rows, decisions):
-                    if flag:  # a point that disagrees keeps its rows: the later rank checks catch it
-                        echelon.add(r[i], reduced)
+        return _majority_choice(echelons, rows, order)
     except Undecided:
         return None
-    return chosen
 
 
 def components(pattern: sp.spmatrix) -> list[np.ndarray]:
