@@ -234,6 +234,7 @@ class ConstraintAnalysis:
             + (" (symbolic parameters at generic random values)" if self.parameters else ""),
             *regularised,
             *chain.regularity_notes,
+            *dict.fromkeys(self._numerics.notes),
             *(f"assumed {a}: every point of the surface where ranks were decided is away from {a.expression} = 0" for a in nonzero),
             *(f"assumed {e}: imposed as a constraint of stage 2 (no multiplier of its own, the Lagrangian unchanged); "
               "the later stages keep only the part of the surface on which the motion keeps it" for e in equalities),

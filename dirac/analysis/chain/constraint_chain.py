@@ -57,7 +57,9 @@ from dirac.analysis.classes.multiplier_solution import (
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import (
+    LARGE_ROWS,
     Numerics,
+    RankedMatrix,
     SingularSurface,
     columns_invertible_everywhere,
     independent_rows,
@@ -271,7 +273,7 @@ class ConstraintChain:
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
-        points = self.numerics.surface_points(primary, SAMPLE_POINTS, regular=len(primary)) if primary else []
+        points = self._stage_points(primary, []) if primary else []
         base_grads = self._independent(primary, [], points) if primary else []
         self.stages = [[primary[i] for i in base_grads]] if primary else []
         if primary and len(base_grads) < len(primary):
@@ -328,7 +330,7 @@ class ConstraintChain:
                 break
             self.stages.append([candidates[i] for i in chosen])
             self._keep_reducible(candidates, chosen)
-            points = self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
+            points = self._stage_points()
         self.points = points
         self.pivots = (pivots_rows, pivot_cols)
         if pivots_rows:
@@ -355,7 +357,37 @@ class ConstraintChain:
             return points
         self.stages.append([candidates[i] for i in chosen])
         self._keep_reducible(candidates, chosen)
-        return self.numerics.surface_points(self.constraints + self.reducible, SAMPLE_POINTS, regular=len(self.constraints))
+        return self._stage_points()
+
+    def _stage_points(self, constraints: list[sympy.Expr] | None = None, reducible: list[sympy.Expr] | None = None) -> list[np.ndarray]:
+        """Regular points of the surface of the constraints found so far, away from loci where a used rank drops.
+
+        The chain reads the rank of ``{Phi_a, phi_k}`` at these points (which multipliers
+        are fixed) and, at the last stage, the classification reads that of
+        ``C_ab = {Phi_a, Phi_b}``; points next to a locus where either drops are set aside
+        (:func:`~dirac.analysis.core.numeric.near_rank_drop`). Large systems (from
+        ``LARGE_ROWS`` constraints or ``LARGE_SYSTEM`` phase-space variables) skip that
+        test: their ranks are read block by block, sparsely. ``constraints`` and
+        ``reducible`` default to the chain's own.
+        """
+        constraints = self.constraints if constraints is None else constraints
+        reducible = self.reducible if reducible is None else reducible
+        minors: list[RankedMatrix] = []
+        if len(constraints) < LARGE_ROWS and self.phase_space.dimension < LARGE_SYSTEM:
+            m, K = len(constraints), len(self.primary)
+            pb = self.phase_space.poisson_bracket
+            brackets = {(a, b): pb(constraints[a], constraints[b]) for a in range(m) for b in range(a + 1, m)}
+            entries = {k: v for k, v in brackets.items() if v != 0}
+            entries.update({(b, a): -v for (a, b), v in list(entries.items())})
+            minors.append(RankedMatrix(self.numerics, entries, (m, m), "C_ab = {Phi_a, Phi_b}"))
+            multipliers = {}
+            for a, c in enumerate(constraints):
+                row = self._rows(c)[1]
+                multipliers.update({(a, k): row[k] for k in self._row_support[c]})
+            minors.append(RankedMatrix(self.numerics, multipliers, (m, K), "{Phi_a, phi_k}"))
+        return self.numerics.surface_points(
+            constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=minors
+        )
 
     def _nonzero(self, candidates: list[sympy.Expr], points: list[np.ndarray]) -> list[sympy.Expr]:
         """The candidates that are not weakly zero, tidied (constraints: the sign is free)."""

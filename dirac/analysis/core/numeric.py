@@ -29,7 +29,7 @@ from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
-__all__ = ["Numerics", "SingularSurface", "numeric_rank", "independent_rows"]
+__all__ = ["Numerics", "RankedMatrix", "SingularSurface", "magnitude", "near_rank_drop", "numeric_rank", "independent_rows"]
 
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
@@ -44,6 +44,12 @@ REGULAR_TOLERANCE = 1e-6
 SINGULAR_GRADIENT = 1e-4
 #: rows (candidates and base together) from which independence is decided in one pass
 LARGE_ROWS = 64
+#: a singular value of a matrix whose rank the analysis uses (``{Phi_a, Phi_b}``,
+#: ``{Phi_a, phi_k}``), relative to the size of the terms its entries are computed from,
+#: between ``ZERO_TOLERANCE`` and this marks a point next to a locus where that rank drops
+#: (:func:`near_rank_drop`): the rank is still read right there, but everything built on
+#: the inverse of that block is ill-conditioned at the point (by ``1 / s`` per inverse)
+SINGULAR_MINOR = 1e-4
 
 
 class SingularSurface(AnalysisError):
@@ -78,6 +84,102 @@ def numeric_rank(matrix: np.ndarray, tol: float = 1e-8, scale: float | None = No
     if s[0] == 0 or not np.isfinite(s[0]):
         return 0
     return int(np.sum(s > tol * max(s[0], scale or 0.0)))
+
+
+def magnitude(expr: sympy.Expr, memo: dict[sympy.Expr, sympy.Expr] | None = None) -> sympy.Expr:
+    """The size of the terms ``expr`` is computed from: ``expr`` with every sum and product taken of absolute values.
+
+    ``|a + b| -> |a| + |b|``, ``|a b| -> |a| |b|``, ``|a^k| -> |a|^k`` (``k`` a positive
+    integer), any other node ``f -> |f|``. Evaluated at a point, it bounds the value
+    (``|expr| <= magnitude(expr)``), and the ratio of the two measures the cancellation
+    at that point: the rounding error of evaluating ``expr`` is at most a small multiple
+    of the unit round-off times this bound (Higham, *Accuracy and Stability of Numerical
+    Algorithms*, 2nd ed., 2002, Sect. 3.1 and Sect. 5.1, the running error bound). Unlike
+    :meth:`Numerics.term_scale` (top-level terms only), a cancellation inside a factor
+    (``p_2 (p_1 - 2)`` at ``p_1 = 2``) is seen.
+    """
+    memo = {} if memo is None else memo
+    found = memo.get(expr)
+    if found is not None:
+        return found
+    if expr.is_Number:
+        size: sympy.Expr = abs(expr)
+    elif expr.is_Symbol:
+        size = sympy.Abs(expr)
+    elif expr.is_Add or expr.is_Mul:
+        size = expr.func(*(magnitude(a, memo) for a in expr.args))
+    elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
+        size = magnitude(expr.base, memo) ** expr.exp
+    else:
+        size = sympy.Abs(expr)
+    memo[expr] = size
+    return size
+
+
+def near_rank_drop(values: np.ndarray, sizes: np.ndarray) -> float | None:
+    """The smallest singular value of ``values`` that is small but not round-off, or ``None``.
+
+    ``values`` is a matrix at one point and ``sizes`` the :func:`magnitude` of each entry
+    there. Entries at round-off of their own size (``|v| <= ZERO_TOLERANCE * size``) are
+    zeros and are dropped, with their sizes (an entry written ``8 q (2 - p) + 8 q (p - 2)``
+    is zero, however large its terms). The rest is equilibrated, rows and then columns
+    divided by their largest size (constraints may be multiplied by any non-zero function,
+    so only the scale-free part of the rank counts), and its singular values ``s`` are
+    taken. A value with ``ZERO_TOLERANCE < s < SINGULAR_MINOR`` says that the point lies
+    next to a locus where the rank drops (the values of a rank-deficient block at a
+    regular point are round-off, below ``ZERO_TOLERANCE``; those of a full-rank block are
+    of the order of its terms).
+    """
+    sizes = np.where(np.abs(values) > ZERO_TOLERANCE * sizes, sizes, 0.0)
+    rows = np.max(sizes, axis=1, initial=0.0) > 0
+    values, sizes = values[rows], sizes[rows]
+    if not values.size:
+        return None
+    row_size = np.max(sizes, axis=1)
+    values, sizes = values / row_size[:, None], sizes / row_size[:, None]
+    columns = np.max(sizes, axis=0) > 0
+    values = values[:, columns] / np.max(sizes[:, columns], axis=0)
+    if not np.all(np.isfinite(values)):
+        return None
+    s = np.linalg.svd(values, compute_uv=False)
+    small = s[(s > ZERO_TOLERANCE) & (s < SINGULAR_MINOR)]
+    return float(np.min(small)) if small.size else None
+
+
+class RankedMatrix:
+    """A matrix whose rank the analysis reads at surface points, compiled with the sizes of its entries.
+
+    Parameters
+    ----------
+    numerics
+        Where the entries are compiled.
+    entries
+        ``(row, column) -> expression`` of the entries that are not identically zero.
+    shape
+        The matrix's shape.
+    name
+        How notes name it (``{Phi_a, Phi_b}``).
+    """
+
+    def __init__(self, numerics: Numerics, entries: Mapping[tuple[int, int], sympy.Expr], shape: tuple[int, int], name: str) -> None:
+        self.shape = shape
+        self.name = name
+        self._where = list(entries)
+        exprs = [entries[k] for k in self._where]
+        memo: dict[sympy.Expr, sympy.Expr] = {}
+        self._values = numerics.function(exprs)
+        self._sizes = numerics.function([magnitude(e, memo) for e in exprs])
+
+    def near_rank_drop(self, z: np.ndarray) -> float | None:
+        """:func:`near_rank_drop` of the matrix at ``z``."""
+        if not self._where:
+            return None
+        values = np.zeros(self.shape)
+        sizes = np.zeros(self.shape)
+        rows, cols = (np.array(k, dtype=int) for k in zip(*self._where))
+        values[rows, cols] = self._values(z)
+        sizes[rows, cols] = self._sizes(z)
+        return near_rank_drop(values, sizes)
 
 
 #: at most this many column sets are tried by :func:`columns_invertible_everywhere`
@@ -217,6 +319,8 @@ class Numerics:
         self.avoid: list[sympy.Expr] = []
         #: indices of variables that projections hold two of at their start values (:meth:`_held_variables`)
         self.hold: tuple[int, ...] = ()
+        #: what the analysis should tell the user about its sample points (points kept next to a rank-drop locus)
+        self.notes: list[str] = []
 
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
@@ -380,6 +484,7 @@ class Numerics:
         attempts: int = 40,
         start: np.ndarray | None = None,
         regular: int = 0,
+        minors: Sequence[RankedMatrix] = (),
     ) -> list[np.ndarray]:
         """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
 
@@ -400,6 +505,14 @@ class Numerics:
             returned (a full-rank Jacobian, the regularity condition of Henneaux–Teitelboim,
             Sect. 1.1.2): points where they do not (crossings, singular points) are dropped
             and others sampled, so that no decision is taken at a singular point.
+        minors
+            Matrices whose rank is read at the points: points next to a locus where one
+            of their ranks drops (:func:`near_rank_drop`) are set aside and others
+            sampled. Gauss–Newton steps onto conditions such as ``p_2 (p_1 - 2) + 4 q_2^2 = 0``
+            are drawn towards such loci (there, ``q_2 = 0``), so that half the points can
+            fall within ``1e-3`` of one. Only when ``attempts`` run out are the set-aside
+            points used, those farthest from the locus first, and a note in :attr:`notes`
+            says so.
 
         Raises
         ------
@@ -418,6 +531,7 @@ class Numerics:
         fixed = dict(fixed or {})
         free = np.array([i for i in range(n) if i not in fixed], dtype=int)
         points: list[np.ndarray] = []
+        near: list[tuple[float, np.ndarray, str]] = []  # (smallest singular value, point, matrix) set aside
         tries = 0
         singular = 0
         while len(points) < count and tries < attempts:
@@ -452,11 +566,31 @@ class Numerics:
                 continue
             if ok and self.avoid and self._near_avoided(z):
                 continue
+            drop = self._near_rank_drop(minors, z) if ok else None
+            if drop is not None:
+                near.append((drop[0], z, drop[1]))
+                continue
             if ok:
                 points.append(z)
+        if len(points) < count and near:
+            near.sort(key=lambda item: -item[0])
+            used = near[: count - len(points)]
+            points.extend(z for _, z, _ in used)
+            self.notes.append(
+                f"{len(used)} of {len(points)} sample points on a surface of {m} constraint(s) lie next to a locus where "
+                f"the rank of {used[-1][2]} drops (a singular value {used[-1][0]:.1e} relative to the size of its terms): "
+                f"no point away from it was found in {attempts} tries; ranks read there are right while that value is "
+                "well above round-off, but quantities built on the inverse of that block are ill-conditioned at those points"
+            )
         if len(points) < count:
             raise _no_surface_point(constraints, singular)
         return points
+
+    @staticmethod
+    def _near_rank_drop(minors: Sequence[RankedMatrix], z: np.ndarray) -> tuple[float, str] | None:
+        """The smallest :func:`near_rank_drop` value of ``minors`` at ``z`` and its matrix's name, or ``None``."""
+        found = [(value, m.name) for m in minors if (value := m.near_rank_drop(z)) is not None]
+        return min(found) if found else None
 
 
 class _DenseJacobian:

@@ -1,0 +1,80 @@
+"""Sample points kept away from loci where a rank the analysis reads drops (dirac.analysis.core.numeric)."""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy
+
+import dirac
+from dirac.analysis.core.numeric import SINGULAR_MINOR, Numerics, RankedMatrix, magnitude, near_rank_drop
+from dirac.analysis.core.phase_space import PhaseSpace
+
+q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2", real=True)
+
+
+def test_magnitude_takes_every_sum_and_product_of_absolute_values():
+    """By hand: the size of ``p2 (p1 - 2) - 8 q2^2`` is ``|p2| (|p1| + 2) + 8 q2^2``, and bounds the value."""
+    expr = p2 * (p1 - 2) - 8 * q2**2
+    assert sympy.simplify(magnitude(expr) - (sympy.Abs(p2) * (sympy.Abs(p1) + 2) + 8 * q2**2)) == 0
+    rng = np.random.default_rng(1)
+    f = sympy.lambdify((p1, p2, q2), expr)
+    g = sympy.lambdify((p1, p2, q2), magnitude(expr))
+    for _ in range(50):
+        x = rng.normal(size=3) * 3
+        assert abs(f(*x)) <= g(*x) * (1 + 1e-15)
+
+
+def test_near_rank_drop_flags_cancellation_not_round_off_nor_small_parameters():
+    """The band ``ZERO_TOLERANCE < s < SINGULAR_MINOR`` of the equilibrated singular values."""
+    sizes = np.array([[0.0, 2.0], [2.0, 0.0]])
+
+    def antisymmetric(c: float) -> np.ndarray:
+        return np.array([[0.0, c], [-c, 0.0]])
+
+    # C_12 = 2.4e-6 left of terms of size 2: next to the locus where C vanishes
+    assert near_rank_drop(antisymmetric(2.4e-6), sizes) == 1.2e-6
+    assert near_rank_drop(antisymmetric(0.5), sizes) is None  # a regular point
+    assert near_rank_drop(antisymmetric(2e-17), sizes) is None  # rank 0 everywhere: round-off, no locus
+    # a small parameter is not a cancellation: diag(1, 1e-6) with entries of those sizes has full rank cleanly
+    small = np.diag([1.0, 1e-6])
+    assert near_rank_drop(small, small) is None
+    # an unsimplified zero entry (8 q (2 - p) + 8 q (p - 2)) of large size does not hide a small one
+    assert near_rank_drop(np.array([[0.0, 1e-6], [-1e-6, 0.0]]), np.array([[0.0, 1.0], [1.0, 10.0]])) is not None
+
+
+def _analysis():
+    """``L = -q1' q2' - q2 q1' q3' + 2 q1' - 2 q2^2`` (found by the random-Lagrangian invariants).
+
+    By hand: ``p1 = 2 - q2' - q2 q3'``, ``p2 = -q1'``, ``p3 = -q2 q1'``, so
+    ``phi_1 = p3 - q2 p2`` is primary; ``H_c = -p1 p2 + 2 p2 + 2 q2^2`` and
+    ``{phi_1, H_c} = phi_2 = p2 (p1 - 2) + 4 q2^2`` is secondary; ``{phi_1, phi_2} =
+    -p2 (p1 - 2) + 8 q2^2 = 12 q2^2`` on the surface. Both are second class where
+    ``q2 != 0`` (2 degrees of freedom); at ``q2 = 0`` the matrix ``C`` has rank 0.
+    """
+    lagrangian = dirac.Lagrangian.from_strings(
+        "jacobi", ["q1", "q2", "q3"], "-q1_dot*q2_dot - q2*q1_dot*q3_dot + 2*q1_dot - 2*q2**2"
+    )
+    return dirac.analyze(lagrangian)
+
+
+def test_sample_points_stay_away_from_where_C_drops_rank():
+    """Gauss–Newton steps onto ``phi_2 = 0`` drew half the points to ``q2 ~ 1e-3`` (C ~ 1e-6): no more."""
+    a = _analysis()
+    assert (len(a.first_class), len(a.second_class), a.physical_degrees_of_freedom) == (0, 2, 2)
+    names = [str(v) for v in a.phase_space]
+    for z in a._points:
+        v = dict(zip(names, z))
+        size = abs(v["p_q2"]) * (abs(v["p_q1"]) + 2) + 8 * v["q2"] ** 2
+        assert 12 * v["q2"] ** 2 >= SINGULAR_MINOR * size, (v, a.notes)
+    assert not any("lie next to a locus" in n for n in a.notes)
+
+
+def test_points_that_cannot_avoid_a_locus_are_used_with_a_note():
+    """A block that is small against its terms on the whole surface: the points are kept, and the user is told."""
+    x, y = sympy.symbols("x y", real=True)
+    space = PhaseSpace((x,), (y,))
+    numerics = Numerics(space, {})
+    block = RankedMatrix(numerics, {(0, 0): x - y + sympy.Rational(1, 10**6)}, (1, 1), "the test block")
+    points = numerics.surface_points([x - y], 3, minors=[block])
+    assert len(points) == 3 and all(abs(z[0] - z[1]) < 1e-9 for z in points)
+    assert len(numerics.notes) == 1 and "3 of 3 sample points" in numerics.notes[0] and "the test block" in numerics.notes[0]
