@@ -58,8 +58,8 @@ from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import (
     LARGE_ROWS,
+    BracketBlocks,
     Numerics,
-    RankedMatrix,
     SingularSurface,
     columns_invertible_everywhere,
     independent_rows,
@@ -270,6 +270,8 @@ class ConstraintChain:
 
     def _run(self, max_stages: int | None) -> ConstraintChain:
         self._row_cache: dict = {}
+        #: the sizes of the terms of derivatives (:func:`~dirac.analysis.core.numeric.magnitude`), shared by the stages
+        self._magnitudes: dict[sympy.Expr, sympy.Expr] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
@@ -284,6 +286,7 @@ class ConstraintChain:
         K = len(self.primary)
         pivots_rows: list[int] = []
         pivot_cols: list[int] = []
+        settled = False  # the points of the last stage were sampled away from where the rank of C drops
         while True:
             constraints = self.constraints
             if not constraints:
@@ -326,11 +329,17 @@ class ConstraintChain:
                     f"stage {len(self.stages) + 1}: {len(deferred)} consistency condition(s) that need multipliers "
                     "eliminated were deferred to the next stage and re-examined there on the smaller surface"
                 )
+            if not chosen and not settled and self._near_locus(points):
+                # the last stage: its points must also keep away from where the rank of C drops; decide again at new ones
+                settled = True
+                points = self._stage_points(whole=True)
+                continue
             if not chosen:
                 break
             self.stages.append([candidates[i] for i in chosen])
             self._keep_reducible(candidates, chosen)
             points = self._stage_points()
+            settled = False
         self.points = points
         self.pivots = (pivots_rows, pivot_cols)
         if pivots_rows:
@@ -359,35 +368,45 @@ class ConstraintChain:
         self._keep_reducible(candidates, chosen)
         return self._stage_points()
 
-    def _stage_points(self, constraints: list[sympy.Expr] | None = None, reducible: list[sympy.Expr] | None = None) -> list[np.ndarray]:
+    def _stage_points(
+        self, constraints: list[sympy.Expr] | None = None, reducible: list[sympy.Expr] | None = None, whole: bool = False
+    ) -> list[np.ndarray]:
         """Regular points of the surface of the constraints found so far, away from loci where a used rank drops.
 
         The chain reads the rank of ``{Phi_a, phi_k}`` at these points (which multipliers
-        are fixed) and, at the last stage, the classification reads that of
-        ``C_ab = {Phi_a, Phi_b}``; points next to a locus where either drops are set aside
-        (:func:`~dirac.analysis.core.numeric.near_rank_drop`). Large systems (from
-        ``LARGE_ROWS`` constraints or ``LARGE_SYSTEM`` phase-space variables) skip that
-        test: their ranks are read block by block, sparsely. ``constraints`` and
-        ``reducible`` default to the chain's own.
+        are fixed); points next to a locus where it drops are set aside
+        (:func:`~dirac.analysis.core.numeric.near_rank_drop`). With ``whole``, so is
+        ``C_ab = {Phi_a, Phi_b}`` of all the constraints, whose rank the classification
+        reads at the last stage's points (:meth:`_near_locus` decides when that is needed).
+        ``constraints`` and ``reducible`` default to the chain's own.
         """
         constraints = self.constraints if constraints is None else constraints
         reducible = self.reducible if reducible is None else reducible
-        minors: list[RankedMatrix] = []
-        if len(constraints) < LARGE_ROWS and self.phase_space.dimension < LARGE_SYSTEM:
-            m, K = len(constraints), len(self.primary)
-            pb = self.phase_space.poisson_bracket
-            brackets = {(a, b): pb(constraints[a], constraints[b]) for a in range(m) for b in range(a + 1, m)}
-            entries = {k: v for k, v in brackets.items() if v != 0}
-            entries.update({(b, a): -v for (a, b), v in list(entries.items())})
-            minors.append(RankedMatrix(self.numerics, entries, (m, m), "C_ab = {Phi_a, Phi_b}"))
-            multipliers = {}
-            for a, c in enumerate(constraints):
-                row = self._rows(c)[1]
-                multipliers.update({(a, k): row[k] for k in self._row_support[c]})
-            minors.append(RankedMatrix(self.numerics, multipliers, (m, K), "{Phi_a, phi_k}"))
         return self.numerics.surface_points(
-            constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=minors
+            constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=self._minors(constraints, whole)
         )
+
+    def _near_locus(self, points: list[np.ndarray]) -> bool:
+        """Whether a point of the last stage lies next to a locus where ``C_ab = {Phi_a, Phi_b}`` drops rank."""
+        minors = self._minors(self.constraints, whole=True)
+        return any(self.numerics.near_rank_drop(minors, z) is not None for z in points)
+
+    def _minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks]:
+        """The blocks of ``C`` whose ranks are read at the points of ``constraints``' surface (see :meth:`_stage_points`).
+
+        ``{Phi_a, phi_k}``, and with ``whole`` also ``C_ab`` over all the constraints. None
+        for large systems (from ``LARGE_ROWS`` constraints or ``LARGE_SYSTEM`` phase-space
+        variables): their ranks are read block by block, sparsely, without this test.
+        """
+        if len(constraints) >= LARGE_ROWS or self.phase_space.dimension >= LARGE_SYSTEM or not self.primary:
+            return []
+        rows = list(constraints) + [p for p in self.primary if p not in set(constraints)]
+        position = {c: a for a, c in enumerate(rows)}
+        own = list(range(len(constraints)))
+        blocks = {"{Phi_a, phi_k}": (own, [position[p] for p in self.primary])}
+        if whole:
+            blocks["C_ab = {Phi_a, Phi_b}"] = (own, own)
+        return [BracketBlocks(self.numerics, rows, blocks, self._magnitudes)]
 
     def _nonzero(self, candidates: list[sympy.Expr], points: list[np.ndarray]) -> list[sympy.Expr]:
         """The candidates that are not weakly zero, tidied (constraints: the sign is free)."""

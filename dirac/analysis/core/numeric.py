@@ -29,7 +29,7 @@ from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
-__all__ = ["Numerics", "RankedMatrix", "SingularSurface", "magnitude", "near_rank_drop", "numeric_rank", "independent_rows"]
+__all__ = ["Numerics", "BracketBlocks", "SingularSurface", "magnitude", "near_rank_drop", "numeric_rank", "independent_rows"]
 
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
@@ -102,16 +102,17 @@ def magnitude(expr: sympy.Expr, memo: dict[sympy.Expr, sympy.Expr] | None = None
     found = memo.get(expr)
     if found is not None:
         return found
+    # built unevaluated: only compiled, never simplified (sympy's canonical ordering would cost more than the rest)
     if expr.is_Number:
         size: sympy.Expr = abs(expr)
     elif expr.is_Symbol:
-        size = sympy.Abs(expr)
+        size = sympy.Abs(expr, evaluate=False)
     elif expr.is_Add or expr.is_Mul:
-        size = expr.func(*(magnitude(a, memo) for a in expr.args))
+        size = expr.func(*(magnitude(a, memo) for a in expr.args), evaluate=False)
     elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
-        size = magnitude(expr.base, memo) ** expr.exp
+        size = sympy.Pow(magnitude(expr.base, memo), expr.exp, evaluate=False)
     else:
-        size = sympy.Abs(expr)
+        size = sympy.Abs(expr, evaluate=False)
     memo[expr] = size
     return size
 
@@ -146,40 +147,57 @@ def near_rank_drop(values: np.ndarray, sizes: np.ndarray) -> float | None:
     return float(np.min(small)) if small.size else None
 
 
-class RankedMatrix:
-    """A matrix whose rank the analysis reads at surface points, compiled with the sizes of its entries.
+class BracketBlocks:
+    """Blocks of ``C_ab = {Phi_a, Phi_b}`` whose ranks the analysis reads, tested at points (:func:`near_rank_drop`).
+
+    ``C`` and the sizes of its terms are formed at each point from the gradients of the
+    constraints, ``C_ab = sum_i (dPhi_a/dq_i dPhi_b/dp_i - dPhi_a/dp_i dPhi_b/dq_i)`` and
+    ``S_ab = sum_i (|dPhi_a/dq_i| |dPhi_b/dp_i| + |dPhi_a/dp_i| |dPhi_b/dq_i|)`` with
+    ``|.|`` the :func:`magnitude` of each derivative: the magnitude of the bracket written
+    out as that sum, without compiling the brackets (only the gradients, which the surface
+    projections compile anyway, and their magnitudes).
 
     Parameters
     ----------
     numerics
-        Where the entries are compiled.
-    entries
-        ``(row, column) -> expression`` of the entries that are not identically zero.
-    shape
-        The matrix's shape.
-    name
-        How notes name it (``{Phi_a, Phi_b}``).
+        Where the gradients are compiled.
+    rows
+        The constraints (all that any block uses).
+    blocks
+        Name -> (row indices, column indices) into ``rows``: ``C_ab`` over all the
+        constraints, ``{Phi_a, phi_k}`` over them and the primaries.
+    memo
+        :func:`magnitude` memo shared between the stages of one analysis.
     """
 
-    def __init__(self, numerics: Numerics, entries: Mapping[tuple[int, int], sympy.Expr], shape: tuple[int, int], name: str) -> None:
-        self.shape = shape
-        self.name = name
-        self._where = list(entries)
-        exprs = [entries[k] for k in self._where]
-        memo: dict[sympy.Expr, sympy.Expr] = {}
-        self._values = numerics.function(exprs)
-        self._sizes = numerics.function([magnitude(e, memo) for e in exprs])
+    def __init__(
+        self,
+        numerics: Numerics,
+        rows: Sequence[sympy.Expr],
+        blocks: Mapping[str, tuple[Sequence[int], Sequence[int]]],
+        memo: dict[sympy.Expr, sympy.Expr] | None = None,
+    ) -> None:
+        space = numerics.phase_space
+        self.blocks = {name: (list(r), list(c)) for name, (r, c) in blocks.items()}
+        self._shape = (len(rows), len(space.variables))
+        at_rows, at_cols, entries = space.gradient_entries(rows)
+        self._at = (np.asarray(at_rows, dtype=int), np.asarray(at_cols, dtype=int))
+        memo = {} if memo is None else memo
+        self._values = numerics.function(entries)
+        self._sizes = numerics.function([magnitude(e, memo) for e in entries])
 
-    def near_rank_drop(self, z: np.ndarray) -> float | None:
-        """:func:`near_rank_drop` of the matrix at ``z``."""
-        if not self._where:
-            return None
-        values = np.zeros(self.shape)
-        sizes = np.zeros(self.shape)
-        rows, cols = (np.array(k, dtype=int) for k in zip(*self._where))
-        values[rows, cols] = self._values(z)
-        sizes[rows, cols] = self._sizes(z)
-        return near_rank_drop(values, sizes)
+    def near_rank_drop(self, z: np.ndarray) -> tuple[float, str] | None:
+        """The smallest :func:`near_rank_drop` value of the blocks at ``z``, with the block's name."""
+        gradients = np.zeros(self._shape)
+        sizes = np.zeros(self._shape)
+        gradients[self._at] = self._values(z)
+        sizes[self._at] = self._sizes(z)
+        n = self._shape[1] // 2
+        dq, dp, sq, sp_ = gradients[:, :n], gradients[:, n:], sizes[:, :n], sizes[:, n:]
+        C = dq @ dp.T - dp @ dq.T
+        S = sq @ sp_.T + sp_ @ sq.T
+        found = [(s, name) for name, (r, c) in self.blocks.items() if (s := near_rank_drop(C[np.ix_(r, c)], S[np.ix_(r, c)])) is not None]
+        return min(found) if found else None
 
 
 #: at most this many column sets are tried by :func:`columns_invertible_everywhere`
@@ -484,7 +502,7 @@ class Numerics:
         attempts: int = 40,
         start: np.ndarray | None = None,
         regular: int = 0,
-        minors: Sequence[RankedMatrix] = (),
+        minors: Sequence[BracketBlocks] = (),
     ) -> list[np.ndarray]:
         """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
 
@@ -566,7 +584,7 @@ class Numerics:
                 continue
             if ok and self.avoid and self._near_avoided(z):
                 continue
-            drop = self._near_rank_drop(minors, z) if ok else None
+            drop = self.near_rank_drop(minors, z) if ok else None
             if drop is not None:
                 near.append((drop[0], z, drop[1]))
                 continue
@@ -587,9 +605,9 @@ class Numerics:
         return points
 
     @staticmethod
-    def _near_rank_drop(minors: Sequence[RankedMatrix], z: np.ndarray) -> tuple[float, str] | None:
+    def near_rank_drop(minors: Sequence[BracketBlocks], z: np.ndarray) -> tuple[float, str] | None:
         """The smallest :func:`near_rank_drop` value of ``minors`` at ``z`` and its matrix's name, or ``None``."""
-        found = [(value, m.name) for m in minors if (value := m.near_rank_drop(z)) is not None]
+        found = [drop for m in minors if (drop := m.near_rank_drop(z)) is not None]
         return min(found) if found else None
 
 

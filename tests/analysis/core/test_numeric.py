@@ -6,7 +6,7 @@ import numpy as np
 import sympy
 
 import dirac
-from dirac.analysis.core.numeric import SINGULAR_MINOR, Numerics, RankedMatrix, magnitude, near_rank_drop
+from dirac.analysis.core.numeric import SINGULAR_MINOR, BracketBlocks, Numerics, magnitude, near_rank_drop
 from dirac.analysis.core.phase_space import PhaseSpace
 
 q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2", real=True)
@@ -70,11 +70,19 @@ def test_sample_points_stay_away_from_where_C_drops_rank():
 
 
 def test_points_that_cannot_avoid_a_locus_are_used_with_a_note():
-    """A block that is small against its terms on the whole surface: the points are kept, and the user is told."""
-    x, y = sympy.symbols("x y", real=True)
-    space = PhaseSpace((x,), (y,))
-    numerics = Numerics(space, {})
-    block = RankedMatrix(numerics, {(0, 0): x - y + sympy.Rational(1, 10**6)}, (1, 1), "the test block")
-    points = numerics.surface_points([x - y], 3, minors=[block])
-    assert len(points) == 3 and all(abs(z[0] - z[1]) < 1e-9 for z in points)
+    """A block small against its terms on the whole surface: the points are kept, and the user is told.
+
+    ``{x + (1 + 1e-6) y, p_x - p_y} = 1 - (1 + 1e-6) = -1e-6`` from terms of size 2.
+    """
+    x, y, px, py = sympy.symbols("x y p_x p_y", real=True)
+    numerics = Numerics(PhaseSpace((x, y), (px, py)), {})
+    rows = [x + (1 + sympy.Rational(1, 10**6)) * y, px - py]
+    block = BracketBlocks(numerics, rows, {"the test block": ([0, 1], [0, 1])})
+    points = numerics.surface_points(rows, 3, minors=[block])
+    assert len(points) == 3
     assert len(numerics.notes) == 1 and "3 of 3 sample points" in numerics.notes[0] and "the test block" in numerics.notes[0]
+    # the same block with 1 in place of 1 + 1e-6 is round-off (rank 0 cleanly): no note
+    numerics = Numerics(PhaseSpace((x, y), (px, py)), {})
+    rows = [x + y, px - py]
+    numerics.surface_points(rows, 3, minors=[BracketBlocks(numerics, rows, {"the test block": ([0, 1], [0, 1])})])
+    assert numerics.notes == []
