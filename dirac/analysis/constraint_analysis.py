@@ -184,6 +184,7 @@ class ConstraintAnalysis:
         chain.written = {e: chi for e, chi in zip(expanded, lagrangian.constraints) if isinstance(chi, sympy.Mul)}
         chain.holonomic = {e: k for k, e in enumerate(expanded, start=1)}
         chain.imposed = [e.expression for e in equalities]
+        chain.hessian, chain.hessian_rank = legendre.hessian, legendre.rank
         chain.run()
         self._chain = chain
         done(f"constraint chain: {_count(len(chain.stages), 'stage')} "

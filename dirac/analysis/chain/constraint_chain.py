@@ -59,6 +59,7 @@ from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import (
     LARGE_ROWS,
     BracketBlocks,
+    EntryBlock,
     Numerics,
     SingularSurface,
     columns_invertible_everywhere,
@@ -170,6 +171,9 @@ class ConstraintChain:
     choices: dict[sympy.Expr, sympy.Expr] = field(default_factory=dict)
     forces: dict[sympy.Symbol, sympy.Expr] = field(default_factory=dict)
     imposed: list[sympy.Expr] = field(default_factory=list)
+    #: the Hessian ``W = d^2 L / dq_dot^2`` and its rank at generic configurations (the Legendre transform's)
+    hessian: sympy.Matrix | None = None
+    hessian_rank: int = 0
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -272,6 +276,7 @@ class ConstraintChain:
         self._row_cache: dict = {}
         #: the sizes of the terms of derivatives (:func:`~dirac.analysis.core.numeric.magnitude`), shared by the stages
         self._magnitudes: dict[sympy.Expr, sympy.Expr] = {}
+        self._hessian: EntryBlock | None = None
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
@@ -382,31 +387,71 @@ class ConstraintChain:
         """
         constraints = self.constraints if constraints is None else constraints
         reducible = self.reducible if reducible is None else reducible
-        return self.numerics.surface_points(
+        points = self.numerics.surface_points(
             constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=self._minors(constraints, whole)
         )
+        self._check_hessian_rank(points)
+        return points
 
     def _near_locus(self, points: list[np.ndarray]) -> bool:
         """Whether a point of the last stage lies next to a locus where ``C_ab = {Phi_a, Phi_b}`` drops rank."""
         minors = self._minors(self.constraints, whole=True)
         return any(self.numerics.near_rank_drop(minors, z) is not None for z in points)
 
-    def _minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks]:
-        """The blocks of ``C`` whose ranks are read at the points of ``constraints``' surface (see :meth:`_stage_points`).
+    def _minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks | EntryBlock]:
+        """The blocks whose ranks are read at the points of ``constraints``' surface (see :meth:`_stage_points`).
 
-        ``{Phi_a, phi_k}``, and with ``whole`` also ``C_ab`` over all the constraints. None
+        ``{Phi_a, phi_k}``, with ``whole`` also ``C_ab`` over all the constraints, and the
+        Hessian ``W`` (:meth:`_hessian_block`). None
         for large systems (from ``LARGE_ROWS`` constraints or ``LARGE_SYSTEM`` phase-space
         variables): their ranks are read block by block, sparsely, without this test.
         """
-        if len(constraints) >= LARGE_ROWS or self.phase_space.dimension >= LARGE_SYSTEM or not self.primary:
+        if len(constraints) >= LARGE_ROWS or self.phase_space.dimension >= LARGE_SYSTEM:
             return []
+        hessian = self._hessian_block()
+        if not self.primary:
+            return [hessian] if hessian is not None else []
         rows = list(constraints) + [p for p in self.primary if p not in set(constraints)]
         position = {c: a for a, c in enumerate(rows)}
         own = list(range(len(constraints)))
         blocks = {"{Phi_a, phi_k}": (own, [position[p] for p in self.primary])}
         if whole:
             blocks["C_ab = {Phi_a, Phi_b}"] = (own, own)
-        return [BracketBlocks(self.numerics, rows, blocks, self._magnitudes)]
+        return [BracketBlocks(self.numerics, rows, blocks, self._magnitudes)] + ([hessian] if hessian is not None else [])
+
+    def _hessian_block(self) -> EntryBlock | None:
+        """The Hessian as a block whose rank is read (compiled once), when it has rank > 0 and no velocities in it."""
+        if self.hessian is None or not self.hessian_rank or self.hessian.shape[0] >= LARGE_ROWS:
+            return None
+        known = {*self.phase_space.variables, *self.phase_space.parameters, *([self.time] if self.time is not None else [])}
+        if not self.hessian.free_symbols <= known:  # W of velocities (L not quadratic in them): no function of the point
+            return None
+        if self._hessian is None:
+            self._hessian = EntryBlock(self.numerics, self.hessian, "the Hessian W = d^2 L / dq_dot^2")
+        return self._hessian
+
+    def _check_hessian_rank(self, points: list[np.ndarray]) -> None:
+        """Refuse a surface on which the Hessian has a lower rank than at generic configurations.
+
+        The Legendre transform solves the velocities where ``W`` has its generic rank
+        (Henneaux–Teitelboim, Sect. 1.1.2: the rank of ``W`` is assumed constant); when
+        the constraints confine the motion to where that rank drops (``L = -q1' q2' - q2
+        q1' q3' - q2' q3'``, ``det W = -2 q2``, under ``q2 = 0``), ``H_c`` and every
+        consistency condition divide by zero on the surface.
+        """
+        block = self._hessian_block()
+        if block is None or not points:
+            return
+        ranks = [block.rank(z) for z in points]
+        if min(ranks) < self.hessian_rank:
+            raise AnalysisError(
+                f"the Hessian W = d^2 L / dq_dot^2 has rank {self.hessian_rank} at generic configurations, but rank "
+                f"{min(ranks)} on the constraint surface found (at {sum(r < self.hessian_rank for r in ranks)} of "
+                f"{len(ranks)} sample points): the velocities solved from W divide by zero there, so the canonical "
+                "Hamiltonian and the consistency conditions are singular on the surface; substitute the holonomic "
+                "constraints into L (eliminate the coordinates they fix) or choose coordinates in which W has one rank "
+                "on the constraint surface"
+            )
 
     def _nonzero(self, candidates: list[sympy.Expr], points: list[np.ndarray]) -> list[sympy.Expr]:
         """The candidates that are not weakly zero, tidied (constraints: the sign is free)."""
@@ -514,7 +559,7 @@ class ConstraintChain:
         return ConstraintChain(
             self.phase_space, self.numerics, self.canonical_hamiltonian, list(self.primary), self.multipliers,
             time=self.time, written=dict(self.written), holonomic=dict(self.holonomic), choices=choices,
-            forces=dict(self.forces), imposed=list(self.imposed),
+            forces=dict(self.forces), imposed=list(self.imposed), hessian=self.hessian, hessian_rank=self.hessian_rank,
         )
 
     def _structure(self) -> tuple[tuple[int, ...], int, tuple[str, ...], int]:

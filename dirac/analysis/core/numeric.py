@@ -29,7 +29,7 @@ from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function, scalar_function
 from dirac.errors import AnalysisError
 
-__all__ = ["Numerics", "BracketBlocks", "SingularSurface", "magnitude", "near_rank_drop", "numeric_rank", "independent_rows"]
+__all__ = ["Numerics", "BracketBlocks", "EntryBlock", "SingularSurface", "magnitude", "near_rank_drop", "numeric_rank", "independent_rows"]
 
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
@@ -198,6 +198,62 @@ class BracketBlocks:
         S = sq @ sp_.T + sp_ @ sq.T
         found = [(s, name) for name, (r, c) in self.blocks.items() if (s := near_rank_drop(C[np.ix_(r, c)], S[np.ix_(r, c)])) is not None]
         return min(found) if found else None
+
+
+class EntryBlock:
+    """A matrix of expressions whose rank the analysis relies on (the Hessian ``W``), compiled with its sizes.
+
+    Parameters
+    ----------
+    numerics
+        Where the entries and their :func:`magnitude` are compiled.
+    matrix
+        The matrix (entries in the phase-space variables, ``t`` and parameters).
+    name
+        How notes and errors name it.
+    """
+
+    def __init__(self, numerics: Numerics, matrix: sympy.Matrix, name: str) -> None:
+        self.name = name
+        self.shape = matrix.shape
+        nonzero = matrix.todok()
+        self._where = list(nonzero)
+        self._at = tuple(np.array(k, dtype=int) for k in zip(*self._where)) if self._where else None
+        exprs = [nonzero[k] for k in self._where]
+        memo: dict[sympy.Expr, sympy.Expr] = {}
+        self._values = numerics.function(exprs)
+        self._sizes = numerics.function([magnitude(e, memo) for e in exprs])
+
+    def at(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The matrix and the sizes of its entries at ``z``."""
+        values = np.zeros(self.shape)
+        sizes = np.zeros(self.shape)
+        if self._at is not None:
+            values[self._at] = self._values(z)
+            sizes[self._at] = self._sizes(z)
+        return values, sizes
+
+    def near_rank_drop(self, z: np.ndarray) -> tuple[float, str] | None:
+        """:func:`near_rank_drop` of the matrix at ``z``, with its name."""
+        s = near_rank_drop(*self.at(z))
+        return None if s is None else (s, self.name)
+
+    def rank(self, z: np.ndarray) -> int:
+        """The rank at ``z`` of the matrix with rows and columns scaled by the sizes of their terms.
+
+        Entries at round-off of their own size are zeros; singular values at or below
+        ``ZERO_TOLERANCE`` of the equilibrated matrix do not count (see :func:`near_rank_drop`).
+        """
+        values, sizes = self.at(z)
+        sizes = np.where(np.abs(values) > ZERO_TOLERANCE * sizes, sizes, 0.0)
+        row = np.max(sizes, axis=1, initial=0.0)
+        keep = row > 0
+        values, sizes = values[keep] / row[keep, None], sizes[keep] / row[keep, None]
+        column = np.max(sizes, axis=0, initial=0.0)
+        values = values[:, column > 0] / column[column > 0]
+        if not values.size:
+            return 0
+        return int(np.sum(np.linalg.svd(values, compute_uv=False) > ZERO_TOLERANCE))
 
 
 #: at most this many column sets are tried by :func:`columns_invertible_everywhere`
@@ -502,7 +558,7 @@ class Numerics:
         attempts: int = 40,
         start: np.ndarray | None = None,
         regular: int = 0,
-        minors: Sequence[BracketBlocks] = (),
+        minors: Sequence[BracketBlocks | EntryBlock] = (),
     ) -> list[np.ndarray]:
         """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
 
@@ -605,7 +661,7 @@ class Numerics:
         return points
 
     @staticmethod
-    def near_rank_drop(minors: Sequence[BracketBlocks], z: np.ndarray) -> tuple[float, str] | None:
+    def near_rank_drop(minors: Sequence[BracketBlocks | EntryBlock], z: np.ndarray) -> tuple[float, str] | None:
         """The smallest :func:`near_rank_drop` value of ``minors`` at ``z`` and its matrix's name, or ``None``."""
         found = [drop for m in minors if (drop := m.near_rank_drop(z)) is not None]
         return min(found) if found else None

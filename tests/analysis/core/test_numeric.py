@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy
 
 import dirac
 from dirac.analysis.core.numeric import SINGULAR_MINOR, BracketBlocks, Numerics, magnitude, near_rank_drop
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.errors import AnalysisError
 
 q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2", real=True)
 
@@ -86,3 +88,22 @@ def test_points_that_cannot_avoid_a_locus_are_used_with_a_note():
     rows = [x + y, px - py]
     numerics.surface_points(rows, 3, minors=[BracketBlocks(numerics, rows, {"the test block": ([0, 1], [0, 1])})])
     assert numerics.notes == []
+
+
+def test_a_hessian_whose_rank_drops_on_the_constraint_surface_is_refused():
+    """``L = -q1' q2' - q2 q1' q3' - q2' q3'`` under ``q2 = 0`` (found by the random-Lagrangian invariants).
+
+    By hand: ``W = [[0, -1, -q2], [-1, 0, -1], [-q2, -1, 0]]`` has ``det W = -2 q2``, rank 3
+    where ``q2 != 0`` and rank 2 on the constraint surface ``q2 = 0``. The velocities solved
+    from ``W`` divide by ``q2``, so the total Hamiltonian was not tangent to the surface
+    (``{chi, H_T}`` of order ``1e16`` at its points) while counts were reported.
+    """
+    lagrangian = dirac.Lagrangian.from_strings(
+        "drop", ["q1", "q2", "q3"], "-q1_dot*q2_dot - q2*q1_dot*q3_dot - q2_dot*q3_dot", constraints=["-2*q2"]
+    )
+    with pytest.raises(AnalysisError, match=r"has rank 3 at generic configurations, but rank 2 on the constraint surface"):
+        dirac.analyze(lagrangian)
+    # the same Lagrangian under q1 = 0 keeps rank 3 on its surface and is analysed
+    assert dirac.analyze(lagrangian.__class__.from_strings(
+        "kept", ["q1", "q2", "q3"], "-q1_dot*q2_dot - q2*q1_dot*q3_dot - q2_dot*q3_dot", constraints=["q1"]
+    )).hessian_rank == 3
