@@ -58,8 +58,6 @@ from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import (
     LARGE_ROWS,
-    BracketBlocks,
-    EntryBlock,
     Numerics,
     SingularSurface,
     columns_invertible_everywhere,
@@ -67,6 +65,7 @@ from dirac.analysis.core.numeric import (
     numeric_rank,
 )
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.rank_loci import BracketBlocks, EntryBlock
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.regularity import (
     IRREGULAR_GRADIENT,
@@ -465,7 +464,50 @@ class ConstraintChain:
         # a product, written (a holonomic constraint) or expanded (x**2 - y**2, z x + z): sample
         # points may all fall on one branch or on the crossing, so its branches are found here,
         # by factorisation, not left to chance
-        return [self._branch(c, self._parts(c)) for c in kept]
+        fixed = self._fixed_variables(self.constraints + kept)
+        followed = []
+        for c in kept:
+            parts = self._parts(c)
+            if len(parts) < 2:
+                c, parts = self._factored_on_the_surface(c, fixed)
+            followed.append(self._branch(c, parts))
+        return followed
+
+    def _fixed_variables(self, constraints: list[sympy.Expr]) -> list[tuple[sympy.Expr, sympy.Symbol, sympy.Expr]]:
+        """``(constraint, v, value)`` for each constraint ``a v + b`` (numbers ``a != 0``, ``b``): it fixes ``v = -b / a``."""
+        variables = set(self.phase_space.variables)
+        fixed = []
+        for c in constraints:
+            free = c.free_symbols & variables
+            if len(free) == 1:
+                (v,) = free
+                poly = sympy.Poly(c, v) if c.is_polynomial(v) else None
+                if poly is not None and poly.degree() == 1 and all(k.is_number for k in poly.all_coeffs()):
+                    a, b = poly.all_coeffs()
+                    fixed.append((c, v, -b / a))
+        return fixed
+
+    def _factored_on_the_surface(
+        self, constraint: sympy.Expr, fixed: list[tuple[sympy.Expr, sympy.Symbol, sympy.Expr]]
+    ) -> tuple[sympy.Expr, list[sympy.Expr]]:
+        """``constraint`` with the variables that other constraints fix put in, when that makes it a product.
+
+        ``N`` may be irreducible while ``N`` on ``q1 = 0`` is a product of branches: with
+        ``q1 = 0`` found at the same stage, ``-p1 p2 - 2 p1 + p2^2 - 2 p2 q1 + 4 p2 + 2 q1 q3^2
+        - 4 q1 + 4`` is ``(p2 + 2)(p2 + 2 - p1)`` there. The two differ by a multiple of
+        ``q1``, so on the surface either is the same constraint (with the same regularity);
+        the product form is followed, so that its branches are not left to chance.
+        Returns ``(constraint, [constraint])`` when nothing changes.
+        """
+        values = {v: value for c, v, value in fixed if c is not constraint and v in constraint.free_symbols}
+        if not values:
+            return constraint, [constraint]
+        reduced = constraint.xreplace(values)
+        if reduced == constraint or not (reduced.free_symbols & set(self.phase_space.variables)):
+            return constraint, [constraint]
+        reduced = tidy(reduced, self.phase_space.variables, sign=True)
+        parts = self._parts(reduced)
+        return (reduced, parts) if len(parts) >= 2 else (constraint, [constraint])
 
     def _parts(self, constraint: sympy.Expr) -> list[sympy.Expr]:
         """The branches of a new constraint: the factors that can vanish (``[constraint]`` if none)."""
@@ -691,9 +733,9 @@ class ConstraintChain:
         """
         parts = branches(constraint, self.phase_space.variables)
         name = constraint if shown_as is None else shown_as
-        holonomic = self.holonomic.get(name)
         if len(parts) < 2:
             return
+        holonomic = self.holonomic.get(name) or self.holonomic.get(tidy(name, self.phase_space.variables, sign=True))
         for i in range(len(parts)):
             for j in range(i + 1, len(parts)):
                 try:
@@ -706,7 +748,9 @@ class ConstraintChain:
                     f"{where} is irregular: it is the union of the "
                     f"branches {shown}, which meet (where {parts[i]} = {parts[j]} = 0 its gradient vanishes), so there "
                     f"is no single regular constraint surface; analyse the branches {shown} separately "
-                    "(one system each" + (", with the branch as its constraint)" if holonomic else ")"),
+                    + ("(one system each, with the branch as its constraint)" if holonomic
+                       else f"(one system each, or one part of this one with --assume \"{parts[0]} = 0\", in Python "
+                            f"assume=[\"{parts[0]} = 0\"])"),
                     holonomic=holonomic,
                     branches=list(parts),
                 )

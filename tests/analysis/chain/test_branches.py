@@ -172,3 +172,32 @@ def test_crossing_branches_of_a_constraint_with_a_denominator_are_refused():
     shown = [sympy.sympify(text.removesuffix(" = 0"), locals=names) for text in listed]
     for branch in (2 * P1 - q3 * P2, q3 * P1 - 2 * P2):
         assert any(sympy.expand(e - branch) == 0 or sympy.expand(e + branch) == 0 for e in shown)
+
+
+BRANCHES = "-q3*q1_dot*q2_dot - q1*q1_dot*q3_dot - 2*q1*q1_dot - 2*q2_dot + 2*q1*q3"
+
+
+def test_a_product_once_a_variable_fixed_at_the_same_stage_is_put_in_is_refused_by_its_branches():
+    """``L = -q3 q1' q2' - q1 q1' q3' - 2 q1 q1' - 2 q2' + 2 q1 q3`` under ``q1 = 0`` (found by the
+    random-Lagrangian invariants).
+
+    By hand: ``p1 = -q3 q2' - q1 q3' - 2 q1``, ``p2 = -q3 q1' - 2``, ``p3 = -q1 q1'``, so
+    ``phi = q1 (p2 + 2) - q3 p3`` is primary and ``H_c = -(p1 + 2 q1)(p2 + 2)/q3 - 2 q1 q3 +
+    2 lambda q1``. Stage 2 is ``q1 = 0`` with ``{phi, H_c} = (p2 + 2)(p1 + 2 q1 - p2 - 2)/q3 - 2 q1
+    q3``, irreducible, but ``(p2 + 2)(p1 - p2 - 2)/q3`` on ``q1 = 0``: two branches that meet.
+    On ``p1 - p2 - 2 = 0`` the motion leaves ``q1 = 0`` (``q1' = -(p2 + 2)/q3 != 0``); before,
+    the chain stopped there with both branches as one surface, its sample points all on that
+    branch, and ``H_T`` was not tangent to it.
+    """
+    L = dirac.Lagrangian.from_strings("branches", ["q1", "q2", "q3"], BRANCHES, ["q1"])
+    with pytest.raises(AnalysisError, match=r"branches p_q2 \+ 2 = 0 and p_q1 - p_q2 - 2 = 0, which meet.*--assume \"p_q2 \+ 2 = 0\""):
+        dirac.analyze(L)
+
+
+def test_the_consistent_branch_picked_by_an_assumption_against_the_hand_count():
+    """On ``p2 + 2 = 0`` (the test above): ``p_lambda``, ``phi`` (``-q3 p3`` there), ``p2 + 2`` and
+    ``q1`` have vanishing brackets with each other: 4 first class, ``(8 - 8)/2 = 0`` degrees of
+    freedom."""
+    L = dirac.Lagrangian.from_strings("branches", ["q1", "q2", "q3"], BRANCHES, ["q1"])
+    a = dirac.analyze(L, assume=["p_q2 + 2 = 0"])
+    assert (len(a.first_class), len(a.second_class), a.physical_degrees_of_freedom) == (4, 0, 0)

@@ -1,4 +1,4 @@
-"""Sample points kept away from loci where a rank the analysis reads drops (dirac.analysis.core.numeric)."""
+"""Sample points kept away from loci where a rank the analysis reads drops (dirac.analysis.core.rank_loci)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,9 @@ import pytest
 import sympy
 
 import dirac
-from dirac.analysis.core.numeric import SINGULAR_MINOR, BracketBlocks, Numerics, magnitude, near_rank_drop
+from dirac.analysis.core.numeric import Numerics
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.rank_loci import SINGULAR_MINOR, BracketBlocks, magnitude, near_rank_drop
 from dirac.errors import AnalysisError
 
 q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2", real=True)

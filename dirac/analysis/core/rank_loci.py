@@ -1,0 +1,201 @@
+"""Loci where a rank the analysis reads drops, and sample points kept away from them.
+
+The engine reads ranks at a few surface points: of the Hessian ``W`` (how many velocities
+are solved), of ``{Phi_a, phi_k}`` (which multipliers are fixed) and of
+``C_ab = {Phi_a, Phi_b}`` (the classes). A rank read at a point right on a locus where it
+drops is wrong; one read next to such a locus is right, but everything built on the
+inverse of that block (multipliers, the Dirac bracket) is ill-conditioned there, by
+``1 / s`` for a singular value ``s``. Gauss–Newton projections are drawn to such loci
+(onto ``p_2 (p_1 - 2) + 4 q_2^2 = 0`` they land at ``q_2 ~ 1e-3`` half the time). Here a
+point is *next to* a locus when a singular value of the block, scaled by the size of the
+terms its entries are computed from (:func:`magnitude`), is small but not round-off
+(:func:`near_rank_drop`); :meth:`dirac.analysis.core.numeric.Numerics.surface_points`
+sets such points aside.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import sympy
+
+from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics
+
+__all__ = ["SINGULAR_MINOR", "BracketBlocks", "EntryBlock", "magnitude", "near_rank_drop"]
+
+#: a singular value of a matrix whose rank the analysis uses (``W``, ``{Phi_a, Phi_b}``,
+#: ``{Phi_a, phi_k}``), relative to the size of the terms its entries are computed from,
+#: between ``ZERO_TOLERANCE`` and this marks a point next to a locus where that rank drops
+#: (:func:`near_rank_drop`): the rank is still read right there, but everything built on
+#: the inverse of that block is ill-conditioned at the point (by ``1 / s`` per inverse)
+SINGULAR_MINOR = 1e-4
+
+
+def magnitude(expr: sympy.Expr, memo: dict[sympy.Expr, sympy.Expr] | None = None) -> sympy.Expr:
+    """The size of the terms ``expr`` is computed from: ``expr`` with every sum and product taken of absolute values.
+
+    ``|a + b| -> |a| + |b|``, ``|a b| -> |a| |b|``, ``|a^k| -> |a|^k`` (``k`` a positive
+    integer), any other node ``f -> |f|``. Evaluated at a point, it bounds the value
+    (``|expr| <= magnitude(expr)``), and the ratio of the two measures the cancellation
+    at that point: the rounding error of evaluating ``expr`` is at most a small multiple
+    of the unit round-off times this bound (Higham, *Accuracy and Stability of Numerical
+    Algorithms*, 2nd ed., 2002, Sect. 3.1 and Sect. 5.1, the running error bound). Unlike
+    :meth:`Numerics.term_scale` (top-level terms only), a cancellation inside a factor
+    (``p_2 (p_1 - 2)`` at ``p_1 = 2``) is seen.
+    """
+    memo = {} if memo is None else memo
+    found = memo.get(expr)
+    if found is not None:
+        return found
+    # built unevaluated: only compiled, never simplified (sympy's canonical ordering would cost more than the rest)
+    if expr.is_Number:
+        size: sympy.Expr = abs(expr)
+    elif expr.is_Symbol:
+        size = sympy.Abs(expr, evaluate=False)
+    elif expr.is_Add or expr.is_Mul:
+        size = expr.func(*(magnitude(a, memo) for a in expr.args), evaluate=False)
+    elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
+        size = sympy.Pow(magnitude(expr.base, memo), expr.exp, evaluate=False)
+    else:
+        size = sympy.Abs(expr, evaluate=False)
+    memo[expr] = size
+    return size
+
+
+def near_rank_drop(values: np.ndarray, sizes: np.ndarray) -> float | None:
+    """The smallest singular value of ``values`` that is small but not round-off, or ``None``.
+
+    ``values`` is a matrix at one point and ``sizes`` the :func:`magnitude` of each entry
+    there. Entries at round-off of their own size (``|v| <= ZERO_TOLERANCE * size``) are
+    zeros and are dropped, with their sizes (an entry written ``8 q (2 - p) + 8 q (p - 2)``
+    is zero, however large its terms). The rest is equilibrated, rows and then columns
+    divided by their largest size (constraints may be multiplied by any non-zero function,
+    so only the scale-free part of the rank counts), and its singular values ``s`` are
+    taken. A value with ``ZERO_TOLERANCE < s < SINGULAR_MINOR`` says that the point lies
+    next to a locus where the rank drops (the values of a rank-deficient block at a
+    regular point are round-off, below ``ZERO_TOLERANCE``; those of a full-rank block are
+    of the order of its terms).
+    """
+    s = _equilibrated_singular_values(values, sizes)
+    small = s[(s > ZERO_TOLERANCE) & (s < SINGULAR_MINOR)]
+    return float(np.min(small)) if small.size else None
+
+
+def _equilibrated_singular_values(values: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """Singular values of ``values`` with round-off entries dropped and rows, then columns, scaled by their largest size.
+
+    Empty where nothing is left or a value is not finite (no decision can be read there).
+    """
+    sizes = np.where(np.abs(values) > ZERO_TOLERANCE * sizes, sizes, 0.0)
+    rows = np.max(sizes, axis=1, initial=0.0) > 0
+    values, sizes = values[rows], sizes[rows]
+    if not values.size:
+        return np.zeros(0)
+    row_size = np.max(sizes, axis=1)
+    values, sizes = values / row_size[:, None], sizes / row_size[:, None]
+    columns = np.max(sizes, axis=0) > 0
+    values = values[:, columns] / np.max(sizes[:, columns], axis=0)
+    if not values.size or not np.all(np.isfinite(values)):
+        return np.zeros(0)
+    return np.linalg.svd(values, compute_uv=False)
+
+
+class BracketBlocks:
+    """Blocks of ``C_ab = {Phi_a, Phi_b}`` whose ranks the analysis reads, tested at points (:func:`near_rank_drop`).
+
+    ``C`` and the sizes of its terms are formed at each point from the gradients of the
+    constraints, ``C_ab = sum_i (dPhi_a/dq_i dPhi_b/dp_i - dPhi_a/dp_i dPhi_b/dq_i)`` and
+    ``S_ab = sum_i (|dPhi_a/dq_i| |dPhi_b/dp_i| + |dPhi_a/dp_i| |dPhi_b/dq_i|)`` with
+    ``|.|`` the :func:`magnitude` of each derivative: the magnitude of the bracket written
+    out as that sum, without compiling the brackets (only the gradients, which the surface
+    projections compile anyway, and their magnitudes).
+
+    Parameters
+    ----------
+    numerics
+        Where the gradients are compiled.
+    rows
+        The constraints (all that any block uses).
+    blocks
+        Name -> (row indices, column indices) into ``rows``: ``C_ab`` over all the
+        constraints, ``{Phi_a, phi_k}`` over them and the primaries.
+    memo
+        :func:`magnitude` memo shared between the stages of one analysis.
+    """
+
+    def __init__(
+        self,
+        numerics: Numerics,
+        rows: Sequence[sympy.Expr],
+        blocks: Mapping[str, tuple[Sequence[int], Sequence[int]]],
+        memo: dict[sympy.Expr, sympy.Expr] | None = None,
+    ) -> None:
+        space = numerics.phase_space
+        self.blocks = {name: (list(r), list(c)) for name, (r, c) in blocks.items()}
+        self._shape = (len(rows), len(space.variables))
+        at_rows, at_cols, entries = space.gradient_entries(rows)
+        self._at = (np.asarray(at_rows, dtype=int), np.asarray(at_cols, dtype=int))
+        memo = {} if memo is None else memo
+        self._values = numerics.function(entries)
+        self._sizes = numerics.function([magnitude(e, memo) for e in entries])
+
+    def near_rank_drop(self, z: np.ndarray) -> tuple[float, str] | None:
+        """The smallest :func:`near_rank_drop` value of the blocks at ``z``, with the block's name."""
+        gradients = np.zeros(self._shape)
+        sizes = np.zeros(self._shape)
+        gradients[self._at] = self._values(z)
+        sizes[self._at] = self._sizes(z)
+        n = self._shape[1] // 2
+        dq, dp, sq, sp_ = gradients[:, :n], gradients[:, n:], sizes[:, :n], sizes[:, n:]
+        C = dq @ dp.T - dp @ dq.T
+        S = sq @ sp_.T + sp_ @ sq.T
+        found = [(s, name) for name, (r, c) in self.blocks.items() if (s := near_rank_drop(C[np.ix_(r, c)], S[np.ix_(r, c)])) is not None]
+        return min(found) if found else None
+
+
+class EntryBlock:
+    """A matrix of expressions whose rank the analysis relies on (the Hessian ``W``), compiled with its sizes.
+
+    Parameters
+    ----------
+    numerics
+        Where the entries and their :func:`magnitude` are compiled.
+    matrix
+        The matrix (entries in the phase-space variables, ``t`` and parameters).
+    name
+        How notes and errors name it.
+    """
+
+    def __init__(self, numerics: Numerics, matrix: sympy.Matrix, name: str) -> None:
+        self.name = name
+        self.shape = matrix.shape
+        nonzero = matrix.todok()
+        self._where = list(nonzero)
+        self._at = tuple(np.array(k, dtype=int) for k in zip(*self._where)) if self._where else None
+        exprs = [nonzero[k] for k in self._where]
+        memo: dict[sympy.Expr, sympy.Expr] = {}
+        self._values = numerics.function(exprs)
+        self._sizes = numerics.function([magnitude(e, memo) for e in exprs])
+
+    def at(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The matrix and the sizes of its entries at ``z``."""
+        values = np.zeros(self.shape)
+        sizes = np.zeros(self.shape)
+        if self._at is not None:
+            values[self._at] = self._values(z)
+            sizes[self._at] = self._sizes(z)
+        return values, sizes
+
+    def near_rank_drop(self, z: np.ndarray) -> tuple[float, str] | None:
+        """:func:`near_rank_drop` of the matrix at ``z``, with its name."""
+        s = near_rank_drop(*self.at(z))
+        return None if s is None else (s, self.name)
+
+    def rank(self, z: np.ndarray) -> int:
+        """The rank at ``z`` of the matrix with rows and columns scaled by the sizes of their terms.
+
+        Entries at round-off of their own size are zeros; singular values at or below
+        ``ZERO_TOLERANCE`` of the equilibrated matrix do not count (see :func:`near_rank_drop`).
+        """
+        return int(np.sum(_equilibrated_singular_values(*self.at(z)) > ZERO_TOLERANCE))
