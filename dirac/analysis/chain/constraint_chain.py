@@ -478,6 +478,8 @@ class ConstraintChain:
         variables = set(self.phase_space.variables)
         fixed = []
         for c in constraints:
+            if not (c.is_Symbol or ((c.is_Add or c.is_Mul) and len(c.args) == 2)):
+                continue  # a v + b has at most two terms: no walk of larger trees
             free = c.free_symbols & variables
             if len(free) == 1:
                 (v,) = free
@@ -499,7 +501,10 @@ class ConstraintChain:
         the product form is followed, so that its branches are not left to chance.
         Returns ``(constraint, [constraint])`` when nothing changes.
         """
-        values = {v: value for c, v, value in fixed if c is not constraint and v in constraint.free_symbols}
+        if not fixed:
+            return constraint, [constraint]
+        free = constraint.free_symbols  # one walk of the tree
+        values = {v: value for c, v, value in fixed if c is not constraint and v in free}
         if not values:
             return constraint, [constraint]
         reduced = constraint.xreplace(values)
