@@ -273,7 +273,7 @@ class ConstraintChain:
 
     def _run(self, max_stages: int | None) -> ConstraintChain:
         self._row_cache: dict = {}
-        #: the sizes of the terms of derivatives (:func:`~dirac.analysis.core.numeric.magnitude`), shared by the stages
+        #: the sizes of the terms of derivatives (:func:`~dirac.analysis.core.rank_loci.magnitude`), shared by the stages
         self._magnitudes: dict[sympy.Expr, sympy.Expr] = {}
         self._hessian: EntryBlock | None = None
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
@@ -379,7 +379,7 @@ class ConstraintChain:
 
         The chain reads the rank of ``{Phi_a, phi_k}`` at these points (which multipliers
         are fixed); points next to a locus where it drops are set aside
-        (:func:`~dirac.analysis.core.numeric.near_rank_drop`). With ``whole``, so is
+        (:func:`~dirac.analysis.core.rank_loci.near_rank_drop`). With ``whole``, so is
         ``C_ab = {Phi_a, Phi_b}`` of all the constraints, whose rank the classification
         reads at the last stage's points (:meth:`_near_locus` decides when that is needed).
         ``constraints`` and ``reducible`` default to the chain's own.
