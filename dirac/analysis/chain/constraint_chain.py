@@ -508,8 +508,9 @@ class ConstraintChain:
         if not values:
             return constraint, [constraint]
         reduced = constraint.xreplace(values)
-        if reduced == constraint or not (reduced.free_symbols & set(self.phase_space.variables)):
-            return constraint, [constraint]
+        if (reduced == constraint or reduced.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
+                or not (reduced.free_symbols & set(self.phase_space.variables))):
+            return constraint, [constraint]  # unchanged, undefined there (a fixed variable in a denominator), or a number
         reduced = tidy(reduced, self.phase_space.variables, sign=True)
         parts = self._parts(reduced)
         return (reduced, parts) if len(parts) >= 2 else (constraint, [constraint])
