@@ -276,6 +276,7 @@ class ConstraintChain:
         #: the sizes of the terms of derivatives (:func:`~dirac.analysis.core.rank_loci.magnitude`), shared by the stages
         self._magnitudes: dict[sympy.Expr, sympy.Expr] = {}
         self._hessian: EntryBlock | None = None
+        self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock]] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
@@ -407,6 +408,13 @@ class ConstraintChain:
         """
         if len(constraints) >= LARGE_ROWS or self.phase_space.dimension >= LARGE_SYSTEM:
             return []
+        key = (tuple(constraints), whole)
+        if key not in self._minors_of:  # _near_locus and the resampling after it ask for the same blocks
+            self._minors_of[key] = self._new_minors(constraints, whole)
+        return self._minors_of[key]
+
+    def _new_minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks | EntryBlock]:
+        """The blocks of :meth:`_minors`, built."""
         hessian = self._hessian_block()
         if not self.primary:
             return [hessian] if hessian is not None else []

@@ -9,7 +9,7 @@ fraction field when the variables occur in denominators) is orders of magnitude 
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import sympy
@@ -17,11 +17,11 @@ from sympy.core.add import _addsort
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["tidy", "prints_shorter", "present_in_order"]
+__all__ = ["NotInRing", "tidy", "prints_shorter", "present_in_order", "ring_value"]
 
 
-class _NotRational(Exception):
-    pass
+class NotInRing(Exception):
+    """An expression is not an element of the ring asked for (a function, a non-integer power, a division)."""
 
 
 def prints_shorter(expr: sympy.Expr, limit: int) -> bool:
@@ -97,11 +97,18 @@ def _printed_at_most(expr: sympy.Expr, limit: int) -> int | None:
     return walk(expr)
 
 
-def _evaluate(expr: sympy.Expr, gens: dict, domain, allow_division: bool):
-    """Evaluate ``expr`` in ``domain`` (a ring or field), mapping symbols through ``gens``."""
+def ring_value(expr: sympy.Expr, gens: Mapping, domain: Any, invert: Callable[[Any], Any] | None = None) -> Any:
+    """``expr`` as an element of ``domain`` (a polynomial ring or a field), by one walk of its tree.
+
+    Symbols (and any other node keyed in ``gens``) map through ``gens``; rationals,
+    sums, products and integer powers are taken in ``domain``. A negative power needs
+    ``invert`` (``base -> 1 / base`` in ``domain``; it may raise :class:`NotInRing` for a
+    base that has no inverse there). Any other node raises :class:`NotInRing`. Shared
+    sub-trees are walked once.
+    """
     cache: dict = {}
 
-    def walk(e):
+    def walk(e: sympy.Expr) -> Any:
         hit = cache.get(e)
         if hit is not None:
             return hit
@@ -122,16 +129,12 @@ def _evaluate(expr: sympy.Expr, gens: dict, domain, allow_division: bool):
             k = int(e.exp)
             if k >= 0:
                 out = base**k
-            elif allow_division:
-                out = (domain(1) / base) ** (-k)
+            elif invert is not None:
+                out = invert(base) ** (-k)
             else:
-                raise _NotRational
-        elif not (e.free_symbols - set(gens)) and e.is_number is False:
-            raise _NotRational
-        elif e.is_number:
-            raise _NotRational
+                raise NotInRing
         else:
-            raise _NotRational
+            raise NotInRing
         cache[e] = out
         return out
 
@@ -224,7 +227,7 @@ def _tidy_by_term(work: sympy.Expr, variables: Sequence[sympy.Symbol], others: S
         if not gens_all or len(gens_all) < len(free):
             return None
         ring = PolyRing(gens_all, sympy.QQ)
-        value = _evaluate(term, dict(zip(gens_all, ring.gens)), ring, allow_division=False)
+        value = ring_value(term, dict(zip(gens_all, ring.gens)), ring)
         nv = len(own_v)
         for monom, c in value.terms():
             key = (
@@ -278,20 +281,19 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
         if by_term is not None:
             out = by_term
         else:
-            value = _evaluate(work, gens, ring, allow_division=False)
+            value = ring_value(work, gens, ring)
             out = _poly_to_expr(value, variables, others, back)
-    except (_NotRational, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+    except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
         if not rational:  # rational normal forms need gcds: too slow for large expressions
             return expr
         field = FracField(gens_all, sympy.QQ)
         fgens = dict(zip(gens_all, field.gens))
         try:
-            value = _evaluate(work, fgens, field, allow_division=True)
-        except (_NotRational, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+            value = ring_value(work, fgens, field, invert=lambda base: field(1) / base)
+        except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
             out = sympy.cancel(expr)
             return -out if sign and out.could_extract_minus_sign() else out
-        ring = PolyRing(gens_all, sympy.QQ)
-        num = _poly_to_expr(ring(value.numer.as_expr()) if False else value.numer, variables, others, back)
+        num = _poly_to_expr(value.numer, variables, others, back)
         den = _poly_to_expr(value.denom, variables, others, back)
         if den.could_extract_minus_sign():
             num, den = -num, -den

@@ -18,6 +18,8 @@ from sympy.core.add import _addsort
 from sympy.core.mul import _mulsort
 from sympy.polys.rings import PolyElement, PolyRing
 
+from dirac.analysis.core.algebra import NotInRing, ring_value
+
 __all__ = ["PolynomialPartials", "SPARSE_HESSIAN"]
 
 #: sums of more terms than this are differentiated term by term (:meth:`PolynomialPartials.partials`)
@@ -76,29 +78,6 @@ class PolynomialPartials:
             return
         raise _NotPolynomial
 
-    def _walk(self, e: sympy.Expr, gens: dict, ring: PolyRing, cache: dict) -> PolyElement:
-        hit = cache.get(e)
-        if hit is not None:
-            return hit
-        if e in gens:
-            out = gens[e]
-        elif e.is_Rational:
-            out = ring.ground_new(sympy.QQ(int(e.p), int(e.q)))
-        elif e.is_Add:
-            out = ring.zero
-            for a in e.args:
-                out = out + self._walk(a, gens, ring, cache)
-        elif e.is_Mul:
-            out = ring.one
-            for a in e.args:
-                out = out * self._walk(a, gens, ring, cache)
-        elif e.is_Pow and e.exp.is_Integer and e.exp >= 0:
-            out = self._walk(e.base, gens, ring, cache) ** int(e.exp)
-        else:
-            raise _NotPolynomial
-        cache[e] = out
-        return out
-
     def element(self, expr: sympy.Expr) -> tuple[PolyElement, list[sympy.Symbol], dict] | None:
         """``(p, variables, back)``: ``expr`` in the ring of the variables it contains, or ``None``.
 
@@ -121,8 +100,8 @@ class PolynomialPartials:
         ring = PolyRing([*symbols, *atoms.values()], sympy.QQ)
         gens = dict(zip([*symbols, *atoms], ring.gens))
         try:
-            p = self._walk(expr, gens, ring, {})
-        except (_NotPolynomial, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+            p = ring_value(expr, gens, ring)
+        except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
             return None
         return p, variables, {d: a for a, d in atoms.items()}
 

@@ -31,7 +31,7 @@ import numpy as np
 import sympy
 from sympy.polys.rings import PolyRing
 
-from dirac.analysis.core.algebra import present_in_order
+from dirac.analysis.core.algebra import NotInRing, present_in_order, ring_value
 from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["square_free_part", "branches", "factors", "factored", "branch_hint", "regular_holonomic", "normal_components", "IRREGULAR_GRADIENT", "MAX_FACTOR_TERMS"]
@@ -262,15 +262,11 @@ def _irreducible_quadric(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) ->
             S[i][j] += c / 2
             S[j][i] += c / 2
     return _rank(S) >= 3
-class _NoScreen(Exception):
-    """The quick irreducibility screen does not apply: the full path decides."""
-
-
 def _sparse_polynomial(expr: sympy.Expr, present: Sequence[sympy.Symbol], params: Sequence[sympy.Symbol]):
     """``expr`` in the sparse ring ``QQ(params)[present]``, by one walk of its tree.
 
     The same polynomial as ``sympy.Poly(expr, *present)`` (exact arithmetic: coefficients
-    are reduced rational functions of the parameters); raises :class:`_NoScreen` for any
+    are reduced rational functions of the parameters); raises :class:`~dirac.analysis.core.algebra.NotInRing` for any
     other node (a function, a non-integer power, a variable in a denominator).
     """
     domain = sympy.QQ.frac_field(*params) if params else sympy.QQ
@@ -279,39 +275,13 @@ def _sparse_polynomial(expr: sympy.Expr, present: Sequence[sympy.Symbol], params
     if params:
         field_gens = dict(zip(params, domain.gens))
         gens.update({p: ring.ground_new(g) for p, g in field_gens.items()})
-    cache: dict = {}
 
-    def walk(e: sympy.Expr):
-        hit = cache.get(e)
-        if hit is not None:
-            return hit
-        if e in gens:
-            out = gens[e]
-        elif e.is_Rational:
-            out = ring.ground_new(domain.convert(sympy.QQ(int(e.p), int(e.q))))
-        elif e.is_Add:
-            out = ring.zero
-            for a in e.args:
-                out = out + walk(a)
-        elif e.is_Mul:
-            out = ring.one
-            for a in e.args:
-                out = out * walk(a)
-        elif e.is_Pow and e.exp.is_Integer:
-            base = walk(e.base)
-            k = int(e.exp)
-            if k >= 0:
-                out = base**k
-            elif base.is_ground and not base.is_zero:  # a power of a parameter expression: a field element
-                out = ring.ground_new(domain.one / base.LC) ** (-k)
-            else:
-                raise _NoScreen
-        else:
-            raise _NoScreen
-        cache[e] = out
-        return out
+    def invert(base):  # a power of a parameter expression: a field element; a variable in a denominator: no polynomial
+        if not base.is_ground or base.is_zero:
+            raise NotInRing
+        return ring.ground_new(domain.one / base.LC)
 
-    return walk(expr)
+    return ring_value(expr, gens, ring, invert)
 
 
 def _at(p, point: Sequence[int]):
@@ -343,7 +313,7 @@ def _screened_irreducible(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -
     params = sorted(free - set(present), key=lambda s: s.name)
     try:
         p = _sparse_polynomial(expr, present, params)
-    except (_NoScreen, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+    except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
         return False
     if not p:
         return False
