@@ -23,6 +23,7 @@ from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.blas_threads import one_blas_thread
+from dirac.analysis.core.divisors import LEGENDRE_SINGULAR, MULTIPLIERS_SINGULAR, Division, SingularLocus, divisions, singular_loci
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
@@ -41,6 +42,9 @@ __all__ = ["ConstraintAnalysis", "analyze"]
 
 #: largest second-class set whose bracket matrix counts as small
 SMALL_SECOND_CLASS = 8
+
+#: largest second-class set whose ``det C`` is formed to find where the Dirac bracket divides by zero
+SMALL_DETERMINANT = 4
 
 #: seconds allowed for the exact solve of one component of equations_of_motion()
 EXACT_BRACKET_SECONDS = 60.0
@@ -271,10 +275,52 @@ class ConstraintAnalysis:
         #: the parts of a surface with parts of different structure (:class:`dirac.analysis.components.Component`), else empty
         self.components: list = []
         self._generic_analysis: ConstraintAnalysis | None = None
+        self._singular_loci: tuple[SingularLocus, ...] | None = None
+        self._seed = seed
         if self.parameters:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
             self.notes.extend(searched)
         self.seconds = time.perf_counter() - start
+
+    @property
+    def singular_loci(self) -> tuple[SingularLocus, ...]:
+        """Loci of the constraint surface where an expression of the analysis divides by zero.
+
+        Every non-constant divisor (an irreducible factor of a denominator) of the Legendre
+        map (the velocities and ``H_c``: ``det W``, a coordinate singularity such as
+        ``sin(theta) = 0`` for Euler angles), of the elimination of multipliers at each
+        stage (factors that are no branch), of the multiplier solution ``u = U + v_a V_a``
+        and, for at most ``SMALL_DETERMINANT`` second-class constraints, of ``det C`` in the
+        Dirac bracket (240), tested against the surface (:mod:`dirac.analysis.core.divisors`).
+        Computed on first use (the exact multiplier solution is solved then); a tuple of
+        :class:`~dirac.analysis.core.divisors.SingularLocus`, empty when none.
+        """
+        if self._singular_loci is None:
+            self._singular_loci = self._find_singular_loci()
+        return self._singular_loci
+
+    def _find_singular_loci(self) -> tuple[SingularLocus, ...]:
+        """The divisions recorded and found in the results, tested against the surface (:attr:`singular_loci`)."""
+        variables = self._space.variables
+        legendre = self._legendre
+        found: list[Division] = divisions(
+            [*legendre.velocity_solution.values(), self.canonical_hamiltonian], 1, LEGENDRE_SINGULAR, variables
+        )
+        found += self._chain.divisions
+        solution = self.multiplier_solution
+        if self._chain.multiplier_solution is not None and self.constraints:
+            exprs = [*solution.particular.values(), *(e for vec in solution.null_vectors for e in vec.values())]
+            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables)
+        if 0 < len(self.second_class) <= SMALL_DETERMINANT:
+            C = bracket_matrix(self._space, self.second_class)
+            found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
+                               "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
+                               "constraints drops rank)", variables)
+        if not found:
+            return ()
+        numerics = Numerics(self._space, self._generic, seed=self._seed + 1, time=self.time)
+        numerics.avoid = list(self._numerics.avoid)
+        return singular_loci(found, [*self.constraints, *self.reducible_constraints], numerics, variables)
 
     @property
     def multipliers(self) -> Mapping[str, sympy.Expr]:

@@ -194,7 +194,9 @@ def to_json(analysis: AnalysisResult) -> dict:
     ``gauge_transformations`` (for each, its ``parameter``, free ``multiplier`` and
     ``delta``: variable -> ``{z, G}``), ``first_class_without_gauge_transformation`` and
     ``gauge_conditions``; ``forces`` (coordinate name -> the generalized force ``Q_r`` in
-    phase-space variables; ``{}`` when none).
+    phase-space variables; ``{}`` when none); ``singular_loci`` (one ``{"expression", "where", "stage",
+    "what"}`` per locus of the surface where an expression of the analysis divides by zero,
+    :class:`~dirac.analysis.core.divisors.SingularLocus`; ``[]`` when none).
     """
     multipliers, solution, definitions = _multiplier_texts(analysis)
     gauge = analysis.gauge_structure
@@ -233,6 +235,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         "first_class_without_gauge_transformation": [expression_text(c) for c in gauge.without_transformation],
         "gauge_conditions": list(analysis.gauge_conditions),
         "forces": {name: expression_text(Q) for name, Q in getattr(analysis, "forces", {}).items()},
+        "singular_loci": [locus.to_json() for locus in getattr(analysis, "singular_loci", ())],
     }
     if definitions:
         out["multiplier_subexpressions"] = definitions
@@ -372,6 +375,7 @@ def to_text(analysis: AnalysisResult) -> str:
             + ", ".join(_short(c, 80) for c in a.reducible_constraints)
         )
     lines.extend(_gauge_lines(a))
+    lines.extend(_singular_lines(a))
     lines.append(f"Dirac bracket: {a.bracket_strategy}")
     for s in a.special_parameter_values:
         if s.is_curve:
@@ -381,6 +385,11 @@ def to_text(analysis: AnalysisResult) -> str:
     for note in a.notes:
         lines.append(f"note: {note}")
     return "\n".join(lines)
+
+
+def _singular_lines(a: AnalysisResult) -> list[str]:
+    """``singular locus: x = 0 (divisor 3*x - 4*z, stage 2): the multiplier solution divides by zero`` per locus."""
+    return [f"singular locus: {locus}" for locus in getattr(a, "singular_loci", ())]
 
 
 def _gauge_latex_rows(a: AnalysisResult) -> list[str]:
@@ -434,6 +443,9 @@ def to_latex(analysis: AnalysisResult, display: bool = False) -> str:
             else:
                 rows.append(rf"{lx(u)} &\;\text{{undetermined (gauge)}}")
     rows.extend(_gauge_latex_rows(a))
+    for locus in getattr(a, "singular_loci", ()):
+        what = locus.what.replace("_", r"\_").replace("^", r"\^{}")
+        rows.append(rf"&\text{{singular locus (stage {locus.stage}): }} {lx(locus.expression)} = 0 \text{{: {what}}}")
     rows.append(
         rf"&\text{{first class: {len(a.first_class)}, second class: {len(a.second_class)}, "
         rf"physical degrees of freedom: {a.physical_degrees_of_freedom}}}"

@@ -55,6 +55,8 @@ from dirac.analysis.classes.multiplier_solution import (
     unsolved_multipliers,
 )
 from dirac.analysis.core.algebra import prints_shorter, tidy
+from dirac.analysis.core.divisors import Division
+from dirac.analysis.core.divisors import divisions as divisions_of
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import (
     LARGE_ROWS,
@@ -173,6 +175,8 @@ class ConstraintChain:
     #: the Hessian ``W = d^2 L / dq_dot^2`` and its rank at generic configurations (the Legendre transform's)
     hessian: sympy.Matrix | None = None
     hessian_rank: int = 0
+    #: divisions by functions that are no branch: the elimination of multipliers at a stage (:meth:`_cleared`)
+    divisions: list[Division] = field(default_factory=list)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -278,6 +282,8 @@ class ConstraintChain:
         self._hessian: EntryBlock | None = None
         self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock]] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
+        #: divisor -> whether it is a branch (None: it does not vanish on the surface), decided once per chain
+        self._judged: dict[tuple[sympy.Expr, int], bool | None] = {}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
         self.primary = primary
         points = self._stage_points(primary, []) if primary else []
@@ -319,15 +325,15 @@ class ConstraintChain:
             for i in range(len(constraints)):
                 if i in pivot_set or (b_zero[i] and a_row_zero[i]):
                     continue
-                needed = [] if a_row_zero[i] else self._needed(i, pivots_rows, pivot_cols, A_num, b_zero)
+                needed, used = ([], []) if a_row_zero[i] else self._needed(i, pivots_rows, pivot_cols, A_num, b_zero)
                 if needed:
                     deferred.append((i, needed))
                 else:
-                    direct.append(exprs_b[i])
+                    direct.append(self._cleared(exprs_b[i], i, used, constraints, pivots_rows, pivot_cols, A_num, b_zero))
             candidates, chosen = self._settle(self._nonzero(direct, points), constraints, limit) if direct else ([], [])
             if not chosen and deferred:
                 # nothing new without them: build the conditions that need multipliers eliminated
-                eliminated = [self._eliminate(i, needed, constraints, pivots_rows, pivot_cols, A_num) for i, needed in deferred]
+                eliminated = [self._eliminate(i, needed, constraints, pivots_rows, pivot_cols, A_num, b_zero) for i, needed in deferred]
                 candidates, chosen = self._settle(self._nonzero(eliminated, points), constraints, limit)
             elif deferred:
                 self.notes.append(
@@ -872,13 +878,94 @@ class ConstraintChain:
         values = sorted({abs(ri) for ri in r if ri != 0} | {sympy.S.One}, key=float)
         return f"one relation, proved exactly: a combination of {which} with coefficients of size {', '.join(map(str, values))} vanishes identically"
 
-    def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> list[int]:
-        """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by."""
+    def _needed(self, row: int, P: list[int], Q: list[int], A_num: np.ndarray, b_zero: np.ndarray) -> tuple[list[int], list[int]]:
+        """Pivot rows (positions in ``P``) with a non-zero ``b`` that row ``row`` must be reduced by, and all it uses.
+
+        ``A_row = c . A_P`` at the points; the second list has every ``k`` with ``c_k != 0``
+        (also those whose ``b`` vanishes: their coefficients divide, :meth:`_cleared`).
+        """
         if not P:
-            return []
+            return [], []
         coeff = np.array([np.linalg.lstsq(A[np.ix_(P, Q)].T, A[row, Q], rcond=None)[0] for A in A_num])
         scale = 1 + np.max(np.abs(coeff), axis=1, keepdims=True)
-        return [k for k, p in enumerate(P) if not b_zero[p] and not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
+        used = [k for k in range(len(P)) if not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
+        return [k for k in used if not b_zero[P[k]]], used
+
+    def _coefficients(self, row: int, used: list[int], constraints: list[sympy.Expr], P: list[int], Q: list[int], A_num: np.ndarray) -> list[sympy.Expr]:
+        """The exact ``c_k`` (``k`` in ``used``) of ``A_row = sum_k c_k A_{P_k}`` on the surface.
+
+        A square block of ``|used|`` columns of ``Q`` independent at the points is solved
+        (:func:`weak_solve`); ``[]`` when every entry involved is a number (no division by a
+        function) or no such block is found.
+        """
+        rows = [P[k] for k in used]
+        entries = [[self._rows(constraints[p])[1][q] for q in Q] for p in rows]
+        target = [self._rows(constraints[row])[1][q] for q in Q]
+        if all(e.is_number for line in entries for e in line) and all(e.is_number for e in target):
+            return []
+        cols = independent_rows([A[np.ix_(rows, Q)].T for A in A_num], list(range(len(Q))))
+        if len(cols) != len(rows):
+            return []
+        Qc = [Q[j] for j in cols]
+        sub = sympy.Matrix([[entries[r][j] for j in cols] for r in range(len(rows))])
+        rhs = sympy.Matrix([target[j] for j in cols])
+        if sub.shape == (1, 1):
+            return [sympy.cancel(rhs[0, 0] / sub[0, 0])] if sub[0, 0] != 0 else []
+        c = weak_solve(sub.T, rhs, [A[np.ix_(rows, Qc)].T for A in A_num], [A[row, Qc].reshape(-1, 1) for A in A_num], variables=self.phase_space.variables)
+        return list(c)
+
+    def _cleared(
+        self, psi: sympy.Expr, row: int, used: list[int], constraints: list[sympy.Expr], P: list[int], Q: list[int],
+        A_num: np.ndarray, b_zero: np.ndarray, coefficients: list[sympy.Expr] | None = None,
+    ) -> sympy.Expr:
+        """The condition ``psi`` of row ``row`` with the factors the elimination divided by kept where they are branches.
+
+        ``psi = b_row - c . b_P`` holds where the coefficients ``c`` of ``A_row = c . A_P`` are
+        defined; fraction-free, the condition is ``D psi = 0`` with ``D`` the common
+        denominator of ``c`` (Bareiss-style elimination keeps every factor it would divide
+        away). An irreducible factor ``f`` of ``D`` is a branch of the next stage when the
+        consistency conditions can be solved at points of the surface where ``f = 0``
+        (:meth:`_solvable_where`): then the new constraint is ``f psi``, a product that is
+        followed or refused branch by branch (:meth:`_branch`). A factor on whose zeros they
+        cannot be solved only marks where the elimination divides by zero; it is recorded
+        in :attr:`divisions`. ``L = x x' z + x z - 2 x' z^2/3 + 2 y y' z + y z'``: the row of
+        ``p_x`` is ``(4z/3 - x)/(1 - 2y)`` times that of ``p_y`` (whose ``b`` is 0), so its
+        condition ``z = 0`` held only where ``1 - 2y != 0``; ``z (1 - 2y) = 0`` keeps the
+        branch ``y = 1/2``.
+        """
+        if coefficients is None:
+            coefficients = self._coefficients(row, used, constraints, P, Q, A_num) if used else []
+        stage = len(self.stages) + 1
+        branches = []
+        for division in divisions_of(coefficients, stage, "the elimination of multipliers divides by zero", self.phase_space.variables):
+            f = division.divisor
+            key = (f, len(constraints))  # one verdict per divisor and surface
+            if key not in self._judged:
+                self._judged[key] = self._solvable_where(f, constraints)
+            genuine = self._judged[key]
+            if genuine:
+                branches.append(f)
+            elif genuine is not None:
+                self.divisions.append(division)
+        return sympy.Mul(*branches, psi) if branches else psi
+
+    def _solvable_where(self, f: sympy.Expr, constraints: list[sympy.Expr]) -> bool | None:
+        """Whether ``b + A u = 0`` can be solved at points of the surface where ``f = 0`` too (``None``: no such point).
+
+        At each point (up to ``SAMPLE_POINTS``), ``rank [A | b] == rank A``, relative to the
+        size of the entries.
+        """
+        try:
+            points = self.numerics.surface_points(constraints + self.reducible + [f], SAMPLE_POINTS, attempts=4 * SAMPLE_POINTS)
+        except AnalysisError:
+            return None
+        b_num, A_num = self._numeric_rows(constraints, points)
+        for b, A in zip(b_num, A_num):
+            augmented = np.hstack([A, b[:, None]])
+            scale = np.max(np.abs(augmented)) or 1.0
+            if numeric_rank(augmented / scale) != numeric_rank(A / scale):
+                return False
+        return True
 
     def _independent(self, candidates: list[sympy.Expr], old: list[sympy.Expr], points: list[np.ndarray]) -> list[int]:
         n = len(self.phase_space.variables)
@@ -890,13 +977,17 @@ class ConstraintChain:
         base = list(gradient_values(self.phase_space, self.numerics, old, points)) if old else None
         return independent_rows(list(cand), list(range(len(candidates))), base=base)
 
-    def _eliminate(self, row, needed, constraints, P, Q, A_num):
-        """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows ``needed``."""
+    def _eliminate(self, row, needed, constraints, P, Q, A_num, b_zero):
+        """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows ``needed``.
+
+        Factors of the denominators of ``c_a`` that are branches are kept (:meth:`_cleared`).
+        """
         b_row = self._rows(constraints[row])[0]
         A_sym = sympy.Matrix([[self._rows(constraints[p])[1][k] for k in Q] for p in P])
         rhs = sympy.Matrix([self._rows(constraints[row])[1][k] for k in Q])
         c = weak_solve(A_sym.T, rhs, [A[np.ix_(P, Q)].T for A in A_num], [A[row, Q].reshape(-1, 1) for A in A_num], variables=self.phase_space.variables)
-        return b_row - sum((c[k, 0] * self._rows(constraints[P[k]])[0] for k in needed), sympy.S.Zero)
+        psi = b_row - sum((c[k, 0] * self._rows(constraints[P[k]])[0] for k in needed), sympy.S.Zero)
+        return self._cleared(psi, row, [], constraints, P, Q, A_num, b_zero, coefficients=[e for e in c if e != 0])
 
     @staticmethod
     def _fixed_alone_at_point(M: np.ndarray) -> np.ndarray:

@@ -1,0 +1,197 @@
+"""Divisions the analysis makes, and the loci of the constraint surface where they divide by zero.
+
+The analysis divides by phase-space functions in several places: it solves the
+velocities from the Hessian ``W = d^2 L / dq_dot^2`` (the Legendre map divides by
+``det W``), it eliminates multipliers from the consistency conditions
+``b_a + A_ak u_k ≈ 0`` ((210), (213)-(215)) and solves them, ``u = U + v_a V_a``
+(Henneaux–Teitelboim (1.32)), and it inverts the bracket matrix ``C`` in the Dirac
+bracket (240). Each division is exact only where its divisor does not vanish. An
+irreducible factor ``f`` of a divisor is one of two kinds on the constraint surface
+``S`` (Henneaux–Teitelboim, Sect. 1.1.2, regularity; Sundermeyer, "Constrained
+Dynamics", Sect. 4.3 on points where ranks change):
+
+* ``f`` vanishes on a whole part of the set where the consistency conditions can hold:
+  the division lost a branch. The constraint chain works fraction-free there (the new
+  constraint keeps the factor, :meth:`~dirac.analysis.chain.constraint_chain.ConstraintChain`),
+  so the branch is followed or refused like any product constraint;
+* ``f = 0`` meets ``S`` in a lower-dimensional locus: a *singular locus*, where the
+  expressions of the analysis (the multipliers, the velocities) divide by zero. It is
+  reported (:class:`SingularLocus`), never passed over.
+
+:func:`singular_loci` tests each recorded divisor against ``S`` by sampling: a
+Gauss–Newton projection onto ``S`` and ``f = 0`` together
+(:meth:`~dirac.analysis.core.numeric.Numerics.surface_points`) finds a point of the
+locus, or shows none nearby in its attempts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import sympy
+
+from dirac.analysis.core.algebra import prints_shorter
+from dirac.errors import AnalysisError
+
+__all__ = ["Division", "SingularLocus", "denominator_factors", "singular_loci", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR"]
+
+#: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
+DIVISOR_TEXT_LIMIT = 4000
+
+#: projections onto a locus tried before it counts as not meeting the surface
+LOCUS_ATTEMPTS = 8
+
+#: what happens on the locus of a divisor of the Legendre map
+LEGENDRE_SINGULAR = (
+    "the Legendre map is singular (det W = 0, W = d^2 L/dq_dot^2): a coordinate singularity; the velocities and "
+    "H_c divide by zero there, so describe the motion near it in another chart (Cartesian coordinates with a "
+    "constraint, or a rotation matrix for a rigid body)"
+)
+#: what happens on the locus of a divisor of the multiplier solution
+MULTIPLIERS_SINGULAR = "the multiplier solution divides by zero"
+
+
+@dataclass(frozen=True)
+class Division:
+    """One division of the analysis: the (irreducible) ``divisor``, the ``stage`` it belongs to and ``what`` divides."""
+
+    divisor: sympy.Expr
+    stage: int
+    what: str
+
+
+@dataclass(frozen=True)
+class SingularLocus:
+    """A locus of the constraint surface where an expression of the analysis divides by zero.
+
+    Attributes
+    ----------
+    expression
+        The divisor (an irreducible factor): the locus is ``expression = 0`` on the surface.
+    where
+        The locus as an equation, with the variables the constraints fix put in
+        (``"x = 0"`` for the divisor ``3*x - 4*z`` on the surface ``z = 0``).
+    stage
+        The stage of the constraint chain the division belongs to (``1`` for the Legendre
+        map, whose primary constraints are stage 1).
+    what
+        What happens there (:data:`MULTIPLIERS_SINGULAR`, :data:`LEGENDRE_SINGULAR`).
+    """
+
+    expression: sympy.Expr
+    where: str
+    stage: int
+    what: str
+
+    def to_json(self) -> dict:
+        """``{"expression", "where", "stage", "what"}`` (the ``"singular_loci"`` entries of the analysis JSON)."""
+        return {"expression": str(self.expression), "where": self.where, "stage": self.stage, "what": self.what}
+
+    def __str__(self) -> str:
+        return f"{self.where} (divisor {self.expression}, stage {self.stage}): {self.what}"
+
+
+def _never_zero(factor: sympy.Expr) -> bool:
+    """A factor that cannot vanish for real arguments (``x**2 + 1``, ``exp(x)``)."""
+    return bool(factor.is_positive or factor.is_negative or (factor.func == sympy.exp))
+
+
+def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
+    """The distinct irreducible factors of the denominator of ``expr`` that depend on the ``variables``.
+
+    ``expr`` is brought over one denominator (``sympy.together``) and the denominator
+    factored (``sympy.factor_list``; ``sin(theta)`` counts as a factor of
+    ``sin(theta)**2``). Factors without real zeros and numbers are left out; an
+    expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``.
+    """
+    names = set(variables)
+    if not prints_shorter(expr, DIVISOR_TEXT_LIMIT) or not (expr.free_symbols & names):  # size first: a shared tree is huge
+        return []
+    if not any(isinstance(node, sympy.Pow) and node.exp.is_negative and node.base.free_symbols & names
+               for node in sympy.preorder_traversal(expr)):
+        return []  # no variable in a denominator (one walk, no gcd)
+    _, denominator = sympy.fraction(sympy.together(expr))
+    if not (denominator.free_symbols & names):
+        return []
+    found: list[sympy.Expr] = []
+    for part in sympy.Mul.make_args(denominator):
+        base = part.base if isinstance(part, sympy.Pow) and part.exp.is_positive else part
+        if not (base.free_symbols & names):
+            continue
+        try:
+            _, listed = sympy.factor_list(sympy.expand(base))
+            found += [f for f, _ in listed]
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            found.append(base)
+    out = []
+    for f in found:
+        if f.free_symbols & names and not _never_zero(f):
+            f = -f if f.could_extract_minus_sign() else f
+            if f not in out:
+                out.append(f)
+    return out
+
+
+def divisions(exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol]) -> list[Division]:
+    """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`)."""
+    found: dict[sympy.Expr, Division] = {}
+    for e in exprs:
+        for f in denominator_factors(sympy.sympify(e), variables):
+            found.setdefault(f, Division(f, stage, what))
+    return list(found.values())
+
+
+def fixed_values(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> dict[sympy.Symbol, sympy.Expr]:
+    """``v -> -b/a`` for each constraint ``a v + b`` (numbers ``a != 0``, ``b``): the variables the surface fixes."""
+    names = set(variables)
+    values: dict[sympy.Symbol, sympy.Expr] = {}
+    for c in constraints:
+        free = c.free_symbols & names
+        if len(free) != 1 or not (c.is_Symbol or ((c.is_Add or c.is_Mul) and len(c.args) <= 2)):
+            continue
+        (v,) = free
+        if c.is_polynomial(v):
+            poly = sympy.Poly(c, v)
+            if poly.degree() == 1 and all(k.is_number for k in poly.all_coeffs()):
+                a, b = poly.all_coeffs()
+                values.setdefault(v, -b / a)
+    return values
+
+
+def locus_equation(divisor: sympy.Expr, fixed: dict[sympy.Symbol, sympy.Expr]) -> str:
+    """``"x = 0"``: the divisor with the fixed variables put in, without a constant factor."""
+    reduced = divisor.xreplace(fixed) if fixed else divisor
+    if reduced.has(sympy.zoo, sympy.nan) or reduced.is_number:
+        reduced = divisor
+    _, reduced = sympy.factor_terms(sympy.expand(reduced)).as_coeff_Mul()
+    if reduced.could_extract_minus_sign():
+        reduced = -reduced
+    return f"{reduced} = 0"
+
+
+def singular_loci(
+    found: Sequence[Division],
+    surface: Sequence[sympy.Expr],
+    numerics,
+    variables: Sequence[sympy.Symbol],
+) -> tuple[SingularLocus, ...]:
+    """The divisions whose divisor vanishes somewhere on the surface ``surface = 0``, as :class:`SingularLocus`.
+
+    One Gauss–Newton projection onto ``surface`` and the divisor together (up to
+    ``LOCUS_ATTEMPTS`` random starts, points near an assumed-nonzero expression excluded)
+    decides whether the locus meets the surface. A divisor met twice is reported once, at
+    its earliest stage.
+    """
+    fixed = fixed_values(list(surface), variables)
+    seen: dict[sympy.Expr, Division] = {}
+    for d in sorted(found, key=lambda d: d.stage):
+        seen.setdefault(d.divisor, d)
+    out = []
+    for d in seen.values():
+        try:
+            numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
+        except AnalysisError:
+            continue  # the divisor does not vanish on the surface (or only where an assumption excludes)
+        out.append(SingularLocus(d.divisor, locus_equation(d.divisor, fixed), d.stage, d.what))
+    return tuple(out)
