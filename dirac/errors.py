@@ -18,6 +18,7 @@ __all__ = [
     "InconsistentSystemError",
     "AnalysisError",
     "IntegrationError",
+    "CoordinateSingularityError",
     "DiracWarning",
     "warn",
     "install_warning_printer",
@@ -84,6 +85,11 @@ class IntegrationError(DiracError):
     def __init__(self, message: str, partial: object | None = None) -> None:
         super().__init__(message)
         self.partial = partial
+
+
+class CoordinateSingularityError(IntegrationError):
+    """A run came near a coordinate singularity (``det W = 0``, ``W = d^2 L/dq_dot^2``, e.g. ``sin(theta) = 0``
+    for Euler angles): the message names the locus, the time and another chart to use."""
 
 
 class DiracWarning(UserWarning):

@@ -26,7 +26,8 @@ from typing import Required, TypedDict
 
 import numpy as np
 
-from dirac.errors import InputError, IntegrationError
+from dirac.errors import CoordinateSingularityError, InputError, IntegrationError
+from dirac.flows.chart_guard import GUARD_STEPS, STOP_RATIO, WATCH_RATIO, ChartGuard, chart_guard
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
 from dirac.flows.methods.torqued import refuse_undriven
@@ -369,6 +370,9 @@ class _Loop:
                 self._run_fixed(bar, intervals)
             else:
                 self._run_adaptive(bar)
+        except _Singular as stop:
+            self.cpu = time.process_time() - start
+            raise CoordinateSingularityError(str(stop), partial=self._solution(False, str(stop))) from None
         except _Stop as stop:
             self.cpu = time.process_time() - start
             raise IntegrationError(str(stop), partial=self._solution(False, str(stop))) from None
@@ -403,6 +407,9 @@ class _Loop:
         # at least MIN_CHUNK_STEPS steps per call, so that large batches are not advanced
         # (and checked) one step at a time
         chunk = max(MIN_CHUNK_STEPS, CHUNK_STEPS // max(1, batch))
+        guard = self._chart_guard()
+        if guard is not None:  # near a coordinate singularity the guard is read often (dirac.flows.chart_guard)
+            chunk = min(chunk, GUARD_STEPS)
         dt = float(self.dt)
         for index, (a, _b, n_steps) in enumerate(intervals):
             done = 0
@@ -412,9 +419,12 @@ class _Loop:
                     self.stepper.step(n, dt)
                 except StepFailure as failure:
                     self.t_now = a + (done + failure.steps_done) * dt
+                    self._near_singularity(guard)
                     raise
                 done += n
                 self.t_now = a + done * dt
+                if guard is not None:
+                    chunk = self._near_singularity(guard)
                 self._check()
                 bar.update(n)
             self.t_now = float(self.times[first + index])
@@ -423,6 +433,22 @@ class _Loop:
             if index == len(intervals) - 1:
                 self._check(final=True)
             self._keep(first + index, self.stepper.observe())
+
+    def _chart_guard(self) -> ChartGuard | None:
+        """The coordinate-singularity guard of a constrained system's stepper, if its ``det W`` can vanish."""
+        mechanics = getattr(self.problem, "mechanics", None)
+        if mechanics is None or not hasattr(self.stepper, "q") or not hasattr(mechanics, "symbolic"):
+            return None
+        return chart_guard(mechanics)
+
+    def _near_singularity(self, guard: ChartGuard | None) -> int:
+        """Stop near a coordinate singularity; the steps until the guard is read again (1 when close)."""
+        if guard is None:
+            return GUARD_STEPS
+        ratio = guard.ratio(self.stepper.q, getattr(self.stepper, "time", 0.0))
+        if ratio < STOP_RATIO:
+            raise _Singular(guard.message(str(self.problem.system), ratio, self._where()))
+        return 1 if ratio < WATCH_RATIO else GUARD_STEPS
 
     def _run_adaptive(self, bar) -> None:
         for index, t in enumerate(self.times):
@@ -451,3 +477,7 @@ class _Loop:
 
 class _Stop(Exception):
     """A guard rail fired (internal; becomes an IntegrationError)."""
+
+
+class _Singular(_Stop):
+    """The run came near a coordinate singularity (internal; becomes a CoordinateSingularityError)."""

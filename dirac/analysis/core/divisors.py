@@ -39,6 +39,9 @@ __all__ = ["Division", "SingularLocus", "denominator_factors", "singular_loci", 
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
 DIVISOR_TEXT_LIMIT = 4000
 
+#: a trigonometric factor with at most this many terms is simplified (``sin(x)**2 + cos(x)**2`` is no divisor)
+TRIG_TERMS = 8
+
 #: projections onto a locus tried before it counts as not meeting the surface
 LOCUS_ATTEMPTS = 8
 
@@ -126,6 +129,8 @@ def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> 
             found.append(base)
     out = []
     for f in found:
+        if f.has(sympy.sin, sympy.cos) and len(f.args) <= TRIG_TERMS:
+            f = sympy.trigsimp(f)  # sin(psi)**2 + cos(psi)**2 is 1
         if f.free_symbols & names and not _never_zero(f):
             f = -f if f.could_extract_minus_sign() else f
             if f not in out:
