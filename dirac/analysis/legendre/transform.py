@@ -84,6 +84,10 @@ class LegendreTransform:
     velocity_solution: dict = field(default_factory=dict)
 
 
+#: largest matrix of trigonometric entries inverted through its simplified determinant (:func:`_inverse`)
+TRIG_INVERSE_SIZE = 4
+
+
 class NotQuadraticError(AnalysisError):
     """``L`` is not quadratic in the velocities (then :mod:`dirac.analysis.legendre.velocity_elimination` is tried)."""
 
@@ -363,8 +367,17 @@ def _not_quadratic(
 
 
 def _inverse(M: sympy.Matrix) -> sympy.Matrix:
-    """Exact inverse, cheap for diagonal and block-diagonal matrices."""
+    """Exact inverse, cheap for diagonal and block-diagonal matrices.
+
+    A small matrix of trigonometric entries (Euler angles) is inverted as ``adj(M)/det M``
+    with ``det M`` simplified (``2 sin(theta)^2/5`` for an asymmetric top): the rational
+    normal form of its LU inverse (``cancel`` of 2000-operation entries with ``sin`` and
+    ``cos`` as generators) took minutes, and its denominator hid the factor ``sin(theta)``.
+    """
     if M.is_diagonal():
         return sympy.diag(*[1 / M[i, i] for i in range(M.shape[0])])
+    if M.shape[0] <= TRIG_INVERSE_SIZE and M.has(sympy.sin, sympy.cos):
+        det = sympy.factor(sympy.trigsimp(M.det(method="berkowitz")))
+        return M.adjugate(method="berkowitz").applyfunc(lambda e: sympy.factor(sympy.trigsimp(e)) / det)
     inv = M.inv(method="LU")
     return inv.applyfunc(sympy.cancel)
