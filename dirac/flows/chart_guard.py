@@ -9,32 +9,36 @@ Sect. 4.4 on the gimbal-lock of Euler angles). Near it the velocities grow like
 ``1/det W`` and a fixed step loses its accuracy without a word (a top in Euler angles
 passing ``theta = 4e-4`` keeps a 1 % energy error), or its Newton iteration fails.
 
-:class:`ChartGuard` measures how close a configuration is to the locus by the Hadamard
-ratio ``r(q) = |det W| / prod_i |W_i|`` (``|W_i|`` the Euclidean norm of row ``i``;
-``0 <= r <= 1`` by Hadamard's inequality, 1 for orthogonal rows, 0 on the locus; ``r ~
-sin(theta)^2`` for Euler angles), compiled as one scalar function. The loop of
-:func:`dirac.flows.integrate` evaluates it every ``GUARD_STEPS`` steps, every step once
-``r < WATCH_RATIO``, and stops with :class:`~dirac.errors.CoordinateSingularityError`
-when ``r < STOP_RATIO``, naming the locus, the time and another chart. Systems whose
-``det W`` is constant or never vanishes (Cartesian coordinates, a rotation matrix) have no
-guard and run exactly as before.
+:class:`ChartGuard` measures how close a configuration is to the locus by the first-order
+distance ``d(q) = min_f |f(q)| / |grad f(q)|`` over the factors ``f`` of ``det W`` that can
+vanish (``|tan(theta)|`` for ``sin(theta)``: radians for an angle, the coordinates' units in
+general), compiled as one scalar function. The loop of :func:`dirac.flows.integrate` reads it
+between calls of the step loop, stops with :class:`~dirac.errors.CoordinateSingularityError`
+when ``d < STOP_DISTANCE`` (naming the locus, the time and another chart), and chooses the
+steps until the next reading from the rate at which ``d`` fell (:meth:`ChartGuard.next_reading`):
+every step once ``d < WATCH_DISTANCE``, up to ``MAX_GUARD_STEPS`` far from the locus, so
+that the check costs little. Systems whose ``det W`` is constant or never vanishes
+(Cartesian coordinates, a rotation matrix) have no guard and run exactly as before.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-__all__ = ["ChartGuard", "chart_guard", "GUARD_STEPS", "WATCH_RATIO", "STOP_RATIO"]
+__all__ = ["ChartGuard", "chart_guard", "GUARD_STEPS", "WATCH_DISTANCE", "STOP_DISTANCE"]
 
-#: steps between two evaluations of the guard away from the locus
+#: steps between the first two readings of the guard
 GUARD_STEPS = 32
-#: below this ratio the guard is evaluated at every step
-WATCH_RATIO = 1e-2
-#: below this ratio the run stops (``sin(theta) ~ 1e-2`` for Euler angles)
-STOP_RATIO = 1e-4
+#: most steps between two readings
+MAX_GUARD_STEPS = 4096
+#: below this distance (radians for an angle) the guard is read at every step
+WATCH_DISTANCE = 0.1
+#: below this distance the run stops
+STOP_DISTANCE = 1e-2
 #: largest number of coordinates for which ``det W`` is formed symbolically
 MAX_GUARD_DIMENSION = 8
 
@@ -46,7 +50,7 @@ REMEDY = (
 
 
 class ChartGuard:
-    """The Hadamard ratio of the mass matrix ``W(q, t)`` of one system, compiled (see the module docstring).
+    """The distance of a configuration to the locus ``det W = 0`` of one system, compiled (module docstring).
 
     Attributes
     ----------
@@ -54,26 +58,52 @@ class ChartGuard:
         The locus as text (``"sin(theta) = 0"``): the factors of ``det W`` that can vanish.
     """
 
-    def __init__(self, ratio: Callable[..., list[float]], locus: str, time: bool, params: np.ndarray) -> None:
-        self._ratio = ratio
+    def __init__(self, values: Callable[..., list[float]], locus: str, time: bool, params: np.ndarray) -> None:
+        self._values = values  # (f_1, |grad f_1|, f_2, |grad f_2|, ...)
         self.locus = locus
         self._time = time
-        self._params = [float(c) for c in params]
+        self._params = tuple(float(c) for c in params)
+        self._last: float | None = None
 
-    def ratio(self, q: np.ndarray, t: float = 0.0) -> float:
-        """The smallest ``r(q)`` over a batch of configurations ``q`` (shape ``(n,)`` or ``(B, n)``)."""
-        rows = np.atleast_2d(np.asarray(q, dtype=float))
-        extra = [float(t)] if self._time else []
-        values = [self._ratio(*row.tolist(), *extra, *self._params)[0] for row in rows]
-        finite = [v for v in values if np.isfinite(v)]
-        return 0.0 if len(finite) < len(values) else float(min(finite))
+    def distance(self, q: np.ndarray, t: float = 0.0) -> float:
+        """The smallest ``d(q)`` over a batch of configurations ``q`` (shape ``(n,)`` or ``(B, n)``); 0 where undefined."""
+        rows = q.tolist() if isinstance(q, np.ndarray) else list(q)
+        if rows and not isinstance(rows[0], list):
+            rows = [rows]
+        extra = (float(t),) if self._time else ()
+        best = math.inf
+        for row in rows:  # plain floats: a call of the compiled scalar costs well under a microsecond
+            values = self._values(*row, *extra, *self._params)
+            for k in range(0, len(values), 2):
+                f, g = abs(values[k]), values[k + 1]
+                if not (f >= 0.0 and g >= 0.0):  # NaN: undefined there
+                    return 0.0
+                best = min(best, f / g if g > 0.0 else (0.0 if f == 0.0 else math.inf))
+        return best
 
-    def message(self, system: str, ratio: float, where: str) -> str:
+    def next_reading(self, distance: float, steps: int) -> int:
+        """Steps until the guard is read again, after ``steps`` steps that brought it to ``distance``.
+
+        Every step below ``WATCH_DISTANCE``; otherwise a quarter of the steps the last fall
+        rate needs to reach ``WATCH_DISTANCE`` (the distance falls about linearly near a
+        pass), at most twice the last interval and ``MAX_GUARD_STEPS``.
+        """
+        last, self._last = self._last, distance
+        if distance < WATCH_DISTANCE:
+            return 1
+        limit = min(MAX_GUARD_STEPS, 2 * max(steps, GUARD_STEPS // 2))
+        if last is None or last <= distance:
+            return limit
+        per_step = (last - distance) / max(steps, 1)
+        return max(1, min(limit, int((distance - WATCH_DISTANCE) / per_step / 4)))
+
+    def message(self, system: str, distance: float, where: str) -> str:
         """The error text: the locus, how near, where (time, step, method) and the remedy."""
         return (
             f"the run of {system!r} came near a coordinate singularity of its coordinates, {self.locus} "
-            f"(det W = 0, W = d^2 L/dq_dot^2; |det W| is {ratio:.1e} of the product of its row norms) {where}: "
-            f"the equations of motion divide by det W there, so a fixed step loses its accuracy; {REMEDY}"
+            f"(det W = 0, W = d^2 L/dq_dot^2; distance {distance:.2g} in the units of the coordinates, radians for "
+            f"an angle) {where}: the equations of motion divide by det W there, so a fixed step loses its accuracy; "
+            f"{REMEDY}"
         )
 
 
@@ -95,10 +125,12 @@ def _build(mechanics: Any) -> ChartGuard | None:
         return None  # det W constant or never zero: nothing to guard
     params = list(symbolic.get("parameters") or ())
     time = mechanics.time_symbol
-    norms = sympy.Mul(*[sympy.sqrt(sum(W[i, j] ** 2 for j in range(W.shape[1]))) for i in range(W.shape[0])])
+    exprs = []
+    for f in locus:  # f and the length of its gradient in q
+        exprs += [f, sympy.sqrt(sum(sympy.diff(f, x) ** 2 for x in q))]
     arguments = [*q, *([time] if time is not None else []), *params]
     try:
-        compiled = scalar_function(arguments, [sympy.Abs(det) / norms])
+        compiled = scalar_function(arguments, exprs)
     except Exception:  # an unusual function in W: no guard (the run is as before)  # noqa: BLE001
         return None
     return ChartGuard(compiled, " and ".join(f"{f} = 0" for f in locus), time is not None, mechanics.params)

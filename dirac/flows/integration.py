@@ -27,7 +27,7 @@ from typing import Required, TypedDict
 import numpy as np
 
 from dirac.errors import CoordinateSingularityError, InputError, IntegrationError
-from dirac.flows.chart_guard import GUARD_STEPS, STOP_RATIO, WATCH_RATIO, ChartGuard, chart_guard
+from dirac.flows.chart_guard import GUARD_STEPS, STOP_DISTANCE, ChartGuard, chart_guard
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
 from dirac.flows.methods.torqued import refuse_undriven
@@ -408,6 +408,7 @@ class _Loop:
         # (and checked) one step at a time
         chunk = max(MIN_CHUNK_STEPS, CHUNK_STEPS // max(1, batch))
         guard = self._chart_guard()
+        limit = chunk
         if guard is not None:  # near a coordinate singularity the guard is read often (dirac.flows.chart_guard)
             chunk = min(chunk, GUARD_STEPS)
         dt = float(self.dt)
@@ -424,7 +425,7 @@ class _Loop:
                 done += n
                 self.t_now = a + done * dt
                 if guard is not None:
-                    chunk = self._near_singularity(guard)
+                    chunk = min(limit, self._near_singularity(guard, n))
                 self._check()
                 bar.update(n)
             self.t_now = float(self.times[first + index])
@@ -441,14 +442,14 @@ class _Loop:
             return None
         return chart_guard(mechanics)
 
-    def _near_singularity(self, guard: ChartGuard | None) -> int:
-        """Stop near a coordinate singularity; the steps until the guard is read again (1 when close)."""
+    def _near_singularity(self, guard: ChartGuard | None, steps: int = GUARD_STEPS) -> int:
+        """Stop near a coordinate singularity; else the steps until the guard is read again (1 when close)."""
         if guard is None:
             return GUARD_STEPS
-        ratio = guard.ratio(self.stepper.q, getattr(self.stepper, "time", 0.0))
-        if ratio < STOP_RATIO:
-            raise _Singular(guard.message(str(self.problem.system), ratio, self._where()))
-        return 1 if ratio < WATCH_RATIO else GUARD_STEPS
+        distance = guard.distance(self.stepper.q, getattr(self.stepper, "time", 0.0))
+        if distance < STOP_DISTANCE:
+            raise _Singular(guard.message(str(self.problem.system), distance, self._where()))
+        return guard.next_reading(distance, steps)
 
     def _run_adaptive(self, bar) -> None:
         for index, t in enumerate(self.times):

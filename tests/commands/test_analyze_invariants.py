@@ -139,7 +139,10 @@ def chain_violations(analysis) -> list[str]:
             generic = numerics.surface_points(surface, CHAIN_POINTS, regular=len(surface))
         except DiracError:
             continue
-        rank = max(numeric_rank(A / (np.max(np.abs(A)) or 1.0)) for A in chain._numeric_rows(surface, generic)[1])
+        generic_rows = [A for A in chain._numeric_rows(surface, generic)[1] if np.all(np.isfinite(A))]
+        if not generic_rows:
+            continue
+        rank = max(numeric_rank(A / (np.max(np.abs(A)) or 1.0)) for A in generic_rows)
         points = list(generic)
         for f in dict.fromkeys(divisors):
             try:
@@ -148,6 +151,8 @@ def chain_violations(analysis) -> list[str]:
                 continue
         b_num, A_num = chain._numeric_rows(surface, points)
         for z, b, A in zip(points, b_num, A_num):
+            if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+                continue  # on the zero set of a divisor of H_c or of the constraints: no regular point
             if numeric_rank(A / (np.max(np.abs(A)) or 1.0)) != rank or not _solvable(b, A):
                 continue
             if not following:

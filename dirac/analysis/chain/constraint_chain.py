@@ -282,6 +282,7 @@ class ConstraintChain:
         self._hessian: EntryBlock | None = None
         self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock]] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
+        self._legendre_divisors: list[sympy.Expr] | None = None  # the factors of the denominator of H_c (found on first use)
         #: divisor -> whether it is a branch (None: it does not vanish on the surface), decided once per chain
         self._judged: dict[tuple[sympy.Expr, int], bool | None] = {}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
@@ -397,7 +398,37 @@ class ConstraintChain:
             constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=self._minors(constraints, whole)
         )
         self._check_hessian_rank(points)
+        self._check_legendre_divisors(points)
         return points
+
+    def _check_legendre_divisors(self, points: list[np.ndarray]) -> None:
+        """Refuse a surface with sample points where ``H_c`` divides by zero (a divisor of the Legendre map).
+
+        The Legendre transform solves the velocities where a block of ``W`` is invertible;
+        its determinant, a denominator of ``H_c``, may vanish on a whole part of the
+        surface without ``W`` dropping rank (``L = -q1' q2' - q2'^2 - q1 q2' q3' - 2 q3' +
+        2 q1^2 - q1`` with ``q2 = -1``: ``H_c`` divides by ``4 p1^2 - p1 p2 - 8 q1^2 + q1``,
+        which vanishes on the branch ``q1 = 0`` of ``p1 = 0, 4 q1^2 - q1 = 0``). There ``H_c``
+        and every consistency condition are undefined; points on it are refused, naming the
+        divisor and the assumption that sets that part aside.
+        """
+        if not points:
+            return
+        if self._legendre_divisors is None:
+            self._legendre_divisors = [d.divisor for d in divisions_of([self.canonical_hamiltonian], 1, "", self.phase_space.variables)]
+        if not self._legendre_divisors:
+            return
+        values = np.abs(self.numerics.evaluate(self._legendre_divisors, points))
+        scales = self.numerics.term_scale(self._legendre_divisors, points)
+        for k, f in enumerate(self._legendre_divisors):
+            hit = ~(values[:, k] > ROUND_OFF * scales[:, k])  # also NaN
+            if np.any(hit):
+                raise AnalysisError(
+                    f"the constraint surface found at stage {len(self.stages)} has a part where the Legendre map divides "
+                    f"by zero ({f} = 0 at {int(np.sum(hit))} of {len(points)} sample points): the canonical Hamiltonian and "
+                    f"the consistency conditions are singular there, so that part cannot be analysed with the rest; set it "
+                    f"aside with --assume \"{f} != 0\" (in Python assume=[\"{f} != 0\"]) or analyse it as a system of its own"
+                )
 
     def _near_locus(self, points: list[np.ndarray]) -> bool:
         """Whether a point of the last stage lies next to a locus where ``C_ab = {Phi_a, Phi_b}`` drops rank."""
