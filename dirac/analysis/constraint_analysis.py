@@ -23,7 +23,14 @@ from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.blas_threads import one_blas_thread
-from dirac.analysis.core.divisors import LEGENDRE_SINGULAR, MULTIPLIERS_SINGULAR, Division, SingularLocus, divisions, singular_loci
+from dirac.analysis.core.divisors import (
+    LEGENDRE_SINGULAR,
+    MULTIPLIERS_SINGULAR,
+    Division,
+    SingularLocus,
+    divisions,
+    singular_loci,
+)
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM

