@@ -423,6 +423,44 @@ def special_parameter_values(
     return [replace(values[key], where="; ".join(w)) for key, w in found.items()], notes
 
 
+class _Scanner:
+    """Ranks of one matrix at numeric parameter values, its expressions compiled once.
+
+    The parameters stay arguments of the compiled functions
+    (:class:`~dirac.analysis.core.numeric.Numerics` takes them as a vector), so that each
+    value scanned costs a few evaluations and a Gauss-Newton projection onto the surface,
+    not a substitution and a compilation.
+    """
+
+    def __init__(self, space: PhaseSpace, generic: dict[sympy.Symbol, float], use: RankUse,
+                 constraints: list[sympy.Expr], seed: int, time: sympy.Symbol | None) -> None:
+        self.space, self.generic, self.use, self.constraints = space, generic, use, constraints
+        self.seed, self.time = seed, time
+        self.entries = list(use.matrix)
+        self.numerics = Numerics(space, generic, seed=seed, time=time)
+
+    def rank(self, p: sympy.Symbol, value: float) -> int | None:
+        """Rank with ``p = value`` (others generic); ``UNDEFINED`` where the entries are not finite; None: no surface point."""
+        numerics = self.numerics
+        numerics.parameter_vector = np.array([value if q == p else float(self.generic[q]) for q in numerics.parameters])
+        if self.use.on_surface:
+            try:
+                points = numerics.surface_points(self.constraints, 4, attempts=20)
+            except AnalysisError:
+                return None
+        else:
+            points = [numerics.random_point() for _ in range(4)]
+        values = numerics.evaluate(self.entries, points)
+        scales = numerics.term_scale(self.entries, points)
+        ranks = []
+        for v, sc in zip(values, scales):
+            if not (np.all(np.isfinite(v)) and np.all(np.isfinite(sc))):
+                return UNDEFINED  # a denominator vanishes there
+            v = np.where(np.abs(v) <= ZERO_TOLERANCE * sc, 0.0, v).reshape(self.use.matrix.shape)
+            ranks.append(numeric_rank(v, scale=float(np.max(sc))))
+        return max(set(ranks), key=ranks.count)
+
+
 def _scan(
     space: PhaseSpace,
     generic: dict[sympy.Symbol, float],
@@ -443,12 +481,13 @@ def _scan(
     params = sorted(use.block.free_symbols & set(space.parameters), key=lambda s: s.name)
     scanned: list[str] = []
     left_out: list[str] = []
+    scanner = _Scanner(space, generic, use, constraints_at({}) if use.on_surface else [], seed, time)
     for p in params:
         done = True
         for value in SCAN_VALUES:
             try:
                 with scan.interrupting():
-                    at = _rank_at(space, generic, use, {p: value}, constraints_at, seed, time)
+                    at = scanner.rank(p, float(value))
             except OverBudget:
                 done = False
                 break
