@@ -14,6 +14,13 @@ factors of the gcd of its coefficients (its content) depend on the parameters al
 candidates, each checked by evaluating the rank again with the
 parameter at that value (on points of the surface of the constraints at that value).
 Factors that vanish only on the constraint surface are not searched.
+
+Entries with radicals (``sqrt(c**2 m**2 + p**2)`` of a relativistic particle) are not
+handed to sympy's domain of arbitrary expressions, where a 4 x 4 determinant takes
+minutes: each radical becomes a new symbol with its defining relation, removed again by a
+resultant (:func:`_radical_free_numerator`). The whole symbolic search has a CPU-time
+budget (:data:`SEARCH_SECONDS`); a block it cuts is scanned numerically at the simple
+values :data:`SCAN_VALUES` instead, and a note says what was not searched.
 """
 
 from __future__ import annotations
