@@ -15,7 +15,13 @@ orthogonality constraint (78), through its angular momentum (228), and the
 relativistic particle ``L = -m sqrt(t_dot^2 - x_dot^2 - y_dot^2)`` on the ellipse
 ``x^2 + y^2/4 = 1`` (the engine refuses it at stage 2 with a clear error: the
 consistency of the mass shell gives ``lambda_1 (4 x p_x + y p_y) = 0``, two branches that
-meet; the figure is the time to that answer).
+meet; the figure is the time to that answer), and the regular relativistic particle
+``L = -m c^2 sqrt(1 - (x_dot^2 + y_dot^2)/c^2)`` on the ellipse ``x^2/a^2 + y^2/b^2 = 1``
+with all four parameters symbolic (4 second class, 1 degree of freedom; its
+special-parameter-value search has square roots in every entry of ``C``).
+
+:data:`ANALYZE_COMMAND_TARGETS` are the end-to-end times of ``dirac analyze NAME`` as a
+user meets them (:func:`dirac.bench.targets.analyze_command_targets`).
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ import subprocess
 import sys
 from dataclasses import dataclass
 
-__all__ = ["ANALYSIS_CASES", "AnalysisCase", "analysis_time", "analysis_runs"]
+__all__ = ["ANALYSIS_CASES", "ANALYZE_COMMAND_TARGETS", "BOUNDED_CASES", "AnalysisCase", "analysis_time", "analysis_runs"]
 
 
 @dataclass(frozen=True)
@@ -51,6 +57,20 @@ ANALYSIS_CASES = (
         5.0,
     ),
 )
+
+#: cases whose every symbolic step is bounded (the special-value search under its budget)
+BOUNDED_CASES = (
+    AnalysisCase(
+        "relativistic particle on a conic, all parameters symbolic (4 second class, 1 degree of freedom)",
+        "dirac.Lagrangian.from_strings('relativistic_ellipse', ['x', 'y'], "
+        "'-m*c**2*sqrt(1 - (x_dot**2 + y_dot**2)/c**2)', constraints=['x**2/a**2 + y**2/b**2 - 1'], "
+        "parameters={'m': 1.0, 'c': 1.0, 'a': 2.0, 'b': 1.0})",
+        5.0,
+    ),
+)
+
+#: ``dirac analyze NAME`` end to end (fresh process: interpreter, imports, analysis, report): target CPU seconds
+ANALYZE_COMMAND_TARGETS = {"rigid_body_momentum": 3.0, "rigid_body_particles": 2.5, "rigid_body_matrix": 2.0}
 
 _CHILD = """
 import json, time, warnings
@@ -84,8 +104,9 @@ def analysis_runs(repeats: int) -> list[tuple[AnalysisCase, list[dict]]]:
     The cases are run in turn (case 1, 2, 3, 4, then again), so that a change in the
     load of the machine touches them alike.
     """
-    runs: dict[str, list[dict]] = {case.name: [] for case in ANALYSIS_CASES}
+    cases = (*ANALYSIS_CASES, *BOUNDED_CASES)
+    runs: dict[str, list[dict]] = {case.name: [] for case in cases}
     for _ in range(repeats):
-        for case in ANALYSIS_CASES:
+        for case in cases:
             runs[case.name].append(analysis_time(case))
-    return [(case, runs[case.name]) for case in ANALYSIS_CASES]
+    return [(case, runs[case.name]) for case in cases]

@@ -14,6 +14,13 @@ factors of the gcd of its coefficients (its content) depend on the parameters al
 candidates, each checked by evaluating the rank again with the
 parameter at that value (on points of the surface of the constraints at that value).
 Factors that vanish only on the constraint surface are not searched.
+
+Entries with radicals (``sqrt(c**2 m**2 + p**2)`` of a relativistic particle) are not
+handed to sympy's domain of arbitrary expressions, where a 4 x 4 determinant takes
+minutes: each radical becomes a new symbol with its defining relation, removed again by a
+resultant (:func:`_radical_free_numerator`). The whole symbolic search has a CPU-time
+budget (:data:`SEARCH_SECONDS`); a block it cuts is scanned numerically at the simple
+values :data:`SCAN_VALUES` instead, and a note says what was not searched.
 """
 
 from __future__ import annotations
@@ -25,14 +32,24 @@ import numpy as np
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
+from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.errors import AnalysisError
 
-__all__ = ["SpecialValue", "special_parameter_values", "MAX_BLOCK"]
+__all__ = ["SpecialValue", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
 
 #: blocks larger than this are not searched (their determinants are too large)
 MAX_BLOCK = 4
+
+#: CPU seconds the symbolic search of all the blocks of one analysis may take (:func:`special_parameter_values`)
+SEARCH_SECONDS = 2.0
+
+#: CPU seconds of the numeric scan of the blocks whose symbolic search ran over SEARCH_SECONDS
+SCAN_SECONDS = 1.0
+
+#: the values each parameter of a block is set to, one at a time, by the numeric scan
+SCAN_VALUES = tuple(sympy.Rational(v) for v in ("0", "1", "-1", "2", "-2", "1/2", "-1/2"))
 
 
 
@@ -139,13 +156,114 @@ def _numerator_of_determinant(block: sympy.Matrix) -> sympy.Expr:
     """Numerator of ``det block`` for a block whose entries are rational functions of the parameters.
 
     Computed over the field of rational functions (sympy's ``DomainMatrix``), much faster
-    than a sympy determinant followed by ``together``.
+    than a sympy determinant followed by ``together``. Entries with radicals (the square
+    root ``sqrt(c**2 m**2 + p**2)`` of a relativistic particle) go to
+    :func:`_radical_free_numerator` instead: over sympy's domain of arbitrary expressions
+    (``EX``) a 4 x 4 determinant takes minutes.
     """
+    if _radicals(block):
+        return _radical_free_numerator(block)
     try:
         matrix = DomainMatrix.from_Matrix(block).to_field()
         return sympy.fraction(matrix.domain.to_sympy(matrix.det()))[0]  # reduced in the field already
     except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, ValueError, TypeError):
         return sympy.fraction(sympy.together(block.det(method="berkowitz")))[0]
+
+
+def _is_radical(power: sympy.Basic) -> bool:
+    """Whether ``power`` is ``base**(p/q)`` with a fraction ``p/q`` (a square root, a cube root)."""
+    return isinstance(power, sympy.Pow) and power.exp.is_Rational and not power.exp.is_Integer
+
+
+def _radicals(matrix: sympy.Matrix) -> set[sympy.Pow]:
+    return {p for entry in matrix for p in entry.atoms(sympy.Pow) if _is_radical(p)}
+
+
+def _radicals_to_symbols(matrix: sympy.Matrix) -> tuple[sympy.Matrix, list[tuple[sympy.Symbol, int, sympy.Expr]]]:
+    """``matrix`` with each radical ``X**(p/q)`` written ``r**(p Q/q)`` for a new symbol ``r`` with ``r**Q = X``.
+
+    The innermost radicals are replaced first, so that nested ones (``sqrt(1 + sqrt(a))``)
+    get relations in the symbols of the inner ones. Returns the new matrix and the
+    relations ``(r, Q, X)`` in the order they were made (inner first).
+    """
+    relations: list[tuple[sympy.Symbol, int, sympy.Expr]] = []
+    while True:
+        found = _radicals(matrix)
+        inner = [p for p in found if not any(_is_radical(q) for q in p.base.atoms(sympy.Pow))]
+        if not inner:
+            return matrix, relations
+        by_base: dict[sympy.Expr, list[sympy.Pow]] = {}
+        for p in sorted(inner, key=sympy.default_sort_key):
+            by_base.setdefault(p.base, []).append(p)
+        replace_by: dict[sympy.Expr, sympy.Expr] = {}
+        for base, powers in by_base.items():
+            order = int(sympy.ilcm(1, *[int(p.exp.q) for p in powers]))
+            r = sympy.Dummy(f"r{len(relations)}")
+            for p in powers:
+                replace_by[p] = r ** int(p.exp * order)
+            relations.append((r, order, base))
+        matrix = matrix.xreplace(replace_by)
+        relations = [(r, order, base.xreplace(replace_by)) for r, order, base in relations]
+
+
+def _pfaffian(matrix: sympy.Matrix) -> sympy.Expr:
+    """Pfaffian of an antisymmetric matrix, ``Pf(A)^2 = det A``, by expansion along the first row."""
+    n = matrix.shape[0]
+    if n == 0:
+        return sympy.S.One
+    if n % 2:
+        return sympy.S.Zero
+    total = sympy.S.Zero
+    for j in range(1, n):
+        if matrix[0, j] != 0:
+            rest = [k for k in range(1, n) if k != j]
+            total += (-1) ** (j + 1) * matrix[0, j] * _pfaffian(matrix[rest, rest])
+    return total
+
+
+def _is_antisymmetric(matrix: sympy.Matrix) -> bool:
+    n = matrix.shape[0]
+    return all(matrix[i, j] == -matrix[j, i] for i in range(n) for j in range(i, n))
+
+
+def _radical_free_numerator(block: sympy.Matrix) -> sympy.Expr:
+    """A polynomial in the parameters that vanishes wherever ``det block`` does, for a block with radicals.
+
+    Each radical ``X**(1/Q)`` is written as a new symbol ``r`` with ``r**Q = X``; the
+    determinant (the Pfaffian ``Pf``, ``Pf^2 = det``, of an antisymmetric block such as
+    the bracket matrix ``C``: a handful of products instead of a determinant) is then a
+    rational function of the parameters and ``r``, computed over an ordinary field of
+    rational functions. Its numerator ``N(r)`` is freed of ``r`` by the resultant
+    ``Res_r(N(r), den(X) r**Q - num(X))``, the product of ``N`` over every branch ``r``
+    of the radical: it vanishes wherever ``N`` vanishes on the principal branch, and
+    perhaps on the others too (Cox, Little, O'Shea, *Ideals, Varieties, and Algorithms*,
+    Sect. 3.6). The zeros found are candidates only: each is checked numerically
+    (:func:`_rank_at`), so a zero of another branch is dropped there.
+
+    Raises
+    ------
+    NotPolynomial
+        When other functions of the parameters (``sin(a)``) remain.
+    """
+    matrix, relations = _radicals_to_symbols(block)
+    try:
+        if _is_antisymmetric(matrix):
+            numerator = sympy.fraction(sympy.cancel(sympy.together(_pfaffian(matrix))))[0]
+        else:
+            field = DomainMatrix.from_Matrix(matrix).to_field()
+            if field.domain.is_EX or field.domain.is_EXRAW:
+                raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block is not a rational function of the parameters and its radicals")
+            numerator = sympy.fraction(field.domain.to_sympy(field.det()))[0]
+        for r, order, base in reversed(relations):  # outer radicals first: their relations may hold inner ones
+            num, den = sympy.fraction(sympy.together(base))
+            numerator = sympy.resultant(sympy.expand(numerator), sympy.expand(den * r**order - num), r)
+            numerator = sympy.fraction(sympy.together(numerator))[0]
+        numerator = sympy.expand(numerator)
+    except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, ValueError, TypeError) as exc:
+        raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block with radicals: {exc}") from None
+    if numerator.atoms(sympy.Function) or _radicals(sympy.Matrix([numerator])):
+        raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block is not a polynomial in the parameters")
+    return numerator
 
 
 class NotPolynomial(ValueError):
@@ -209,8 +327,18 @@ def special_parameter_values(
     constraints_at: Callable[[dict], list[sympy.Expr]],
     seed: int = 20240607,
     time: sympy.Symbol | None = None,
+    budget: float | None = None,
+    scan_budget: float | None = None,
 ) -> tuple[list[SpecialValue], list[str]]:
     """The special parameter values of the rank decisions ``uses``, checked numerically.
+
+    The symbolic search (determinants, their content, its factors, and the numerical
+    check of each candidate) runs under a CPU-time budget of ``budget`` seconds for all
+    the blocks together (:mod:`dirac.analysis.core.budget`). A block whose search the
+    budget cuts takes the numeric road instead: its rank is evaluated with each of its
+    parameters in turn at the values :data:`SCAN_VALUES` (the others generic), within
+    ``scan_budget`` more seconds, and a note says what was not searched (other values,
+    curves such as ``b = a**2``); candidates found but not checked are named in a note too.
 
     Parameters
     ----------
@@ -225,11 +353,15 @@ def special_parameter_values(
         the parameter substituted): where the ranks on the surface are evaluated again.
     time
         The time ``t`` of a time-dependent system (sampled like a variable), else ``None``.
+    budget, scan_budget
+        CPU seconds of the symbolic search and of the numeric scan; default
+        :data:`SEARCH_SECONDS` and :data:`SCAN_SECONDS`.
 
     Returns
     -------
     (list of SpecialValue, list of str)
-        The special values, and notes on blocks that were too large to search.
+        The special values, and notes on what was not searched (blocks too large, over
+        the budget, not polynomial).
     """
     parameters = list(space.parameters)
     if not parameters:
@@ -238,6 +370,21 @@ def special_parameter_values(
     found: dict[str, list[str]] = {}
     values: dict[str, SpecialValue] = {}
     notes: list[str] = []
+    clock = CpuBudget(SEARCH_SECONDS if budget is None else budget)
+
+    def record(use: RankUse, p: sympy.Symbol, value: sympy.Expr, at: int | None, curve_factor: sympy.Expr | None) -> None:
+        change = f"rank of the {use.label} drops from {use.rank} to {at}" if at is not None else (
+            f"the {use.label} block is singular (no point of the constraint surface found there)"
+        )
+        # a curve is one set (its first branch that drops stands for it); values are one set each
+        key = SpecialValue(p.name, value, "", curve_factor).equation
+        if key not in values:
+            values[key] = SpecialValue(p.name, value, "", curve_factor)
+        found.setdefault(key, [])
+        if change not in found[key]:
+            found[key].append(change)
+
+    cut: list[RankUse] = []
     for use in uses:
         if use.rank == 0 or not (use.block.free_symbols & set(parameters)):
             continue
@@ -248,29 +395,122 @@ def special_parameter_values(
             )
             continue
         try:
-            candidates = _candidates(use.block, space.variables, parameters, rng)
+            with clock.interrupting():
+                candidates = _candidates(use.block, space.variables, parameters, rng)
         except NotPolynomial as exc:
             notes.append(f"special parameter values: not searched in the {use.label}: {exc}")
             continue
+        except OverBudget:
+            cut.append(use)
+            continue
+        unchecked: list[str] = []
         for factor, solutions in candidates:
             curve = len(factor.free_symbols) > 1
             for p, value in solutions:
-                at = _rank_at(space, generic, use, {p: value}, constraints_at, seed, time)
+                try:
+                    with clock.interrupting():
+                        at = _rank_at(space, generic, use, {p: value}, constraints_at, seed, time)
+                except OverBudget:
+                    unchecked.append(f"{factor} = 0" if curve else _equation(p, value))
+                    continue
                 if at == UNDEFINED or (at is not None and at >= use.rank):
                     continue
-                change = f"rank of the {use.label} drops from {use.rank} to {at}" if at is not None else (
-                    f"the {use.label} block is singular (no point of the constraint surface found there)"
-                )
-                # a curve is one set (its first branch that drops stands for it); values are one set each
-                key = SpecialValue(p.name, value, "", factor if curve else None).equation
-                if key not in values:
-                    values[key] = SpecialValue(p.name, value, "", factor if curve else None)
-                found.setdefault(key, [])
-                if change not in found[key]:
-                    found[key].append(change)
+                record(use, p, value, at, factor if curve else None)
                 if curve:
                     break
+        if unchecked:
+            notes.append(
+                f"special parameter values: candidates of the {use.label} not checked (the search ran over its "
+                f"budget of {clock.seconds:g} s CPU): {', '.join(dict.fromkeys(unchecked))}; the rank may drop there"
+            )
+    if cut:
+        scan = CpuBudget(SCAN_SECONDS if scan_budget is None else scan_budget)
+        for use in cut:
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, clock.seconds, scan, record))
     return [replace(values[key], where="; ".join(w)) for key, w in found.items()], notes
+
+
+class _Scanner:
+    """Ranks of one matrix at numeric parameter values, its expressions compiled once.
+
+    The parameters stay arguments of the compiled functions
+    (:class:`~dirac.analysis.core.numeric.Numerics` takes them as a vector), so that each
+    value scanned costs a few evaluations and a Gauss-Newton projection onto the surface,
+    not a substitution and a compilation.
+    """
+
+    def __init__(self, space: PhaseSpace, generic: dict[sympy.Symbol, float], use: RankUse,
+                 constraints: list[sympy.Expr], seed: int, time: sympy.Symbol | None) -> None:
+        self.space, self.generic, self.use, self.constraints = space, generic, use, constraints
+        self.seed, self.time = seed, time
+        self.entries = list(use.matrix)
+        self.numerics = Numerics(space, generic, seed=seed, time=time)
+
+    def rank(self, p: sympy.Symbol, value: float) -> int | None:
+        """Rank with ``p = value`` (others generic); ``UNDEFINED`` where the entries are not finite; None: no surface point."""
+        numerics = self.numerics
+        numerics.parameter_vector = np.array([value if q == p else float(self.generic[q]) for q in numerics.parameters])
+        if self.use.on_surface:
+            try:
+                points = numerics.surface_points(self.constraints, 4, attempts=20)
+            except AnalysisError:
+                return None
+        else:
+            points = [numerics.random_point() for _ in range(4)]
+        values = numerics.evaluate(self.entries, points)
+        scales = numerics.term_scale(self.entries, points)
+        ranks = []
+        for v, sc in zip(values, scales):
+            if not (np.all(np.isfinite(v)) and np.all(np.isfinite(sc))):
+                return UNDEFINED  # a denominator vanishes there
+            v = np.where(np.abs(v) <= ZERO_TOLERANCE * sc, 0.0, v).reshape(self.use.matrix.shape)
+            ranks.append(numeric_rank(v, scale=float(np.max(sc))))
+        return max(set(ranks), key=ranks.count)
+
+
+def _scan(
+    space: PhaseSpace,
+    generic: dict[sympy.Symbol, float],
+    use: RankUse,
+    constraints_at: Callable[[dict], list[sympy.Expr]],
+    seed: int,
+    time: sympy.Symbol | None,
+    seconds: float,
+    scan: CpuBudget,
+    record: Callable[[RankUse, sympy.Symbol, sympy.Expr, int | None, sympy.Expr | None], None],
+) -> str:
+    """The numeric road of a block whose symbolic search ran over its budget; returns the note that says so.
+
+    The rank of ``use.matrix`` is evaluated with one parameter of the block at a time set
+    to each of :data:`SCAN_VALUES` (the other parameters at their generic values); a drop
+    is recorded as a special value. Only these values are searched.
+    """
+    params = sorted(use.block.free_symbols & set(space.parameters), key=lambda s: s.name)
+    scanned: list[str] = []
+    left_out: list[str] = []
+    scanner = _Scanner(space, generic, use, constraints_at({}) if use.on_surface else [], seed, time)
+    for p in params:
+        done = True
+        for value in SCAN_VALUES:
+            try:
+                with scan.interrupting():
+                    at = scanner.rank(p, float(value))
+            except OverBudget:
+                done = False
+                break
+            if at != UNDEFINED and (at is None or at < use.rank):
+                record(use, p, value, at, None)
+        (scanned if done else left_out).append(p.name)
+    shown = ", ".join(str(v) for v in SCAN_VALUES)
+    note = (
+        f"special parameter values: the symbolic search in the {use.label} ran over its budget of {seconds:g} s CPU "
+        f"and was not finished; scanned numerically instead: "
+        + (f"{', '.join(scanned)} at {shown} (one at a time, the others generic)" if scanned else "nothing")
+        + "; other values and curves of several parameters (such as b = a**2) were not searched"
+    )
+    if left_out:
+        note += f"; not scanned (the scan's budget of {scan.seconds:g} s CPU ran out): {', '.join(left_out)}"
+    return note
 
 
 def _exact_zeros(matrix: sympy.Matrix) -> sympy.Matrix:
