@@ -11,17 +11,18 @@ variables, ``4N`` second-class constraints) analysed once, this measures the CPU
   ``delta_ij - (G^T (G G^T)^{-1} G)_ij`` with numpy, one dense ``N x N`` solve
   (tests/analysis/brackets/test_dirac_bracket_at_point.py derives it).
 
-The minimum over repeats of the CPU time per call is reported (the machine is shared:
+Each size runs in a fresh process. The minimum over repeats of the CPU time per call is reported (the machine is shared:
 the minimum is the figure least disturbed by other jobs). Target: a bracket, and the
 motion, at a new point of the 128-link chain within 5 ms.
 """
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
-
-import numpy as np
+import json
+import os
+import subprocess
+import sys
+import tempfile
 
 from dirac.bench.targets import Target
 
@@ -31,8 +32,18 @@ __all__ = ["measure_brackets_at_point", "format_brackets_at_point"]
 TARGET_MS = 5.0
 
 
-def _per_call(function: Callable[[int], object], calls: int, repeats: int) -> float:
-    """Minimum over ``repeats`` of the CPU seconds per call of ``function(k)``, ``k = 0..calls-1``."""
+#: what a fresh process runs for one size: the public API as a user calls it (the analysis layer is
+#: above the bench's, so it is imported there, not here); prints one JSON line
+_CHILD = r"""
+import json, sys, time
+import numpy as np
+import dirac
+from dirac_systems.scale_models import chain
+
+n, repeats = int(sys.argv[1]), int(sys.argv[2])
+
+
+def per_call(function, calls):
     best = np.inf
     for _ in range(repeats):
         start = time.process_time()
@@ -42,51 +53,51 @@ def _per_call(function: Callable[[int], object], calls: int, repeats: int) -> fl
     return float(best)
 
 
-def _closed_form(point: dict[str, float], n: int, i: int, j: int) -> float:
-    """``{x_i, p_x_j}_D`` by hand: ``delta - G^T (G G^T)^{-1} G`` (numpy, dense)."""
+def closed_form(point, i, j):
+    # {x_i, p_x_j}_D = delta_ij - (G^T (G G^T)^-1 G)_ij over (x1, y1, x2, ...), numpy, dense
     r = np.array([[point[f"x{k}"], point[f"y{k}"]] for k in range(1, n + 1)])
     G = np.zeros((n, 2 * n))
     for k in range(n):
         d = r[k] - (r[k - 1] if k else 0.0)
-        G[k, 2 * k : 2 * k + 2] = d
+        G[k, 2 * k:2 * k + 2] = d
         if k:
-            G[k, 2 * k - 2 : 2 * k] = -d
-    column = G[:, 2 * (j - 1)]
-    return float((i == j) - G[:, 2 * (i - 1)] @ np.linalg.solve(G @ G.T, column))
+            G[k, 2 * k - 2:2 * k] = -d
+    return float((i == j) - G[:, 2 * (i - 1)] @ np.linalg.solve(G @ G.T, G[:, 2 * (j - 1)]))
+
+
+start = time.process_time()
+analysis = dirac.analyze(chain(n))
+analyse_s = time.process_time() - start
+point = analysis.surface_point(seed=1)
+start = time.process_time()
+analysis.dirac_bracket("x1", "p_x1", at=point)
+first_s = time.process_time() - start
+names = [s.name for s in analysis.phase_space]
+pairs = [(names[a], names[b]) for a, b in np.random.default_rng(7).integers(0, len(names), (200, 2))]
+calls = 20
+points = [dict(point, p_x1=point["p_x1"] + 1e-6 * (k + 1)) for k in range(2 * calls * repeats + 2)]
+used = iter(points)
+same = per_call(lambda k: analysis.dirac_bracket(*pairs[k % len(pairs)], at=point), 100)
+fresh = per_call(lambda k: analysis.dirac_bracket("x1", f"p_x{n}", at=next(used)), calls)
+motion = per_call(lambda k: analysis.equations_of_motion(at=next(used)), calls)
+by_hand = per_call(lambda k: closed_form(point, 1, n), calls)
+error = abs(analysis.dirac_bracket(f"x{n - 1}", f"p_x{n}", at=point) - closed_form(point, n - 1, n))
+print(json.dumps({"N": n, "variables": len(names), "second_class": len(analysis.second_class),
+                  "analyse_s": analyse_s, "first_bracket_s": first_s, "bracket_same_point_ms": same * 1e3,
+                  "bracket_new_point_ms": fresh * 1e3, "motion_new_point_ms": motion * 1e3,
+                  "closed_form_ms": by_hand * 1e3, "error": error}))
+"""
 
 
 def _chain_row(n: int, repeats: int) -> dict:
-    import dirac
-    from dirac_systems.scale_models import chain
-
-    start = time.process_time()
-    analysis = dirac.analyze(chain(n))
-    analyse_s = time.process_time() - start
-    point = analysis.surface_point(seed=1)
-    start = time.process_time()
-    analysis.dirac_bracket("x1", "p_x1", at=point)
-    first_s = time.process_time() - start
-    names = [s.name for s in analysis.phase_space]
-    rng = np.random.default_rng(7)
-    pairs = [(names[a], names[b]) for a, b in rng.integers(0, len(names), (200, 2))]
-    calls = 20
-    # new points: the momenta moved along the surface's tangent directions are not needed for timing,
-    # only distinct points (C is evaluated and factorised afresh at each)
-    points = []
-    for k in range(calls * repeats + 1):
-        moved = dict(point)
-        moved["p_x1"] = point["p_x1"] + 1e-6 * (k + 1)
-        points.append(moved)
-    used = iter(points)
-    same = _per_call(lambda k: analysis.dirac_bracket(*pairs[k % len(pairs)], at=point), 100, repeats)
-    fresh = _per_call(lambda k: analysis.dirac_bracket("x1", f"p_x{n}", at=next(used)), calls, repeats)
-    used = iter(points)
-    motion = _per_call(lambda k: analysis.equations_of_motion(at=next(used)), calls, repeats)
-    by_hand = _per_call(lambda k: _closed_form(point, n, 1, n), calls, repeats)
-    error = abs(analysis.dirac_bracket(f"x{n - 1}", f"p_x{n}", at=point) - _closed_form(point, n, n - 1, n))
-    return {"N": n, "variables": len(names), "second_class": len(analysis.second_class), "analyse_s": analyse_s,
-            "first_bracket_s": first_s, "bracket_same_point_ms": same * 1e3, "bracket_new_point_ms": fresh * 1e3,
-            "motion_new_point_ms": motion * 1e3, "closed_form_ms": by_hand * 1e3, "error": error}
+    """One size in a fresh process (its own cache of generated code)."""
+    with tempfile.TemporaryDirectory(prefix="dirac-brackets-") as scratch:
+        env = dict(os.environ, DIRAC_CACHE_DIR=scratch)
+        result = subprocess.run([sys.executable, "-c", _CHILD, str(n), str(repeats)], env=env, capture_output=True,
+                                text=True, timeout=1800)
+    if result.returncode != 0:
+        raise RuntimeError(f"child failed: {result.stderr.strip().splitlines()[-1:]}")
+    return json.loads(result.stdout.strip().splitlines()[-1])
 
 
 def measure_brackets_at_point(quick: bool, repeats: int = 5) -> tuple[list[dict], list[Target]]:
