@@ -369,8 +369,8 @@ class DiracBracket:
             if not np.all(np.diag(factors[0])) or not np.all(np.isfinite(factors[0])):
                 raise singular
 
-            def solve(b: np.ndarray, _f=factors) -> np.ndarray:
-                x = lu_solve(_f, b, check_finite=False)
+            def solve(b: np.ndarray, _lu=factors) -> np.ndarray:
+                x = lu_solve(_lu, b, check_finite=False)
                 if not np.all(np.isfinite(x)):
                     raise singular
                 return x
