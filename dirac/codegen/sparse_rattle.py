@@ -279,6 +279,59 @@ def band_solve(B, x, piv):
 
 
 @numba.njit(cache=True)
+def band_factor(B, piv):
+    """B <- its LU factors with partial pivoting (as LAPACK gbtf2: the multipliers below the
+    diagonal in place, the row exchanges in piv, the diagonal holding reciprocal pivots), for
+    band_lu_solve: the elimination of band_solve without a right-hand side."""
+    for col in range(M):
+        last = min(M - 1, col + KL)
+        best = abs(B[col, KL])
+        r_best = col
+        for r in range(col + 1, last + 1):
+            v = abs(B[r, col - r + KL])
+            if v > best:
+                best = v
+                r_best = r
+        piv[col] = r_best
+        right = min(M - 1, col + KL + KU)
+        if r_best != col:
+            for j in range(col, right + 1):
+                tmp = B[col, j - col + KL]
+                B[col, j - col + KL] = B[r_best, j - r_best + KL]
+                B[r_best, j - r_best + KL] = tmp
+        inverse = 1.0 / B[col, KL]
+        B[col, KL] = inverse
+        for r in range(col + 1, last + 1):
+            f = B[r, col - r + KL] * inverse
+            B[r, col - r + KL] = f
+            if f != 0.0:
+                for j in range(col + 1, right + 1):
+                    B[r, j - r + KL] -= f * B[col, j - col + KL]
+
+
+@numba.njit(cache=True)
+def band_lu_solve(B, piv, x):
+    """x <- A^{-1} x from the factors of band_factor (the row exchanges and multipliers in
+    order, then the back substitution)."""
+    for col in range(M):
+        r_best = piv[col]
+        if r_best != col:
+            tmp = x[col]
+            x[col] = x[r_best]
+            x[r_best] = tmp
+        xc = x[col]
+        last = min(M - 1, col + KL)
+        for r in range(col + 1, last + 1):
+            x[r] -= B[r, col - r + KL] * xc
+    for col in range(M - 1, -1, -1):
+        acc = x[col]
+        right = min(M - 1, col + KL + KU)
+        for j in range(col + 1, right + 1):
+            acc -= B[col, j - col + KL] * x[j]
+        x[col] = acc * B[col, KL]
+
+
+@numba.njit(cache=True)
 def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     """RATTLE, constant diagonal mass, families in loops and a banded Newton solve
     (see dirac.codegen.sparse_rattle)."""
@@ -301,11 +354,12 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
     A1 = np.zeros((M, __W__))
     B = np.zeros((M, BW))
     piv = np.empty(M, dtype=np.int64)
-    # the multipliers of each sub-step at the last two steps: the next one starts from their
-    # linear extrapolation (a guess within O(h^2); zero before any step)
+    # the multipliers of each sub-step at the last three steps: the next one starts from their
+    # quadratic extrapolation (a guess within O(h^3); fewer points at the start of a call)
     S = fractions.shape[0]
     lam_last = np.zeros((S, M))
     lam_before = np.zeros((S, M))
+    lam_third = np.zeros((S, M))
     known = 0
     evals = 0.0
     residual = 0.0
@@ -333,7 +387,9 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
                 for i in range(N):
                     q1[i] = qp[i]
                 for a in range(M):
-                    if known >= 2:
+                    if known >= 3:
+                        lam[a] = 3.0 * (lam_last[s, a] - lam_before[s, a]) + lam_third[s, a]
+                    elif known == 2:
                         lam[a] = 2.0 * lam_last[s, a] - lam_before[s, a]
                     elif known == 1:
                         lam[a] = lam_last[s, a]
@@ -342,6 +398,8 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
                     for k in range(GW[a]):
                         q1[GC[a, k]] -= 0.5 * h * h * A0[a, k] * lam[a]
                 converged = False
+                factored = False  # Newton's matrix of this step factorised (kept while it contracts fast)
+                previous = np.inf
                 for _it in range(max_iter):
                     constraint_parts(q1, tau1, c, chi, G1, ct)
                     evals += 1.0
@@ -358,10 +416,16 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
                         break
                     if residual != residual or residual == np.inf:
                         break
-                    band_assemble(G1, A0, -0.5 * h * h, B)
+                    if not factored or residual > 0.01 * previous:
+                        # the matrix at this iterate; later iterates reuse it while the residual
+                        # falls a hundredfold an iteration (the iterates move by O(residual))
+                        band_assemble(G1, A0, -0.5 * h * h, B)
+                        band_factor(B, piv)
+                        factored = True
+                    previous = residual
                     for a in range(M):
                         d[a] = chi[a]
-                    band_solve(B, d, piv)
+                    band_lu_solve(B, piv, d)
                     for a in range(M):
                         lam[a] -= d[a]
                     for i in range(N):
@@ -376,6 +440,7 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
                     report(info, step, True, evals, residual)
                     return
                 for a in range(M):
+                    lam_third[s, a] = lam_before[s, a]
                     lam_before[s, a] = lam_last[s, a]
                     lam_last[s, a] = lam[a]
                     for k in range(GW[a]):
