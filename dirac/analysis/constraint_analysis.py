@@ -482,12 +482,26 @@ class ConstraintAnalysis:
         InputError
             For a name that is not a phase-space variable.
         """
-        free = set(self.undetermined_multipliers)
-        H = self.canonical_hamiltonian + sum(
-            (u * phi for u, phi in zip(self.primary_multipliers, self.primary_constraints) if u in free), sympy.S.Zero
-        )
+        H = self.__dict__.get("_motion_hamiltonian")
+        if H is None:
+            free = set(self.undetermined_multipliers)
+            H = self.canonical_hamiltonian + sum(
+                (u * phi for u, phi in zip(self.primary_multipliers, self.primary_constraints) if u in free),
+                sympy.S.Zero)
+            self.__dict__["_motion_hamiltonian"] = H
         items = list(self.phase_space) if variables is None else [self._bracket._sympify(z) for z in variables]
         result: dict = {}
+        if at is not None:  # the whole vector z_dot at the point from one solve; each z reads it off
+            motion = self._bracket.field_at(H, at)
+            if motion is not None:
+                z_dot, args = motion
+                if variables is None:
+                    return dict(zip(items, z_dot.tolist()))
+                position = self._bracket.positions
+                for z in items:
+                    k = position.get(z)
+                    result[z] = float(z_dot[k]) if k is not None else float(self._bracket.gradient_at(z, args) @ z_dot)
+                return result
         for z in items:
             if at is not None:
                 result[z] = self._bracket.at(z, H, at) + self._bracket.explicit_time_term(z, at)

@@ -98,6 +98,15 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
             measured.append(forced_target(forced))
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"forced systems: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
+        say("brackets at a point: the chain at 8, 32, 128 links")
+        try:
+            from dirac.bench.brackets_at_point import format_brackets_at_point, measure_brackets_at_point
+
+            bracket_rows, bracket_targets = measure_brackets_at_point(quick, repeats)
+            measured.extend(bracket_targets)
+            notes.append(format_brackets_at_point(bracket_rows))
+        except Exception as exc:  # one failed measurement must not hide the others
+            notes.append(f"brackets at a point: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
         say("codegen scale: chain first call and per-step cost against N, cold first results")
         try:
             from dirac.bench.codegen_scale import codegen_scale_targets

@@ -92,13 +92,22 @@ def group_families(expressions: Sequence[sympy.Expr], coordinates: Sequence[symp
 
 
 def _table(name: str, rows: Sequence[Sequence[int]], width: int) -> str:
-    """A module-level int64 table ``name`` (len(rows), width); short rows padded with 0."""
+    """A module-level int32 table ``name`` (len(rows), width); short rows padded with 0.
+
+    int32 halves the tables' share of the cache next to int64: the tables are read on
+    every step and grow with the system (numba freezes them into the machine code)."""
     body = ", ".join("[" + ", ".join(str(v) for v in [*row, *[0] * (width - len(row))]) + "]" for row in rows)
     if not rows:
-        return f"{name} = np.zeros((0, {max(width, 1)}), dtype=np.int64)\n"
+        return f"{name} = np.zeros((0, {max(width, 1)}), dtype=np.int32)\n"
     if width == 0:
-        return f"{name} = np.zeros(({len(rows)}, 1), dtype=np.int64)\n"
-    return f"{name} = np.array([{body}], dtype=np.int64)\n"
+        return f"{name} = np.zeros(({len(rows)}, 1), dtype=np.int32)\n"
+    return f"{name} = np.array([{body}], dtype=np.int32)\n"
+
+
+def _vector(name: str, values: Sequence[int]) -> str:
+    """A module-level int32 vector ``name``."""
+    return f"{name} = np.array([{', '.join(map(str, values))}], dtype=np.int32)\n" if values else \
+        f"{name} = np.zeros(0, dtype=np.int32)\n"
 
 
 def _family_loop(family: Family, table: str, rows: str, outputs: Sequence[sympy.Expr], targets: Sequence[str],
@@ -153,15 +162,14 @@ def sparse_rattle_source(
         for member, cols in zip(f.members, f.columns):
             columns[member] = cols
     out.append(_table("GC", columns, width))
-    out.append(f"GW = np.array([{', '.join(str(len(cols)) for cols in columns)}], dtype=np.int64)\n"
-               if m else "GW = np.zeros(0, dtype=np.int64)\n")
+    out.append(_vector("GW", [len(cols) for cols in columns]))
     calls = []
     for j, f in enumerate(families):
         k = len(f.placeholders)
         outputs = [f.template, *[sympy.diff(f.template, u) for u in f.placeholders],
                    sympy.diff(f.template, time) if time is not None else sympy.S.Zero]
         out.append(_table(f"CHI_COLS_{j}", f.columns, k))
-        out.append(f"CHI_ROWS_{j} = np.array([{', '.join(map(str, f.members))}], dtype=np.int64)\n")
+        out.append(_vector(f"CHI_ROWS_{j}", f.members))
         targets = ["chi[a]", *[f"Gv[a, {i}]" for i in range(k)], "ct[a]"]
         calls.append(_family_loop(f, f"CHI_COLS_{j}", f"CHI_ROWS_{j}", outputs, targets, parameters, time,
                                   f"constraint family {j}"))
@@ -177,7 +185,7 @@ def constraint_parts(q, t, c, chi, Gv, ct):
     gcalls = []
     for j, f in enumerate(gfamilies):
         out.append(_table(f"GV_COLS_{j}", f.columns, len(f.placeholders)))
-        out.append(f"GV_ROWS_{j} = np.array([{', '.join(map(str, f.members))}], dtype=np.int64)\n")
+        out.append(_vector(f"GV_ROWS_{j}", f.members))
         gcalls.append(_family_loop(f, f"GV_COLS_{j}", f"GV_ROWS_{j}", [f.template], ["out[a]"], parameters, time,
                                    f"dV/dq family {j}"))
     out.append(f"""
@@ -204,8 +212,12 @@ def grad_potential(q, t, c, out):
     pairs = [(a, ka, b, kb) for entries in rows_of.values() for (a, ka) in entries for (b, kb) in entries]
     kl = max([a - b for a, _, b, _ in pairs] + [0])
     ku = max([b - a for a, _, b, _ in pairs] + [0])
-    out.append(_table("PAIRS", pairs, 4))
-    out.append(f"KL = {kl}\nKU = {ku}\nBW = {2 * kl + ku + 1}\nNPAIRS = {len(pairs)}\n")
+    bw = 2 * kl + ku + 1
+    # each pair as three flat positions: in B (band storage), in G's values, in A's values
+    out.append(_vector("PAIR_B", [a * bw + b - a + kl for a, _, b, _ in pairs]))
+    out.append(_vector("PAIR_G", [a * width + ka for a, ka, _, _ in pairs]))
+    out.append(_vector("PAIR_A", [b * width + kb for _, _, b, kb in pairs]))
+    out.append(f"KL = {kl}\nKU = {ku}\nBW = {bw}\nNPAIRS = {len(pairs)}\n")
     out.append(_SPARSE_TEMPLATES.replace("__W__", str(width)))
     return "".join(out)
 
@@ -214,21 +226,23 @@ _SPARSE_TEMPLATES = '''
 
 @numba.njit(cache=True)
 def band_assemble(Gv, Av, scale, B):
-    """B <- scale * G A^T in band storage (B[a, b - a + KL]; columns beyond KU left for fill-in)."""
-    for a in range(M):
-        for j in range(BW):
-            B[a, j] = 0.0
+    """B <- scale * G A^T in band storage (B[a, b - a + KL]; columns beyond KU left for fill-in),
+    over the flat positions of the pairs of rows that share a column."""
+    Bf = B.ravel()
+    Gf = Gv.ravel()
+    Af = Av.ravel()
+    for j in range(M * BW):
+        Bf[j] = 0.0
     for s in range(NPAIRS):
-        a = PAIRS[s, 0]
-        b = PAIRS[s, 2]
-        B[a, b - a + KL] += scale * Gv[a, PAIRS[s, 1]] * Av[b, PAIRS[s, 3]]
+        Bf[PAIR_B[s]] += scale * Gf[PAIR_G[s]] * Af[PAIR_A[s]]
 
 
 @numba.njit(cache=True)
 def band_solve(B, x, piv):
     """x <- B^{-1} x: banded Gaussian elimination with partial pivoting in place
     (bandwidths KL below, KU above the diagonal; fill-in up to KL + KU above, as LAPACK
-    gbtrf). A zero pivot divides by zero (a singular Newton matrix)."""
+    gbtrf); the diagonal of B ends holding the reciprocal pivots. A zero pivot gives an
+    infinite reciprocal (a singular Newton matrix: the next residual is not finite)."""
     for col in range(M):
         last = min(M - 1, col + KL)
         best = abs(B[col, KL])
@@ -248,9 +262,10 @@ def band_solve(B, x, piv):
             tmp = x[col]
             x[col] = x[r_best]
             x[r_best] = tmp
-        pivot = B[col, KL]
+        inverse = 1.0 / B[col, KL]  # one division per column, kept for the back substitution
+        B[col, KL] = inverse
         for r in range(col + 1, last + 1):
-            f = B[r, col - r + KL] / pivot
+            f = B[r, col - r + KL] * inverse
             if f != 0.0:
                 for j in range(col + 1, right + 1):
                     B[r, j - r + KL] -= f * B[col, j - col + KL]
@@ -260,7 +275,60 @@ def band_solve(B, x, piv):
         right = min(M - 1, col + KL + KU)
         for j in range(col + 1, right + 1):
             acc -= B[col, j - col + KL] * x[j]
-        x[col] = acc / B[col, KL]
+        x[col] = acc * B[col, KL]
+
+
+@numba.njit(cache=True)
+def band_factor(B, piv):
+    """B <- its LU factors with partial pivoting (as LAPACK gbtf2: the multipliers below the
+    diagonal in place, the row exchanges in piv, the diagonal holding reciprocal pivots), for
+    band_lu_solve: the elimination of band_solve without a right-hand side."""
+    for col in range(M):
+        last = min(M - 1, col + KL)
+        best = abs(B[col, KL])
+        r_best = col
+        for r in range(col + 1, last + 1):
+            v = abs(B[r, col - r + KL])
+            if v > best:
+                best = v
+                r_best = r
+        piv[col] = r_best
+        right = min(M - 1, col + KL + KU)
+        if r_best != col:
+            for j in range(col, right + 1):
+                tmp = B[col, j - col + KL]
+                B[col, j - col + KL] = B[r_best, j - r_best + KL]
+                B[r_best, j - r_best + KL] = tmp
+        inverse = 1.0 / B[col, KL]
+        B[col, KL] = inverse
+        for r in range(col + 1, last + 1):
+            f = B[r, col - r + KL] * inverse
+            B[r, col - r + KL] = f
+            if f != 0.0:
+                for j in range(col + 1, right + 1):
+                    B[r, j - r + KL] -= f * B[col, j - col + KL]
+
+
+@numba.njit(cache=True)
+def band_lu_solve(B, piv, x):
+    """x <- A^{-1} x from the factors of band_factor (the row exchanges and multipliers in
+    order, then the back substitution)."""
+    for col in range(M):
+        r_best = piv[col]
+        if r_best != col:
+            tmp = x[col]
+            x[col] = x[r_best]
+            x[r_best] = tmp
+        xc = x[col]
+        last = min(M - 1, col + KL)
+        for r in range(col + 1, last + 1):
+            x[r] -= B[r, col - r + KL] * xc
+    for col in range(M - 1, -1, -1):
+        acc = x[col]
+        right = min(M - 1, col + KL + KU)
+        for j in range(col + 1, right + 1):
+            acc -= B[col, j - col + KL] * x[j]
+        x[col] = acc * B[col, KL]
 
 
 @numba.njit(cache=True)
@@ -279,12 +347,20 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
     ct = np.empty(M)
     lam = np.empty(M)
     d = np.empty(M)
+    scale = np.empty(M)
     G0 = np.zeros((M, __W__))
     A0 = np.zeros((M, __W__))
     G1 = np.zeros((M, __W__))
     A1 = np.zeros((M, __W__))
     B = np.zeros((M, BW))
     piv = np.empty(M, dtype=np.int64)
+    # the multipliers of each sub-step at the last three steps: the next one starts from their
+    # quadratic extrapolation (a guess within O(h^3); fewer points at the start of a call)
+    S = fractions.shape[0]
+    lam_last = np.zeros((S, M))
+    lam_before = np.zeros((S, M))
+    lam_third = np.zeros((S, M))
+    known = 0
     evals = 0.0
     residual = 0.0
     for step in range(n_steps):
@@ -303,32 +379,53 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
             if M > 0:
                 constraint_parts(q, tau, c, chi, G0, ct)
                 for a in range(M):
-                    lam[a] = 0.0
+                    g2 = 1.0
                     for k in range(GW[a]):
                         A0[a, k] = minv[GC[a, k]] * G0[a, k]
+                        g2 += G0[a, k] * G0[a, k]
+                    scale[a] = 1.0 / g2
                 for i in range(N):
                     q1[i] = qp[i]
+                for a in range(M):
+                    if known >= 3:
+                        lam[a] = 3.0 * (lam_last[s, a] - lam_before[s, a]) + lam_third[s, a]
+                    elif known == 2:
+                        lam[a] = 2.0 * lam_last[s, a] - lam_before[s, a]
+                    elif known == 1:
+                        lam[a] = lam_last[s, a]
+                    else:
+                        lam[a] = 0.0
+                    for k in range(GW[a]):
+                        q1[GC[a, k]] -= 0.5 * h * h * A0[a, k] * lam[a]
                 converged = False
+                factored = False  # Newton's matrix of this step factorised (kept while it contracts fast)
+                previous = np.inf
                 for _it in range(max_iter):
                     constraint_parts(q1, tau1, c, chi, G1, ct)
                     evals += 1.0
+                    # each constraint against its own scale tol (1 + |grad chi_a(q)|^2): round-off in
+                    # chi_a is of the order of its terms, not of |q|^2, so a long chain far from the
+                    # origin keeps its rods as well as a short one
                     residual = 0.0
                     for a in range(M):
-                        v = abs(chi[a])
+                        v = abs(chi[a]) * scale[a]
                         if v > residual or v != v:
                             residual = v if v == v else np.inf
-                    size = 1.0
-                    for i in range(N):
-                        size += q1[i] * q1[i]
-                    if residual <= tol * size:
+                    if residual <= tol:
                         converged = True
                         break
                     if residual != residual or residual == np.inf:
                         break
-                    band_assemble(G1, A0, -0.5 * h * h, B)
+                    if not factored or residual > 0.01 * previous:
+                        # the matrix at this iterate; later iterates reuse it while the residual
+                        # falls a hundredfold an iteration (the iterates move by O(residual))
+                        band_assemble(G1, A0, -0.5 * h * h, B)
+                        band_factor(B, piv)
+                        factored = True
+                    previous = residual
                     for a in range(M):
                         d[a] = chi[a]
-                    band_solve(B, d, piv)
+                    band_lu_solve(B, piv, d)
                     for a in range(M):
                         lam[a] -= d[a]
                     for i in range(N):
@@ -343,6 +440,9 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
                     report(info, step, True, evals, residual)
                     return
                 for a in range(M):
+                    lam_third[s, a] = lam_before[s, a]
+                    lam_before[s, a] = lam_last[s, a]
+                    lam_last[s, a] = lam[a]
                     for k in range(GW[a]):
                         ph[GC[a, k]] -= 0.5 * h * G0[a, k] * lam[a]
                 for i in range(N):
@@ -354,8 +454,7 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
             evals += 1.0
             for i in range(N):
                 p[i] = ph[i] - 0.5 * h * gv[i]
-            if M > 0:
-                constraint_parts(q, tau1, c, chi, G1, ct)
+            if M > 0:  # G1 and ct are those of the converged iterate q1 = q at tau1
                 for a in range(M):
                     acc = ct[a]
                     for k in range(GW[a]):
@@ -368,6 +467,7 @@ def rattle_constant_mass(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info
                     for k in range(GW[a]):
                         p[GC[a, k]] -= 0.5 * h * G1[a, k] * d[a]
             tau = tau1
+        known += 1
     report(info, n_steps, False, evals, residual)
 
 

@@ -249,6 +249,10 @@ class ConstrainedProblem:
         Put the initial data on the constraint surface first (as ``project = true`` in a
         scene): the closest point in the metric ``M`` (:meth:`MechanicalSystem.project`).
 
+    A system with generalized forces (``Lagrangian(..., forces=...)``) gives a
+    :class:`ForcedProblem` (without impulses): ``rattle-2/4`` then run as
+    ``forced-rattle-2/4``, ``midpoint`` and the scipy methods on the forced Dirac field.
+
     Raises
     ------
     InputError
@@ -267,6 +271,16 @@ class ConstrainedProblem:
 
     kind: ClassVar[str] = "constrained"
     outputs: ClassVar[tuple[str, ...]] = ("q", "p", "q_dot", "energy", "constraint_residual")
+
+    def __new__(cls, *args: object, **kwargs: object) -> ConstrainedProblem:
+        """A system with generalized forces (a Lagrangian built with ``forces=``, or a forced
+        ``MechanicalSystem``) gives a :class:`ForcedProblem`: the same problem, whose methods
+        take the forces (``rattle-2/4``, ``midpoint``, ``auto``, the scipy methods, ...)."""
+        if cls is ConstrainedProblem:
+            system = args[0] if args else kwargs.get("mechanics")
+            if bool(getattr(system, "is_forced", False)) or bool(getattr(system, "forced", False)):
+                return super().__new__(ForcedProblem)
+        return super().__new__(cls)
 
     def __post_init__(self) -> None:
         from dirac.model.lagrangian import Lagrangian
@@ -300,11 +314,6 @@ class ConstrainedProblem:
         if self.project:
             pairs = [mechanics.project(a, b) for a, b in zip(q0, p0)]
             q0, p0 = np.array([a for a, _ in pairs]), np.array([b for _, b in pairs])
-        if getattr(mechanics, "forced", False) and self.kind == "constrained":
-            raise InputError(
-                f"system {mechanics.name!r} has generalized forces: integrate it as a ForcedProblem "
-                "(dirac.flows.ForcedProblem), whose methods take the forces"
-            )
         names = mechanics.coordinate_names
         advice = "or pass project=True to put the data on the surface (the closest point in the metric M)"
         for b in range(q0.shape[0]):

@@ -71,7 +71,14 @@ def test_impulse_after_t_end_warns_and_runs(tmp_path, run_cli):
 
 
 def test_unforced_method_is_refused_naming_the_forced_methods(tmp_path, run_cli):
-    status, _, err = run_cli("run", str(_files(tmp_path, method="rattle-2")), "--no-progress")
+    status, _, err = run_cli("run", str(_files(tmp_path, method="rattle-6")), "--no-progress")
     line = one_error_line(status, err)
     assert "cannot integrate a system with forces or impulses" in line
     assert "forced-rattle-2, forced-rattle-4" in line
+    assert "rattle-2, rattle-4, midpoint" in line
+
+
+def test_ordinary_method_name_runs_a_forced_scene(tmp_path, run_cli):
+    status, _, err = run_cli("run", str(_files(tmp_path, method="rattle-2")), "--no-progress",
+                             "--out", str(tmp_path / "out.npz"))
+    assert status == 0, err

@@ -201,11 +201,15 @@ def test_impulses_after_t_end_warn(damped_pendulum):
 
 
 def test_unforced_methods_are_refused_naming_the_forced_ones(damped_pendulum):
+    """A method that cannot take forces (rattle-6 has no forced version) is refused, naming
+    those that can, the ordinary names among them; ConstrainedProblem of a forced system is
+    a ForcedProblem."""
     problem = ForcedProblem(damped_pendulum, *_start(0.3))
-    with pytest.raises(InputError, match="forced-rattle-2"):
-        dirac.integrate(problem, "rattle-2", t_end=1.0, dt=0.01)
-    with pytest.raises(InputError, match="ForcedProblem"):
-        dirac.flows.ConstrainedProblem(damped_pendulum, *_start(0.3))
+    with pytest.raises(InputError, match="forced-rattle-2") as refused:
+        dirac.integrate(problem, "rattle-6", t_end=1.0, dt=0.01)
+    for name in ("auto", "rattle-2", "rattle-4", "midpoint", "scipy-DOP853", "conformal-2"):
+        assert name in str(refused.value)
+    assert isinstance(dirac.flows.ConstrainedProblem(damped_pendulum, *_start(0.3)), ForcedProblem)
 
 
 def test_auto_chooses_a_forced_method(damped_pendulum):

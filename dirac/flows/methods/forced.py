@@ -25,7 +25,7 @@ the remainder of the cut step, so the steps return to the run's grid. The output
 from __future__ import annotations
 
 import math
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -41,7 +41,55 @@ __all__ = ["ForcedStepper", "METHODS", "FORCED_METHOD_NAMES"]
 _GRID_SLACK = 1e-9
 
 
-class ForcedStepper(ConstrainedStepper):
+class ImpulsesBetweenSteps:
+    """``step(n_steps, dt)`` of a fixed-step method on a forced problem: the steps are cut so
+    that one ends on each impulse time, where ``p`` jumps by the projected impulse and its
+    work is added. The stepper provides ``_advance(n_steps, dt)`` (no impulse inside),
+    ``pending`` (the impulses still to come), ``work`` and the state ``q``, ``p``, ``time``."""
+
+    pending: list
+    work: Any
+    q: Any
+    p: Any
+    time: Any
+    steps: Any
+    mechanics: Any
+
+    def _advance(self, n_steps: int, dt: float, warm_up: bool = False) -> None:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def _kick(self, impulse) -> None:
+        for b in range(self.q.shape[0]):
+            self.p[b], work = self.mechanics.apply_impulse(self.q[b], self.p[b], impulse.vector, self.time)
+            self.work[b] += work
+
+    def step(self, n_steps: int, dt: float) -> None:
+        start = self.time
+        end = start + n_steps * dt
+        done = 0
+        while self.pending and self.pending[0].t <= end + _GRID_SLACK * dt:
+            impulse = self.pending.pop(0)
+            offset = (impulse.t - (start + done * dt)) / dt  # steps from here to the impulse
+            whole = int(math.floor(offset + _GRID_SLACK))
+            cut = (offset - whole) * dt
+            self._advance(whole, dt)
+            done += whole
+            self.time = start + done * dt
+            if cut > _GRID_SLACK * dt:
+                self._advance(1, cut)
+                self.time = impulse.t
+                self._kick(impulse)
+                self._advance(1, dt - cut)
+                self.steps -= 1  # the two pieces of the cut step count as one step of the grid
+                done += 1
+                self.time = start + done * dt
+            else:
+                self._kick(impulse)
+        self._advance(n_steps - done, dt)
+        self.time = end
+
+
+class ForcedStepper(ImpulsesBetweenSteps, ConstrainedStepper):
     """Forced RATTLE or the conformal splitting, composed with ``method.data``, with impulses."""
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...], options: dict) -> None:
@@ -55,7 +103,8 @@ class ForcedStepper(ConstrainedStepper):
             raise InputError(
                 f"method {method.name!r} needs linear damping Q = -gamma M q_dot with a constant mass "
                 f"(a conformal Hamiltonian system); the forces of {mechanics.name!r} are not of that form: "
-                "use forced-rattle-2 or forced-rattle-4"
+                "use forced-rattle-2 or forced-rattle-4 (also by their ordinary names rattle-2 and rattle-4), midpoint, "
+                "auto or a scipy method"
             )
         for q in self.q:
             mechanics.mass_matrix(q)  # refuses a singular mass matrix
@@ -93,36 +142,6 @@ class ForcedStepper(ConstrainedStepper):
         self._advance(1, 1e-6, warm_up=True)
         self.q[:], self.p[:], self.work[:] = saved[0], saved[1], saved[2]
         self.time, self.steps, self.evaluations = saved[3], saved[4], saved[5]
-
-    def _kick(self, impulse) -> None:
-        for b in range(self.q.shape[0]):
-            self.p[b], work = self.mechanics.apply_impulse(self.q[b], self.p[b], impulse.vector, self.time)
-            self.work[b] += work
-
-    def step(self, n_steps: int, dt: float) -> None:
-        start = self.time
-        end = start + n_steps * dt
-        done = 0
-        while self.pending and self.pending[0].t <= end + _GRID_SLACK * dt:
-            impulse = self.pending.pop(0)
-            offset = (impulse.t - (start + done * dt)) / dt  # steps from here to the impulse
-            whole = int(math.floor(offset + _GRID_SLACK))
-            cut = (offset - whole) * dt
-            self._advance(whole, dt)
-            done += whole
-            self.time = start + done * dt
-            if cut > _GRID_SLACK * dt:
-                self._advance(1, cut)
-                self.time = impulse.t
-                self._kick(impulse)
-                self._advance(1, dt - cut)
-                self.steps -= 1  # the two pieces of the cut step count as one step of the grid
-                done += 1
-                self.time = start + done * dt
-            else:
-                self._kick(impulse)
-        self._advance(n_steps - done, dt)
-        self.time = end
 
     def observe(self) -> dict[str, np.ndarray]:
         names = tuple(name for name in self.outputs if name != "work")

@@ -13,7 +13,7 @@ factories are joined here, so neither of those modules imports the other.
 from __future__ import annotations
 
 from dirac.errors import InputError
-from dirac.flows.methods import exact, forced, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
+from dirac.flows.methods import exact, forced, forced_ordinary, heavy_top, lie_poisson, midpoint, rattle, scipy_rk
 from dirac.flows.methods.base import Method
 from dirac.validate import unknown_name_error
 
@@ -43,9 +43,9 @@ METHODS: dict[str, Method] = _collect(
     exact.METHODS,
     tuple(method.with_factories(heavy_top.LIE_POISSON_FACTORIES) for method in lie_poisson.METHODS),
     heavy_top.METHODS,
-    midpoint.METHODS,
-    rattle.METHODS,
-    scipy_rk.METHODS,
+    # the ordinary names take forced systems too (rattle-2/4 as forced-rattle-2/4)
+    tuple(method.with_factories(forced_ordinary.forced_factories(method.name))
+          for method in (*midpoint.METHODS, *rattle.METHODS, *scipy_rk.METHODS)),
     forced.METHODS,
 )
 
