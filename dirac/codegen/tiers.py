@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from dirac.codegen.flatten import flatten_source
 from dirac.codegen.numba_backend import cache_directory, import_source, interpret_source
 
 __all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
@@ -102,7 +103,7 @@ class TieredModule:
     """The interpreted and the compiled form of one generated module (each made on first use)."""
 
     def __init__(self, source: str, title: str) -> None:
-        self.source = source
+        self.source = flatten_source(source)  # helpers inlined at the source level, for both tiers
         self.title = title
         self._compiled: ModuleType | None = None
         self._interpreted: ModuleType | None = None
