@@ -253,9 +253,9 @@ def format_latency(rows: list[LatencyRow]) -> str:
         error = f"{row.error:.1e} {row.conserved}" if row.error is not None else ""
         lines.append(f"{row.system:28s} {row.run:22s} {row.method[:22]:22s} {row.steps or '':>7} {row.wall:7.2f}"
                      f" {row.cpu:6.2f} {target:>6s} {error:>20s}  {_ratio(rows, row)}{mark}")
-    compiled = sorted({(int(c["chars"]), float(c["seconds"]), str(c.get("what", ""))) for row in rows
-                       for c in row.compilations if isinstance(c, dict) and "chars" in c}
-                      | set(), key=lambda entry: entry[0])
+    compiled = sorted({(int(str(c["chars"])), float(str(c["seconds"])), str(c.get("what", ""))) for row in rows
+                       for c in row.compilations if isinstance(c, dict) and "chars" in c and "seconds" in c},
+                      key=lambda entry: entry[0])
     if compiled:
         lines += ["", "compile time against kernel size (each cold, measured by the run that compiled it):",
                   f"{'source chars':>12s} {'cpu s':>6s} {'us/char':>8s}  kernel"]

@@ -5,12 +5,13 @@ instead while a child process compiles the kernel into numba's on-disk cache; th
 switches to the compiled form at the next step boundary after the child is done
 (:meth:`dirac.codegen.tiers.TieredFunction.run_steps`). The child is
 
-    python -m dirac.codegen.background MODULE.py FUNCTION SIGNATURE.pickle
+    python -m dirac.codegen.background MODULE.py FUNCTION SIGNATURE.json CHARS
 
 It imports the generated module file (the same file, under the same name, as the
 parent, so numba's cache index is the one the parent reads), compiles ``FUNCTION`` for
-the argument types the parent pickled (numba types, written by the parent into its own
-cache directory) and writes the compile time to the history below.
+the argument types the parent described (:func:`describe`: the parent does not import
+numba while the cache is cold), writes the compile time to the history below and the
+marker that says the machine code is ready.
 
 The history, ``compile_history.json`` in the cache directory, holds the measured
 seconds of recent compilations against the size of the generated source; the tier
@@ -24,7 +25,6 @@ from __future__ import annotations
 
 import json
 import os
-import pickle
 import subprocess
 import sys
 import tempfile
@@ -32,7 +32,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-__all__ = ["BackgroundCompile", "estimate_compile_seconds", "record_compile_seconds", "HISTORY_FILE",
+__all__ = ["BackgroundCompile", "estimate_compile_seconds", "record_compile_seconds", "HISTORY_FILE", "describe",
+           "numba_type", "mark_ready",
            "DEFAULT_SECONDS_PER_CHAR", "DEFAULT_COMPILE_FLOOR"]
 
 HISTORY_FILE = "compile_history.json"
@@ -90,12 +91,10 @@ class BackgroundCompile:
     numba types of ``args`` into numba's on-disk cache."""
 
     def __init__(self, path: Path, name: str, args: tuple[Any, ...], chars: int) -> None:
-        import numba
-
-        signature = tuple(numba.typeof(a) for a in args)
+        signature = [describe(a) for a in args]  # numba's types, named without importing numba here
         handle, signature_file = tempfile.mkstemp(suffix=".sig", dir=path.parent)
-        with os.fdopen(handle, "wb") as stream:
-            pickle.dump(signature, stream)
+        with os.fdopen(handle, "w") as stream:
+            json.dump(signature, stream)
         self.signature_file = Path(signature_file)
         self.started = time.perf_counter()
         self.process = subprocess.Popen(
@@ -119,12 +118,50 @@ class BackgroundCompile:
         return self.poll()
 
 
+def describe(value: Any) -> list[Any]:
+    """The numba type ``numba.typeof(value)`` would give, as plain data (:func:`numba_type`
+    turns it back): arrays by dtype, dimension, layout and writability; Python scalars."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        layout = "C" if value.flags.c_contiguous else "F" if value.flags.f_contiguous else "A"
+        return ["array", value.dtype.str, value.ndim, layout, bool(value.flags.writeable)]
+    if isinstance(value, (bool, np.bool_)):
+        return ["bool"]
+    if isinstance(value, (int, np.integer)):
+        return ["scalar", np.dtype(type(value) if isinstance(value, np.integer) else np.int64).str]
+    if isinstance(value, (float, np.floating)):
+        return ["scalar", np.dtype(type(value) if isinstance(value, np.floating) else np.float64).str]
+    raise TypeError(f"no background compilation for an argument of type {type(value).__name__}")
+
+
+def numba_type(description: list[Any]) -> Any:
+    """The numba type of a :func:`describe` description."""
+    import numba
+    import numpy as np
+
+    if description[0] == "array":
+        _, dtype, ndim, layout, writeable = description
+        return numba.types.Array(numba.from_dtype(np.dtype(dtype)), int(ndim), layout, readonly=not writeable)
+    if description[0] == "bool":
+        return numba.types.boolean
+    return numba.from_dtype(np.dtype(description[1]))
+
+
+def mark_ready(marker: Path) -> None:
+    """Write the marker of a finished compilation (:func:`dirac.codegen.numba_backend.ready_marker`)."""
+    try:
+        marker.write_text("compiled\n", encoding="utf-8")
+    except OSError:
+        return
+
+
 def _main(argv: list[str]) -> int:
     import importlib.util
 
     path, name, signature_file, chars = argv
-    with open(signature_file, "rb") as stream:  # written by the parent into its own cache directory
-        signature = pickle.load(stream)
+    with open(signature_file, encoding="utf-8") as stream:
+        signature = tuple(numba_type(d) for d in json.load(stream))
     module_name = Path(path).stem
     spec = importlib.util.spec_from_file_location(module_name, path)
     if spec is None or spec.loader is None:
@@ -135,6 +172,7 @@ def _main(argv: list[str]) -> int:
     start = time.process_time()
     getattr(module, name).compile(signature)
     record_compile_seconds(int(chars), time.process_time() - start, f"{name} (background)")
+    mark_ready(Path(path).with_name(f"{module_name}.{name}.ready"))
     return 0
 
 

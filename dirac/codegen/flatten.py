@@ -258,8 +258,7 @@ class _Flattener:
         self.done.add(name)
 
     def run(self) -> None:
-        for name in self.helpers:
-            self._flatten_helper(name)
+        # a helper is flattened when first inlined; one nobody calls stays as written
         for name, function in self.functions.items():
             if name not in self.helpers:
                 self._flatten_function(function)

@@ -39,7 +39,8 @@ import sympy
 
 from dirac.codegen.printer import flat_expressions, straight_line
 
-__all__ = ["GeneratedFunction", "generate_module", "import_source", "interpret_source", "cache_directory"]
+__all__ = ["GeneratedFunction", "generate_module", "import_source", "interpret_source", "cache_directory", "source_path",
+           "ready_marker", "write_source"]
 
 
 @dataclass(frozen=True)
@@ -182,6 +183,28 @@ def generate_module(
     return import_source(source)
 
 
+def source_path(source: str) -> Path:
+    """The file :func:`import_source` writes ``source`` to: ``dirac_gen_<hash>.py`` in the cache."""
+    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
+    return cache_directory() / f"dirac_gen_{digest}.py"
+
+
+def ready_marker(path: Path, name: str) -> Path:
+    """The file that says function ``name`` of the generated module at ``path`` is in numba's
+    on-disk cache (written after a compilation; read without importing numba)."""
+    return path.with_name(f"{path.stem}.{name}.ready")
+
+
+def write_source(source: str) -> Path:
+    """Write ``source`` to :func:`source_path` (unless the file holds it already); its path."""
+    path = source_path(source)
+    if not path.exists() or path.read_text(encoding="utf-8") != source:
+        temporary = path.with_suffix(f".{os.getpid()}.tmp")
+        temporary.write_text(source, encoding="utf-8")
+        os.replace(temporary, path)
+    return path
+
+
 def import_source(source: str) -> ModuleType:
     """Write ``source`` to ``dirac_gen_<hash>.py`` in :func:`cache_directory` (unless a file
     of that name holds it already) and import it, once per process.
@@ -189,15 +212,11 @@ def import_source(source: str) -> ModuleType:
     The module name is the hash of the source, so numba's on-disk cache of the module's
     ``cache=True`` functions is reused by every later run that generates the same source.
     """
-    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
-    module_name = f"dirac_gen_{digest}"
+    path = source_path(source)
+    module_name = path.stem
     if module_name in sys.modules:
         return sys.modules[module_name]
-    path = cache_directory() / f"{module_name}.py"
-    if not path.exists() or path.read_text(encoding="utf-8") != source:
-        temporary = path.with_suffix(f".{os.getpid()}.tmp")
-        temporary.write_text(source, encoding="utf-8")
-        os.replace(temporary, path)
+    write_source(source)
     spec = importlib.util.spec_from_file_location(module_name, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

@@ -36,9 +36,16 @@ from typing import Any
 
 import numpy as np
 
-from dirac.codegen.background import BackgroundCompile, estimate_compile_seconds, record_compile_seconds
+from dirac.codegen.background import BackgroundCompile, estimate_compile_seconds, mark_ready, record_compile_seconds
 from dirac.codegen.flatten import flatten_source
-from dirac.codegen.numba_backend import cache_directory, import_source, interpret_source
+from dirac.codegen.numba_backend import (
+    cache_directory,
+    import_source,
+    interpret_source,
+    ready_marker,
+    source_path,
+    write_source,
+)
 
 __all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "background_enabled", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
@@ -161,13 +168,23 @@ class TieredFunction:
         self.background: BackgroundCompile | None = None
         self.background_failed = False
         self._split: tuple[int, int, int, int] | None | bool = False  # not looked at yet
+        self._marker: Path | None = None
 
     @property
     def tier(self) -> str:
-        """``"compiled"`` or ``"interpreted"``: the form the next call uses."""
-        if self._compiled is None and is_compiled_or_cached(getattr(self.module.compiled, self.name)):
+        """``"compiled"`` or ``"interpreted"``: the form the next call uses. Without the
+        marker of a finished compilation (:func:`~dirac.codegen.numba_backend.ready_marker`)
+        the cache is cold, and neither numba nor the compiled module is imported to find out."""
+        if self._compiled is None and (self.module._compiled is not None or self.ready_marker().exists()) \
+                and is_compiled_or_cached(getattr(self.module.compiled, self.name)):
             self._compiled = getattr(self.module.compiled, self.name)
         return "interpreted" if self._compiled is None else "compiled"
+
+    def ready_marker(self) -> Path:
+        """The marker file of this function's machine code in the cache (found once)."""
+        if self._marker is None:
+            self._marker = ready_marker(source_path(self.module.source), self.name)
+        return self._marker
 
     def compile(self, why: str, args: tuple[Any, ...] | None = None) -> Callable[..., Any]:
         """Switch to the compiled form (compiled now, or loaded from the cache); with the
@@ -183,6 +200,7 @@ class TieredFunction:
                     start = time.process_time()
                     dispatcher.compile(tuple(numba.typeof(a) for a in args))
                     record_compile_seconds(len(self.module.source), time.process_time() - start, self.name)
+                    mark_ready(self.ready_marker())
             self._compiled = dispatcher
         return self._compiled
 
@@ -306,7 +324,9 @@ class TieredFunction:
             announce_compilation(f"{self.name} of {self.module.title}",
                                  f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
-            path = Path(str(self.module.compiled.__file__))
+            path = source_path(self.module.source)
+            if not path.exists():  # the file numba compiles from, written without importing it
+                write_source(self.module.source)
             self.background = BackgroundCompile(path, self.name, args, len(self.module.source))
         elif remaining > self.compile_estimate():
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted", args)
