@@ -47,7 +47,7 @@ from dirac.codegen.numba_backend import (
     write_source,
 )
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "background_enabled", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -56,6 +56,17 @@ COMPILE_SECONDS = 1.0
 #: interpreted seconds between two looks at a background compilation (a step loop runs in
 #: parts of about this length while one is in flight)
 CHECK_SECONDS = 0.05
+
+
+def spare_core() -> bool:
+    """Whether a core is idle for a background compilation: the 1-minute load average at
+    least one below the number of usable cores (on a busy machine a compiling child shares
+    the run's core, and compiling in the process costs less CPU)."""
+    try:
+        usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        return usable - os.getloadavg()[0] >= 1.0
+    except OSError:
+        return False
 
 
 def background_enabled() -> bool:
@@ -178,6 +189,8 @@ class TieredFunction:
         if self._compiled is None and (self.module._compiled is not None or self.ready_marker().exists()) \
                 and is_compiled_or_cached(getattr(self.module.compiled, self.name)):
             self._compiled = getattr(self.module.compiled, self.name)
+            if self.background is not None and self.background.poll() is not None:
+                self.background = None  # its work is done (or another process's was)
         return "interpreted" if self._compiled is None else "compiled"
 
     def ready_marker(self) -> Path:
@@ -320,7 +333,8 @@ class TieredFunction:
         remaining = math.inf if planned is None else per_step * planned
         if remaining <= COMPILE_SECONDS:
             return
-        if background_enabled():
+        estimate = self.compile_estimate()
+        if background_enabled() and (spare_core() or remaining < 2.0 * estimate):
             announce_compilation(f"{self.name} of {self.module.title}",
                                  f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
@@ -328,8 +342,11 @@ class TieredFunction:
             if not path.exists():  # the file numba compiles from, written without importing it
                 write_source(self.module.source)
             self.background = BackgroundCompile(path, self.name, args, len(self.module.source))
-        elif remaining > self.compile_estimate():
-            self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted", args)
+        elif remaining > estimate:
+            # no core to spare and a run far longer than the compilation: compiling here costs
+            # the least CPU (a child would share the core with the interpreted run)
+            self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
+                         "compile", args)
 
     def run_steps(self, steps: int, planned: int | None, *args: Any) -> Any:
         """Call a step loop advancing ``steps`` steps, of ``planned`` steps still to come
@@ -340,10 +357,13 @@ class TieredFunction:
         that can be split (arguments ``t, dt, n_steps, info``) is compiled in a separate
         process (:class:`~dirac.codegen.background.BackgroundCompile`) while it goes on
         interpreted, and switches to the compiled form at the first step boundary after
-        the compilation is done: no run waits for the compiler. Other loops, or with
+        the compilation is done: no run waits for the compiler. That happens when a core
+        is idle (:func:`spare_core`) or the run is shorter than twice the estimated
+        compile time (:func:`~dirac.codegen.background.estimate_compile_seconds`); on a
+        busy machine a longer run compiles in this process, since the interpreted time
+        still to come exceeds the wait. Other loops, or with
         ``DIRAC_BACKGROUND_COMPILE=0``, compile in this process when the interpreted
-        time still to come exceeds the estimated compile time
-        (:func:`~dirac.codegen.background.estimate_compile_seconds`).
+        time still to come exceeds the estimated compile time.
         """
         if self.tier == "interpreted" and self._split_positions() is not None:
             return self._split_run(steps, planned, args)
