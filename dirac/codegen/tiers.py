@@ -328,13 +328,13 @@ class TieredFunction:
             self.background_failed = True
             return
         per_step = self.seconds_per_step()
-        if per_step is None or self.background_failed:
+        if per_step is None:
             return
         remaining = math.inf if planned is None else per_step * planned
         if remaining <= COMPILE_SECONDS:
             return
         estimate = self.compile_estimate()
-        if background_enabled() and (spare_core() or remaining < 2.0 * estimate):
+        if background_enabled() and not self.background_failed and (spare_core() or remaining < 2.0 * estimate):
             announce_compilation(f"{self.name} of {self.module.title}",
                                  f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
