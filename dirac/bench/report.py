@@ -10,7 +10,7 @@ from pathlib import Path
 
 from dirac.versions import installed_versions
 
-__all__ = ["machine_description", "format_rows", "format_targets", "write_json", "write_plot"]
+__all__ = ["machine_description", "format_rows", "format_targets", "write_json", "write_plot", "wrap_title"]
 
 
 def _cpu_model() -> str:
@@ -158,6 +158,18 @@ _STYLE = {
 }
 
 
+def wrap_title(title: str, width: int = 100) -> str:
+    """``title`` in lines of at most ``width`` characters (the command, then the machine and
+    versions broken at commas and spaces): a line wider than the figure is cut off at both
+    ends, as the machine line was (100 characters of 7-point text fit a 6.4-inch figure)."""
+    import textwrap
+
+    lines: list[str] = []
+    for part in title.split(" -- "):
+        lines.extend(textwrap.wrap(part, width=width, break_on_hyphens=False) or [""])
+    return "\n".join(lines)
+
+
 def write_plot(path: str | Path, rows: list[dict], title: str) -> None:
     """CPU time against global error, log–log, one panel per problem."""
     import matplotlib
@@ -187,8 +199,10 @@ def write_plot(path: str | Path, rows: list[dict], title: str) -> None:
         axis.legend(fontsize=7)
     for index in range(len(problems), rows_of_panels * columns):
         axes[index // columns][index % columns].axis("off")
-    figure.suptitle(title, fontsize=9)
-    figure.tight_layout()
+    text = wrap_title(title, width=int(5.2 * columns * 72 / (0.6 * 9)))  # characters of 9-point text the width holds
+    lines = text.count("\n") + 1
+    figure.suptitle(text, fontsize=9)
+    figure.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.17 * lines / (4.2 * rows_of_panels)))  # room for the title's lines
     figure.savefig(path, dpi=110)
     plt.close(figure)
 

@@ -149,7 +149,9 @@ def write_scale_plot(path: str, rows: list[ScaleRow], title: str) -> None:
     axis.set_ylabel("dirac.analyze wall time [s]")
     axis.grid(True, which="major", alpha=0.3)
     axis.legend(fontsize=8)
-    axis.set_title(title.replace(" -- ", "\n", 1), fontsize=8)  # the machine line on a line of its own: not cut off
+    from dirac.bench.report import wrap_title
+
+    axis.set_title(wrap_title(title), fontsize=7)
     figure.tight_layout()
     figure.savefig(path, dpi=120)
     plt.close(figure)

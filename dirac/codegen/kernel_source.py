@@ -38,6 +38,7 @@ from types import ModuleType
 import sympy
 
 from dirac.codegen.field_body import dirac_field_body
+from dirac.codegen.flatten import flatten_source
 from dirac.codegen.kernel_templates import analysed_templates, mechanical_templates
 from dirac.codegen.numba_backend import import_source
 from dirac.codegen.printer import flat_expressions, straight_line
@@ -334,5 +335,6 @@ def _analysed_field(z: list[sympy.Symbol], parameters: Sequence[sympy.Symbol], h
 
 
 def load_kernels(source: str) -> ModuleType:
-    """Write ``source`` under its hash in the cache directory (once) and import it."""
-    return import_source(source)
+    """Write ``source`` (its helpers inlined: :func:`dirac.codegen.flatten.flatten_source`)
+    under its hash in the cache directory (once) and import it."""
+    return import_source(flatten_source(source))

@@ -236,10 +236,12 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     u = np.empty(__N__)
     work = np.empty((__N__, __N__))
     pivn = np.empty(__N__, dtype=np.int64)
-    chi = np.zeros(__M__)
-    G0 = np.zeros((__M__, __N__))
-    G1 = np.zeros((__M__, __N__))
-    W = np.zeros((__N__, __M__))
+    # every entry is written before it is read; np.empty only: each allocation form
+    # (np.zeros among them) is a numba implementation compiled once per process
+    chi = np.empty(__M__)
+    G0 = np.empty((__M__, __N__))
+    G1 = np.empty((__M__, __N__))
+    W = np.empty((__N__, __M__))
     S = np.empty((__M__, __M__))
     rhs = np.empty(__M__)
     mu = np.empty(__M__)

@@ -18,7 +18,8 @@ same way (:func:`import_source`).
 the same expressions with numpy (cross-checks, one-off evaluations).
 
 The cache directory is ``$DIRAC_CACHE_DIR`` if set, else ``~/.cache/dirac/generated``
-(falling back to the system temporary directory when the home is not writable).
+(falling back to the system temporary directory when the home is not writable); a folder
+owned by another user or writable by others is refused (:func:`cache_directory`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import os
+import stat
 import sys
 import tempfile
 from collections.abc import Iterable, Sequence
@@ -37,7 +39,8 @@ import sympy
 
 from dirac.codegen.printer import flat_expressions, straight_line
 
-__all__ = ["GeneratedFunction", "generate_module", "import_source", "interpret_source", "cache_directory"]
+__all__ = ["GeneratedFunction", "generate_module", "import_source", "interpret_source", "cache_directory", "source_path",
+           "ready_marker", "write_source"]
 
 
 @dataclass(frozen=True)
@@ -62,22 +65,68 @@ class GeneratedFunction:
     doc: str = ""
 
 
+def _unsafe(directory: Path) -> str | None:
+    """Why ``directory`` may not hold generated code (None: it may).
+
+    Generated modules are imported and numba's cache files are unpickled, both of which
+    run code: a folder another user owns, or one others may write to, would let them run
+    code as this user. Such a folder is refused."""
+    if not hasattr(os, "getuid"):
+        return None
+    try:
+        status = directory.lstat()
+    except OSError as error:
+        return f"cannot be inspected ({error.strerror})"
+    if stat.S_ISLNK(status.st_mode):
+        return "is a symbolic link"
+    if status.st_uid != os.getuid():
+        return f"is owned by another user (uid {status.st_uid})"
+    if status.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        return f"is writable by others (mode {stat.S_IMODE(status.st_mode):o})"
+    return None
+
+
+_private: Path | None = None
+
+
 def cache_directory() -> Path:
-    """The directory holding generated modules (created on first use)."""
+    """The directory holding generated modules (created on first use).
+
+    ``$DIRAC_CACHE_DIR`` if set, else ``~/.cache/dirac/generated``, else (home not writable)
+    ``dirac-generated-<uid>`` in the system temporary directory. A candidate owned by
+    another user or writable by others is refused with a ``warning:`` line (importing its
+    modules or numba's pickled cache files would run code someone else wrote); when none is
+    left, a private folder (``tempfile.mkdtemp``, mode 700) holds the code of this process.
+    """
+    global _private
     configured = os.environ.get("DIRAC_CACHE_DIR")
     candidates = [Path(configured)] if configured else []
     candidates.append(Path.home() / ".cache" / "dirac" / "generated")
     candidates.append(Path(tempfile.gettempdir()) / f"dirac-generated-{os.getuid() if hasattr(os, 'getuid') else 0}")
     for candidate in candidates:
         try:
-            candidate.mkdir(parents=True, exist_ok=True)
+            candidate.mkdir(parents=True, exist_ok=True, mode=0o700)
+            problem = _unsafe(candidate)
+            if problem is not None:
+                if candidate not in _refused:
+                    _refused.add(candidate)
+                    from dirac.errors import warn
+
+                    warn(f"the cache folder of generated code {candidate} {problem}: not used, since loading code "
+                         "from it would run what someone else wrote; set DIRAC_CACHE_DIR to a folder of your own")
+                continue
             probe = candidate / ".write-test"
             probe.write_text("ok")
             probe.unlink()
             return candidate
         except OSError:
             continue
-    raise OSError("no writable cache directory for generated code; set DIRAC_CACHE_DIR")
+    if _private is None or not _private.is_dir():
+        _private = Path(tempfile.mkdtemp(prefix="dirac-generated-"))
+    return _private
+
+
+_refused: set[Path] = set()
 
 
 def _function_source(function: GeneratedFunction, parameters: Sequence[sympy.Symbol]) -> str:
@@ -134,6 +183,28 @@ def generate_module(
     return import_source(source)
 
 
+def source_path(source: str) -> Path:
+    """The file :func:`import_source` writes ``source`` to: ``dirac_gen_<hash>.py`` in the cache."""
+    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
+    return cache_directory() / f"dirac_gen_{digest}.py"
+
+
+def ready_marker(path: Path, name: str) -> Path:
+    """The file that says function ``name`` of the generated module at ``path`` is in numba's
+    on-disk cache (written after a compilation; read without importing numba)."""
+    return path.with_name(f"{path.stem}.{name}.ready")
+
+
+def write_source(source: str) -> Path:
+    """Write ``source`` to :func:`source_path` (unless the file holds it already); its path."""
+    path = source_path(source)
+    if not path.exists() or path.read_text(encoding="utf-8") != source:
+        temporary = path.with_suffix(f".{os.getpid()}.tmp")
+        temporary.write_text(source, encoding="utf-8")
+        os.replace(temporary, path)
+    return path
+
+
 def import_source(source: str) -> ModuleType:
     """Write ``source`` to ``dirac_gen_<hash>.py`` in :func:`cache_directory` (unless a file
     of that name holds it already) and import it, once per process.
@@ -141,15 +212,11 @@ def import_source(source: str) -> ModuleType:
     The module name is the hash of the source, so numba's on-disk cache of the module's
     ``cache=True`` functions is reused by every later run that generates the same source.
     """
-    digest = hashlib.sha256(source.encode()).hexdigest()[:20]
-    module_name = f"dirac_gen_{digest}"
+    path = source_path(source)
+    module_name = path.stem
     if module_name in sys.modules:
         return sys.modules[module_name]
-    path = cache_directory() / f"{module_name}.py"
-    if not path.exists() or path.read_text(encoding="utf-8") != source:
-        temporary = path.with_suffix(f".{os.getpid()}.tmp")
-        temporary.write_text(source, encoding="utf-8")
-        os.replace(temporary, path)
+    write_source(source)
     spec = importlib.util.spec_from_file_location(module_name, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

@@ -25,23 +25,54 @@ differs. The first compilation in a process writes one line to stderr
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import numpy as np
 
-from dirac.codegen.numba_backend import cache_directory, import_source, interpret_source
+from dirac.codegen.background import BackgroundCompile, estimate_compile_seconds, mark_ready, record_compile_seconds
+from dirac.codegen.flatten import flatten_source
+from dirac.codegen.numba_backend import (
+    cache_directory,
+    import_source,
+    interpret_source,
+    ready_marker,
+    source_path,
+    write_source,
+)
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
 #: a small kernel; ``dirac bench`` measures the actual figures)
 COMPILE_SECONDS = 1.0
+#: interpreted seconds between two looks at a background compilation (a step loop runs in
+#: parts of about this length while one is in flight)
+CHECK_SECONDS = 0.05
+
+
+def spare_core() -> bool:
+    """Whether a core is idle for a background compilation: the 1-minute load average at
+    least one below the number of usable cores (on a busy machine a compiling child shares
+    the run's core, and compiling in the process costs less CPU)."""
+    try:
+        usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        return usable - os.getloadavg()[0] >= 1.0
+    except OSError:
+        return False
+
+
+def background_enabled() -> bool:
+    """Whether step loops compile in a separate process (``$DIRAC_BACKGROUND_COMPILE``,
+    default on; ``0`` compiles in this process, when that pays)."""
+    return os.environ.get("DIRAC_BACKGROUND_COMPILE", "1") != "0"
 
 _announced = False
 
@@ -102,7 +133,7 @@ class TieredModule:
     """The interpreted and the compiled form of one generated module (each made on first use)."""
 
     def __init__(self, source: str, title: str) -> None:
-        self.source = source
+        self.source = flatten_source(source)  # helpers inlined at the source level, for both tiers
         self.title = title
         self._compiled: ModuleType | None = None
         self._interpreted: ModuleType | None = None
@@ -145,30 +176,59 @@ class TieredFunction:
         self.interpreted_seconds = 0.0
         self.interpreted_steps = 0
         self.interpreted_calls = 0
+        self.background: BackgroundCompile | None = None
+        self.background_failed = False
+        self._split: tuple[int, int, int, int] | None | bool = False  # not looked at yet
+        self._marker: Path | None = None
 
     @property
     def tier(self) -> str:
-        """``"compiled"`` or ``"interpreted"``: the form the next call uses."""
-        if self._compiled is None and is_compiled_or_cached(getattr(self.module.compiled, self.name)):
+        """``"compiled"`` or ``"interpreted"``: the form the next call uses. Without the
+        marker of a finished compilation (:func:`~dirac.codegen.numba_backend.ready_marker`)
+        the cache is cold, and neither numba nor the compiled module is imported to find out."""
+        if self._compiled is None and (self.module._compiled is not None or self.ready_marker().exists()) \
+                and is_compiled_or_cached(getattr(self.module.compiled, self.name)):
             self._compiled = getattr(self.module.compiled, self.name)
+            if self.background is not None and self.background.poll() is not None:
+                self.background = None  # its work is done (or another process's was)
         return "interpreted" if self._compiled is None else "compiled"
 
-    def compile(self, why: str) -> Callable[..., Any]:
-        """Switch to the compiled form (compiled now, or loaded from the cache)."""
+    def ready_marker(self) -> Path:
+        """The marker file of this function's machine code in the cache (found once)."""
+        if self._marker is None:
+            self._marker = ready_marker(source_path(self.module.source), self.name)
+        return self._marker
+
+    def compile(self, why: str, args: tuple[Any, ...] | None = None) -> Callable[..., Any]:
+        """Switch to the compiled form (compiled now, or loaded from the cache); with the
+        call's ``args``, the compilation is timed and recorded in the history of
+        :mod:`dirac.codegen.background`."""
         if self._compiled is None:
             dispatcher = getattr(self.module.compiled, self.name)
             if not is_compiled_or_cached(dispatcher):
                 announce_compilation(f"{self.name} of {self.module.title}", why)
+                if args is not None:
+                    import numba
+
+                    start = time.process_time()
+                    dispatcher.compile(tuple(numba.typeof(a) for a in args))
+                    record_compile_seconds(len(self.module.source), time.process_time() - start, self.name)
+                    mark_ready(self.ready_marker())
             self._compiled = dispatcher
         return self._compiled
 
+    def compile_estimate(self) -> float:
+        """Estimated seconds to compile this function (:func:`estimate_compile_seconds` of
+        the module's source size and the measured history in the cache)."""
+        return estimate_compile_seconds(len(self.module.source))
+
     def seconds_per_step(self) -> float | None:
-        """Measured interpreted seconds per step (None before an interpreted call)."""
+        """Measured interpreted seconds (CPU) per step (None before an interpreted call)."""
         return self.interpreted_seconds / self.interpreted_steps if self.interpreted_steps else None
 
     def _interpreted_call(self, steps: int, args: tuple[Any, ...]) -> Any:
         function = getattr(self.module.interpreted, self.name)
-        start = time.perf_counter()
+        start = time.process_time()  # CPU, as the compile estimates: a busy machine slows both alike
         saved = [(a, a.copy()) for a in args if isinstance(a, np.ndarray)]  # the state the call changes in place
         try:
             with np.errstate(divide="raise", over="ignore", invalid="ignore", under="ignore"):
@@ -182,7 +242,7 @@ class TieredFunction:
                 array[...] = before
             return self.compile("the interpreted kernel overflowed (math range error)")(*args)
         finally:
-            self.interpreted_seconds += time.perf_counter() - start
+            self.interpreted_seconds += time.process_time() - start
             self.interpreted_steps += steps
             self.interpreted_calls += 1
 
@@ -190,42 +250,151 @@ class TieredFunction:
         """Call with the budget of single evaluations: interpreted until the interpreted
         time reaches :data:`COMPILE_SECONDS`, compiled afterwards."""
         if self.tier == "interpreted" and current_policy() == "compiled":
-            self.compile("DIRAC_KERNELS=compiled")
+            self.compile("DIRAC_KERNELS=compiled", args)
         if self.tier == "interpreted" and self.interpreted_seconds > COMPILE_SECONDS:
-            self.compile(f"{self.interpreted_calls} interpreted calls took {self.interpreted_seconds:.1f} s")
+            self.compile(f"{self.interpreted_calls} interpreted calls took {self.interpreted_seconds:.1f} s", args)
         if self._compiled is not None:
             return self._compiled(*args)
         return self._interpreted_call(1, args)
 
+    # ------------------------------------------------------------------ step loops
+    def _split_positions(self) -> tuple[int, int, int, int] | None:
+        """Positions of ``t``, ``dt``, ``n_steps`` and ``info`` among the arguments of a step
+        loop (``info = [steps_done, failed, evaluations, residual]``): such a loop can be
+        run as consecutive shorter loops, which lets a run switch tier at a step boundary."""
+        if self._split is False:
+            import inspect
+
+            names = list(inspect.signature(getattr(self.module.interpreted, self.name)).parameters)
+            wanted = ("t", "dt", "n_steps", "info")
+            self._split = tuple(names.index(w) for w in wanted) if all(w in names for w in wanted) else None  # type: ignore[assignment]
+        return self._split  # type: ignore[return-value]
+
+    def _part(self, args: tuple[Any, ...], done: int, count: int, compiled: bool) -> tuple[float, bool]:
+        """Steps ``done .. done + count`` of the loop ``args``: (evaluations, failed)."""
+        t, dt, n, info = self._split_positions()  # type: ignore[misc]
+        part = list(args)
+        part[t] = args[t] + done * args[dt] if done else args[t]
+        part[n] = count
+        if compiled:
+            self._compiled(*part)  # type: ignore[misc]
+        else:
+            self._interpreted_call(count, tuple(part))
+        return float(args[info][2]), bool(args[info][1] != 0.0)
+
+    def _split_run(self, steps: int, planned: int | None, args: tuple[Any, ...]) -> None:
+        """The loop ``args`` of ``steps`` steps in parts: one interpreted step first when
+        no interpreted time per step is known yet, then parts of about
+        :data:`CHECK_SECONDS` interpreted while a background compilation runs, the rest
+        compiled as soon as it is done (or all interpreted when compiling does not pay)."""
+        info = args[self._split_positions()[3]]  # type: ignore[index]
+        done, evaluations = 0, 0.0
+        while done < steps:
+            if self._compiled is None:
+                self._decide(planned if planned is None else max(planned - done, steps - done), args)
+            count = steps - done
+            compiled = self._compiled is not None
+            if not compiled:
+                per_step = self.seconds_per_step()
+                if per_step is None:
+                    count = 1
+                elif self.background is not None:
+                    count = max(1, min(count, int(CHECK_SECONDS / max(per_step, 1e-9))))
+            used, failed = self._part(args, done, count, compiled)
+            evaluations += used
+            if failed:
+                info[0] += done
+                info[2] = evaluations
+                return
+            done += count
+        info[0] = steps
+        info[2] = evaluations
+
+    def _decide(self, planned: int | None, args: tuple[Any, ...]) -> None:
+        """Switch to the compiled form when it is ready or pays (see :meth:`run_steps`)."""
+        if self.tier == "compiled":
+            return
+        if current_policy() == "compiled":
+            self.compile("DIRAC_KERNELS=compiled", args)
+            return
+        if self.background is not None:
+            state = self.background.poll()
+            if state is None:
+                return
+            self.background = None
+            if state and is_compiled_or_cached(getattr(self.module.compiled, self.name)):
+                self._compiled = getattr(self.module.compiled, self.name)
+                return
+            self.background_failed = True
+            return
+        per_step = self.seconds_per_step()
+        if per_step is None:
+            return
+        remaining = math.inf if planned is None else per_step * planned
+        if remaining <= COMPILE_SECONDS:
+            return
+        estimate = self.compile_estimate()
+        if background_enabled() and not self.background_failed and (spare_core() or remaining < 2.0 * estimate):
+            announce_compilation(f"{self.name} of {self.module.title}",
+                                 f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
+                                 f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
+            path = source_path(self.module.source)
+            if not path.exists():  # the file numba compiles from, written without importing it
+                write_source(self.module.source)
+            self.background = BackgroundCompile(path, self.name, args, len(self.module.source))
+        elif remaining > estimate:
+            # no core to spare and a run far longer than the compilation: compiling here costs
+            # the least CPU (a child would share the core with the interpreted run)
+            self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
+                         "compile", args)
+
     def run_steps(self, steps: int, planned: int | None, *args: Any) -> Any:
         """Call a step loop advancing ``steps`` steps, of ``planned`` steps still to come
-        (these included; None: unknown, which compiles at once).
+        (these included; None: unknown).
 
         Interpreted while the interpreted time of what is planned (measured seconds per
-        step times ``planned``) stays below :data:`COMPILE_SECONDS`; compiled otherwise.
+        step times ``planned``) stays below :data:`COMPILE_SECONDS`. Beyond it, a loop
+        that can be split (arguments ``t, dt, n_steps, info``) is compiled in a separate
+        process (:class:`~dirac.codegen.background.BackgroundCompile`) while it goes on
+        interpreted, and switches to the compiled form at the first step boundary after
+        the compilation is done: no run waits for the compiler. That happens when a core
+        is idle (:func:`spare_core`) or the run is shorter than twice the estimated
+        compile time (:func:`~dirac.codegen.background.estimate_compile_seconds`); on a
+        busy machine a longer run compiles in this process, since the interpreted time
+        still to come exceeds the wait. Other loops, or with
+        ``DIRAC_BACKGROUND_COMPILE=0``, compile in this process when the interpreted
+        time still to come exceeds the estimated compile time.
         """
+        if self.tier == "interpreted" and self._split_positions() is not None:
+            return self._split_run(steps, planned, args)
         if self.tier == "interpreted":
             per_step = self.seconds_per_step()
             if current_policy() == "compiled":
-                self.compile("DIRAC_KERNELS=compiled")
+                self.compile("DIRAC_KERNELS=compiled", args)
             elif planned is None:
-                self.compile("a run of unknown length")
-            elif per_step is not None and per_step * planned > COMPILE_SECONDS:
-                self.compile(f"about {planned} steps to go, {per_step * planned:.1f} s interpreted")
+                self.compile("a run of unknown length", args)
+            elif per_step is not None and per_step * planned > max(COMPILE_SECONDS, self.compile_estimate()):
+                self.compile(f"about {planned} steps to go, {per_step * planned:.1f} s interpreted", args)
             elif per_step is None and steps > 1:
                 # no estimate yet: one interpreted step first would need a split of the call
-                self.compile(f"a run of {planned} steps")
+                self.compile(f"a run of {planned} steps", args)
         if self._compiled is not None:
             return self._compiled(*args)
         return self._interpreted_call(steps, args)
 
     def warm_up(self, planned: int | None, *args: Any) -> None:
         """A one-step call on scratch arguments before a run of ``planned`` steps: measures
-        the interpreted time per step and, when the run would take longer than
-        :data:`COMPILE_SECONDS` interpreted, compiles now (before the run's clock starts)."""
+        the interpreted time per step and decides the tier (before the run's clock starts)."""
         if self.tier == "interpreted" and current_policy() == "auto" and planned is not None and self.seconds_per_step() is None:
             self._interpreted_call(1, args)
         self.run_steps(1, planned, *args)
+
+    def finish_background(self, timeout: float | None = None) -> bool | None:
+        """Wait for a background compilation of this function (tests, benchmarks): True
+        when it filled the cache, False when it failed, None when none ran or it is still running."""
+        if self.background is None:
+            return None
+        return self.background.wait(timeout)
 
 
 def tiered(module: Any, name: str) -> Any:

@@ -1,7 +1,7 @@
 """``dirac bench``: work–precision benchmark against scipy baselines, in one run.
 
 ``dirac bench [--quick] [--json FILE] [--plot FILE.png]``. The flags ``--stress``,
-``--ensemble`` and ``--scale`` (:mod:`dirac.commands.bench_scale`) hand over to their own commands, :mod:`dirac.commands.bench_stress` and
+``--ensemble``, ``--latency`` (:mod:`dirac.commands.bench_latency`) and ``--scale`` (:mod:`dirac.commands.bench_scale`) hand over to their own commands, :mod:`dirac.commands.bench_stress` and
 :mod:`dirac.commands.bench_ensemble`, when those are installed.
 """
 
@@ -30,6 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
     parser.add_argument("--stress", action="store_true", help="run the stress benchmark instead (docs/stress.md)")
     parser.add_argument("--ensemble", action="store_true", help="run the ensemble benchmark instead (docs/ensembles.md)")
+    parser.add_argument("--latency", action="store_true",
+                        help="time to the first result on everyday systems, fresh process and empty cache (docs/performance.md)")
     parser.add_argument("--scale", action="store_true",
                         help="analysis time against system size instead, with fitted exponents (docs/scale.md)")
     return parser
@@ -58,9 +60,9 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _main(args: argparse.Namespace) -> int:
-    chosen = [flag for flag in ("stress", "ensemble", "scale") if getattr(args, flag, False)]
+    chosen = [flag for flag in ("stress", "ensemble", "scale", "latency") if getattr(args, flag, False)]
     if len(chosen) > 1:
-        raise InputError(f"give only one of --stress, --ensemble, --scale, not {' and '.join('--' + f for f in chosen)}")
+        raise InputError(f"give only one of --stress, --ensemble, --scale, --latency, not {' and '.join('--' + f for f in chosen)}")
     if args.stress:
         return _delegate("stress", "dirac.commands.bench_stress", args)
     if args.ensemble:
@@ -77,6 +79,10 @@ def _main(args: argparse.Namespace) -> int:
             raise InputError("--plot needs matplotlib: pip install 'dirac-mechanics[plot]'") from None
     if args.scale:
         return _delegate("scale", "dirac.commands.bench_scale", args)
+    if getattr(args, "latency", False):
+        if args.plot:
+            raise InputError("--latency draws no picture: drop --plot")
+        return _delegate("latency", "dirac.commands.bench_latency", args)
     from dirac.bench.run import run_benchmark
 
     run_benchmark(quick=bool(args.quick), json_path=args.json, plot_path=args.plot, progress=not args.no_progress and getattr(args, "verbosity", 0) >= 0)

@@ -3,6 +3,7 @@ the first compilation says so on stderr, once, and never on a warm cache."""
 
 from __future__ import annotations
 
+import math
 import sys
 
 import numpy as np
@@ -99,3 +100,77 @@ def test_policy_names_are_checked(monkeypatch) -> None:
     monkeypatch.setenv("DIRAC_KERNELS", "fastest")
     with pytest.warns(UserWarning, match="DIRAC_KERNELS='fastest'"):
         assert tiers.current_policy() == "auto"
+
+
+_LOOP = '''"""loop -- generated for a test"""
+import math
+import numpy as np
+import numba
+
+
+@numba.njit(cache=True)
+def run(x, t, dt, n_steps, info):
+    """n_steps of x <- x + sin(x) / 8 from time t (a step loop with the arguments a tier may split)."""
+    evals = 0.0
+    for step in range(n_steps):
+        x[0] = x[0] + math.sin(x[0]) / 8.0
+        evals += 1.0
+    info[0] = n_steps
+    info[1] = 0.0
+    info[2] = evals
+    info[3] = 0.0
+'''
+
+
+def _hand_loop(x: float, steps: int) -> float:
+    for _ in range(steps):
+        x = x + math.sin(x) / 8.0
+    return x
+
+
+def _loop_module(tmp_path, monkeypatch) -> tiers.TieredFunction:
+    monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(tiers, "_announced", False)
+    monkeypatch.setattr(tiers, "_policy", "auto")
+    return tiers.TieredModule(_LOOP.replace("for a test", f"for a test in {tmp_path.name}"), "a loop").function("run")
+
+
+def test_a_long_loop_compiles_in_the_background_and_switches_at_a_step_boundary(tmp_path, monkeypatch, capsys) -> None:
+    """Planned far beyond a second of interpreted work with an idle core: a child process
+    compiles while the loop goes on interpreted in parts; after it is done the next part runs
+    compiled. The iterates are the hand loop's to the last bit (the same operations)."""
+    monkeypatch.setattr(tiers, "spare_core", lambda: True)
+    function = _loop_module(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(300, 10**9, x, 0.0, 0.1, 300, info)
+    assert function.background is not None and function.tier == "interpreted"
+    assert "in a separate process" in capsys.readouterr().err
+    assert (info[0], info[1], info[2]) == (300, 0.0, 300)  # parts add up to one call's report
+    assert function.finish_background(timeout=300) is True
+    function.run_steps(200, 10**9, x, 30.0, 0.1, 200, info)
+    assert function.tier == "compiled" and function.background is None
+    assert x[0] == _hand_loop(0.5, 500)
+    assert function.ready_marker().exists()
+    history = (tmp_path / "compile_history.json").read_text()
+    assert '"chars"' in history and "background" in history
+
+
+def test_a_long_loop_on_a_busy_machine_compiles_in_the_process(tmp_path, monkeypatch) -> None:
+    """No idle core and a run far longer than the estimated compilation: compiled at once in
+    the process (the cheapest in CPU), after one interpreted step that measured the rate."""
+    monkeypatch.setattr(tiers, "spare_core", lambda: False)
+    function = _loop_module(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(50, 10**12, x, 0.0, 0.1, 50, info)
+    assert function.background is None and function.tier == "compiled"
+    assert function.interpreted_steps == 1
+    assert x[0] == _hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
+
+
+def test_a_short_loop_stays_interpreted_and_starts_no_compilation(tmp_path, monkeypatch) -> None:
+    monkeypatch.setattr(tiers, "spare_core", lambda: True)
+    function = _loop_module(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
+    assert function.background is None and function.tier == "interpreted"
+    assert x[0] == _hand_loop(0.5, 40) and info[0] == 40

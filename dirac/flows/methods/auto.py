@@ -95,8 +95,10 @@ def _state(stepper) -> np.ndarray:
 
 
 def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) -> np.ndarray:
-    stepper = get_method(method_name).start(problem, outputs, options)
     n = max(1, int(round(span / dt)))
+    # a pilot of known length: a generated kernel stays interpreted unless n steps of it
+    # would take longer than compiling (dirac.codegen.tiers); unknown, it compiled at once
+    stepper = get_method(method_name).start(problem, outputs, {**options, "planned_steps": n})
     stepper.step(n, span / n)
     return _state(stepper)
 
@@ -271,7 +273,7 @@ def _forced(problem, t_end: float, tolerance: float, dt: float | None, outputs, 
     best_cost = math.inf
     for name in candidates:
         step, predicted = _richardson_step(name, problem, outputs, dt_start, t_end, tolerance, options)
-        stepper = get_method(name).start(problem, outputs, options)
+        stepper = get_method(name).start(problem, outputs, {**options, "planned_steps": 4})
         stepper.step(4, step)
         cost = math.ceil(t_end / step) * max(1.0, stepper.evaluations / 4.0)
         if cost < best_cost:

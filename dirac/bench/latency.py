@@ -1,0 +1,271 @@
+"""Latency to the first result on everyday systems, timed the way a new user meets them.
+
+``dirac bench --latency``. Each system of the corpus (``dirac_systems.latency_models``:
+pendulums and double pendulums in angles and in Cartesian coordinates, a triple pendulum,
+tops in Euler angles, a bead on a turning hoop, a relativistic particle) is run in a
+fresh Python process with an empty cache of generated code (a temporary
+``DIRAC_CACHE_DIR`` and ``NUMBA_CACHE_DIR``) and the default kernel policy, interpreter
+start included:
+
+* **first**: ``t_end = 1`` with the default method (``rattle-2``, ``dt = 1e-3`` for the
+  tops in Euler angles);
+* **study**: ``10^5`` steps (``rattle-2``, or ``midpoint`` on an analysed flow, at
+  ``dt = 1e-3``), compilation included;
+* **t=100**: ``t_end = 100`` with the default method, side by side with **scipy**:
+  ``solve_ivp`` with DOP853 at ``rtol = 1e-8`` on a hand-written right-hand side of the
+  same motion, in a fresh process too (pendulum-like systems); the ratio is the
+  machine-independent figure.
+
+Each run prints its largest relative error of the energy (or of the Jacobi integral).
+The paper's three rigid-body Lagrangians are timed end to end as ``dirac analyze NAME``.
+Wall time is what a user waits; CPU time (user + system of the child, without a
+background compilation it left running) is steadier on a loaded machine. Finally the
+compilations the runs made (``compile_history.json`` of each cache) give compile time
+against kernel size.
+
+The module imports only the standard library: the children import ``dirac``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+__all__ = ["LatencyRow", "run_latency", "format_latency", "CORPUS", "ANALYZE_TARGETS", "FIRST_TARGET", "STUDY_TARGET"]
+
+#: the corpus (names of ``dirac_systems.latency_models.MODELS``)
+CORPUS = ("pendulum_angle", "double_pendulum_angles", "triple_pendulum_angles", "pendulum_cartesian",
+          "double_pendulum_cartesian", "symmetric_top_euler", "asymmetric_top_euler", "bead_on_rotating_hoop",
+          "relativistic_oscillator")
+#: ``dirac analyze NAME`` end to end and its target in seconds of wall time
+ANALYZE_TARGETS = {"rigid_body_momentum": 3.0, "rigid_body_particles": 2.5, "rigid_body_matrix": 2.0}
+#: targets of a first result and of a 1e5-step study, seconds of wall time
+FIRST_TARGET = 2.0
+STUDY_TARGET = 5.0
+
+_RUN = r'''
+import json, sys
+import numpy as np
+spec = json.loads(sys.argv[1])
+import dirac
+from dirac_systems.latency_models import MODELS
+model = MODELS[spec["model"]]()
+if model.road == "analysed":
+    from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
+    problem = AnalysedProblem(AnalysedSystem.from_analysis(dirac.analyze(model.system)), model.state)
+else:
+    n = len(model.state) // 2
+    problem = dirac.ConstrainedProblem(model.system, q0=model.state[:n], p0=model.state[n:])
+kwargs = {"t_end": spec["t_end"], "samples": spec["samples"]}
+if spec["method"] is not None:
+    kwargs["dt"] = spec["dt"]
+    run = dirac.integrate(problem, spec["method"], **kwargs)
+else:
+    run = dirac.integrate(problem, **kwargs)
+energy = np.asarray(run["energy"], dtype=float)
+scale = max(abs(energy[0]), 1e-300)
+print(json.dumps({"method": run.method, "steps": int(run.steps), "error": float(np.max(np.abs(energy - energy[0])) / scale),
+                  "engine": dirac.__file__}))
+'''
+
+_SCIPY = r'''
+import json, math, sys
+import numpy as np
+from scipy.integrate import solve_ivp
+spec = json.loads(sys.argv[1])
+g, l = 9.81, 1.0
+if spec["baseline"] == "pendulum":
+    def rhs(t, y):
+        return [y[1], -g / l * math.sin(y[0])]
+    def energy(y):
+        return 0.5 * y[1] ** 2 - g / l * np.cos(y[0])
+    y0 = [1.0, 0.0]
+else:  # double pendulum, unit masses and rods, in its angles (Landau & Lifshitz Sect. 5)
+    def rhs(t, y):
+        a, b, wa, wb = y
+        d = a - b
+        s, c = math.sin(d), math.cos(d)
+        den = 2.0 - c * c
+        da = (-s * (wb * wb + wa * wa * c) - 2.0 * g * math.sin(a) + g * math.sin(b) * c) / den
+        db = (s * (2.0 * wa * wa + wb * wb * c) + 2.0 * g * (math.sin(a) * c - math.sin(b))) / den
+        return [wa, wb, da, db]
+    def energy(y):
+        a, b, wa, wb = y
+        return wa ** 2 + 0.5 * wb ** 2 + wa * wb * np.cos(a - b) - 2.0 * g * np.cos(a) - g * np.cos(b)
+    y0 = [1.0, 0.5, 0.0, 0.0]
+t_eval = np.linspace(0.0, spec["t_end"], spec["samples"])
+solution = solve_ivp(rhs, (0.0, spec["t_end"]), y0, method="DOP853", rtol=1e-8, atol=1e-10, t_eval=t_eval)
+e = energy(solution.y)
+print(json.dumps({"method": "scipy DOP853 rtol=1e-8", "steps": int(solution.t.size), "error": float(np.max(np.abs(e - e[0])) / abs(e[0]))}))
+'''
+
+
+@dataclass
+class LatencyRow:
+    """One timed run: which system and run, wall and CPU seconds, what it measured."""
+
+    system: str
+    run: str
+    wall: float
+    cpu: float
+    method: str = ""
+    steps: int = 0
+    error: float | None = None
+    conserved: str = "energy"
+    target: float | None = None
+    failed: str = ""
+    compilations: list[dict[str, object]] = field(default_factory=list)
+
+
+def _child(arguments: list[str], pythonpath: str | None, timeout: float) -> tuple[float, float, str, str, int, list]:
+    """Run ``python arguments`` fresh with an empty cache: (wall, cpu, stdout, stderr, exit code, compilations)."""
+    with tempfile.TemporaryDirectory(prefix="dirac-latency-") as scratch:
+        env = dict(os.environ, DIRAC_CACHE_DIR=os.path.join(scratch, "dirac"), NUMBA_CACHE_DIR=os.path.join(scratch, "numba"))
+        env.pop("DIRAC_KERNELS", None)  # the default policy, as a user meets it
+        if pythonpath:
+            env["PYTHONPATH"] = pythonpath + os.pathsep + env.get("PYTHONPATH", "")
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        try:
+            done = subprocess.run([sys.executable, *arguments], capture_output=True, text=True, env=env, timeout=timeout)
+            out, err, code = done.stdout, done.stderr, done.returncode
+        except subprocess.TimeoutExpired:
+            out, err, code = "", f"timed out after {timeout:.0f} s", -1
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        try:
+            compilations = json.loads((Path(scratch) / "dirac" / "compile_history.json").read_text())
+        except (OSError, ValueError):
+            compilations = []
+    return wall, cpu, out, err, code, compilations
+
+
+def _row(system: str, run: str, arguments: list[str], pythonpath: str | None, timeout: float, target: float | None,
+         conserved: str = "energy") -> LatencyRow:
+    wall, cpu, out, err, code, compilations = _child(arguments, pythonpath, timeout)
+    row = LatencyRow(system, run, wall, cpu, conserved=conserved, target=target, compilations=compilations)
+    lines = [line for line in out.splitlines() if line.startswith("{")]
+    if code != 0 or (arguments[0] == "-c" and not lines):
+        tail = [line for line in err.strip().splitlines() if line.strip()]
+        row.failed = tail[-1][:160] if tail else f"exit status {code}"
+        return row
+    if lines:
+        result = json.loads(lines[-1])
+        row.method, row.steps, row.error = result["method"], int(result["steps"]), result["error"]
+    return row
+
+
+def run_latency(models: Sequence[str] = CORPUS, *, first_t_end: float = 1.0, study_steps: int = 100_000,
+                long_t_end: float = 100.0, samples: int = 101, analyze: Sequence[str] = tuple(ANALYZE_TARGETS),
+                scipy: bool = True, pythonpath: str | None = None, timeout: float = 600.0,
+                progress: Callable[[str], None] | None = None) -> list[LatencyRow]:
+    """Time the corpus (see the module docstring); one :class:`LatencyRow` per run.
+
+    Parameters
+    ----------
+    models
+        Names in ``dirac_systems.latency_models.MODELS``.
+    first_t_end, study_steps, long_t_end, samples
+        The first run's span, the study's steps (at ``dt = 1e-3``), the span of the run
+        set against scipy (0: none), output samples of every run.
+    analyze
+        Systems timed as ``dirac analyze NAME``.
+    scipy
+        Time the scipy baselines of pendulum-like systems.
+    pythonpath
+        Put this in front of the children's ``PYTHONPATH`` (time another checkout of the
+        engine with this corpus).
+    timeout
+        Seconds after which a child is stopped (the row says so).
+    """
+    import importlib
+
+    latency_models = importlib.import_module("dirac_systems.latency_models").MODELS
+    rows: list[LatencyRow] = []
+    baselines_done: dict[str, LatencyRow] = {}
+
+    def say(text: str) -> None:
+        if progress is not None:
+            progress(text)
+
+    for name in models:
+        model = latency_models[name]()
+        conserved = model.conserved
+
+        def timed(run: str, method: str | None, dt: float | None, t_end: float, target: float | None,
+                  name: str = name, conserved: str = conserved) -> None:
+            spec = {"model": name, "method": method, "dt": dt, "t_end": t_end, "samples": samples}
+            say(f"latency: {name} {run}")
+            rows.append(_row(name, run, ["-c", _RUN, json.dumps(spec)], pythonpath, timeout, target, conserved))
+
+        timed(f"first (t_end={first_t_end:g})", model.first_method, model.first_dt, first_t_end, FIRST_TARGET)
+        if study_steps:
+            method = "midpoint" if model.road == "analysed" else "rattle-2"
+            timed(f"study ({study_steps:.0e} steps)", method, 1e-3, study_steps * 1e-3, STUDY_TARGET)
+        if long_t_end and model.baseline is not None:
+            timed(f"t_end={long_t_end:g}", None, None, long_t_end, None)
+            if scipy:
+                if model.baseline not in baselines_done:
+                    spec = {"baseline": model.baseline, "t_end": long_t_end, "samples": samples}
+                    say(f"latency: scipy {model.baseline}")
+                    baselines_done[model.baseline] = _row(f"scipy {model.baseline}", f"t_end={long_t_end:g}",
+                                                          ["-c", _SCIPY, json.dumps(spec)], pythonpath, timeout, None)
+                    rows.append(baselines_done[model.baseline])
+    for name in analyze:
+        say(f"latency: dirac analyze {name}")
+        rows.append(_row(name, "dirac analyze", ["-m", "dirac", "analyze", name], pythonpath, timeout,
+                         ANALYZE_TARGETS.get(name)))
+    return rows
+
+
+def _ratio(rows: list[LatencyRow], row: LatencyRow) -> str:
+    """A t_end run against the scipy baseline of its system (CPU and wall)."""
+    import importlib
+
+    if row.system.startswith("scipy") or not row.run.startswith("t_end="):
+        return ""
+    baseline = importlib.import_module("dirac_systems.latency_models").MODELS[row.system]().baseline
+    for other in rows:
+        if other.system == f"scipy {baseline}" and other.run == row.run and not other.failed:
+            return f"{row.cpu / other.cpu:.2f} / {row.wall / other.wall:.2f}"
+    return ""
+
+
+def format_latency(rows: list[LatencyRow]) -> str:
+    """The latency table (and compile time against kernel size) as text."""
+    lines = [f"{'system':28s} {'run':22s} {'method':22s} {'steps':>7s} {'wall s':>7s} {'cpu s':>6s} {'target':>6s}"
+             f" {'rel. error':>20s}  vs scipy cpu / wall"]
+    for row in rows:
+        if row.failed:
+            lines.append(f"{row.system:28s} {row.run:22s} FAILED: {row.failed}")
+            continue
+        target = f"{row.target:g}" if row.target is not None else ""
+        mark = "" if row.target is None or row.wall <= row.target else " (over)"
+        error = f"{row.error:.1e} {row.conserved}" if row.error is not None else ""
+        lines.append(f"{row.system:28s} {row.run:22s} {row.method[:22]:22s} {row.steps or '':>7} {row.wall:7.2f}"
+                     f" {row.cpu:6.2f} {target:>6s} {error:>20s}  {_ratio(rows, row)}{mark}")
+    compiled = sorted({(int(str(c["chars"])), float(str(c["seconds"])), str(c.get("what", ""))) for row in rows
+                       for c in row.compilations if isinstance(c, dict) and "chars" in c and "seconds" in c},
+                      key=lambda entry: entry[0])
+    if compiled:
+        lines += ["", "compile time against kernel size (each cold, measured by the run that compiled it):",
+                  f"{'source chars':>12s} {'cpu s':>6s} {'us/char':>8s}  kernel"]
+        lines += [f"{chars:12d} {seconds:6.2f} {1e6 * seconds / chars:8.1f}  {what}" for chars, seconds, what in compiled]
+    lines += ["", "Fresh process and empty cache per row, default kernel policy; wall is what a user waits (distorted "
+              "by other load), cpu is the child's user + system time. Targets: first result <= "
+              f"{FIRST_TARGET:g} s, 1e5-step study <= {STUDY_TARGET:g} s; a t_end run no slower than scipy (ratio <= 1)."]
+    return "\n".join(lines)
+
+
+def rows_as_json(rows: list[LatencyRow]) -> list[dict[str, object]]:
+    """The rows as plain dictionaries (``--json``)."""
+    return [asdict(row) for row in rows]

@@ -1,0 +1,290 @@
+"""Helpers of a generated module inlined at the source level: one function per kernel.
+
+A generated kernel module (:mod:`dirac.codegen.kernel_source`) writes every expression
+(``mass``, ``force``, ``jacobian``, ...) and every small solve as its own function and
+the step loops call them by name. Marked ``@numba.njit(inline="always")``, numba inlined
+them at the level of its own IR: it types and lowers the callee again at every call site,
+and a RATTLE step loop of a three-coordinate top took 20 s of CPU to compile (4.6 s
+without the marks, where each helper is a separately compiled function). Here the same
+inlining is done once on the Python source, before numba sees it: each call of a marked
+helper becomes the helper's body with its locals renamed, so numba types and lowers one
+straight function per kernel (about 1 s cold), and the interpreter runs the same text.
+
+The rewriting keeps the floating-point operations and their order (the syntax tree is
+spliced, never re-associated), so the interpreted and the compiled tier still give the
+same numbers. What it does, for a call of a marked helper ``h(a_1, ..., a_k)``:
+
+* a statement ``h(...)``: replaced by ``h``'s body; an argument that is a plain name
+  (and a parameter the body never rebinds) is substituted, any other argument is bound
+  once to a fresh local first, as the call would evaluate it once; a bare ``return`` at
+  the end is dropped and ``if cond: ...; return`` becomes ``if cond: ... else: <rest>``;
+* an expression containing ``h(...)`` where ``h``'s body is statements and one final
+  ``return value`` and writes into none of its arguments (a pure helper): the statements
+  go before the statement that holds the call, the call becomes ``value``;
+* anything else (a ``return`` inside a loop, a call inside ``and``/``or``, a ``while``
+  test, a name clash): the call is left as it is, and the helper is compiled as a
+  separate numba function, without the inlining mark.
+
+Reference: the inline expansion of a compiler (Aho, Lam, Sethi & Ullman, *Compilers*,
+2nd ed., Sect. 12.1.3); numba's ``inline`` option and its cost: numba documentation,
+"Notes on Inlining".
+"""
+
+from __future__ import annotations
+
+import ast
+import copy
+import itertools
+from collections.abc import Callable, Iterator
+
+__all__ = ["flatten_source", "straight", "INLINE_MARK"]
+
+#: the decorator generated modules put on a helper to be inlined
+INLINE_MARK = '@numba.njit(cache=True, inline="always")'
+
+_PLAIN = ast.parse("@numba.njit(cache=True)\ndef f():\n    pass").body[0].decorator_list[0]  # type: ignore[attr-defined]
+
+
+def _is_marked(function: ast.FunctionDef) -> bool:
+    for decorator in function.decorator_list:
+        if isinstance(decorator, ast.Call) and any(
+                k.arg == "inline" and isinstance(k.value, ast.Constant) and k.value.value == "always"
+                for k in decorator.keywords):
+            return True
+    return False
+
+
+def _stored_names(nodes: list[ast.stmt]) -> set[str]:
+    names: set[str] = set()
+    for node in nodes:
+        for sub in ast.walk(node):
+            if isinstance(sub, ast.Name) and isinstance(sub.ctx, (ast.Store, ast.Del)):
+                names.add(sub.id)
+    return names
+
+
+def _loaded_names(nodes: list[ast.stmt]) -> set[str]:
+    return {sub.id for node in nodes for sub in ast.walk(node) if isinstance(sub, ast.Name)}
+
+
+def _has_return(nodes: list[ast.stmt]) -> bool:
+    return any(isinstance(sub, ast.Return) for node in nodes for sub in ast.walk(node))
+
+
+def _without_docstring(body: list[ast.stmt]) -> list[ast.stmt]:
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        return body[1:]
+    return body
+
+
+def _restructure(statements: list[ast.stmt]) -> list[ast.stmt] | None:
+    """``statements`` without bare returns (the code after ``if c: ...; return`` moved into
+    the ``else``), or None when a return sits where that cannot be done (in a loop, with a value)."""
+    out: list[ast.stmt] = []
+    for index, statement in enumerate(statements):
+        if isinstance(statement, ast.Return):
+            return out if statement.value is None else None
+        if isinstance(statement, ast.If) and _has_return([statement]):
+            body = statement.body
+            if not (isinstance(body[-1], ast.Return) and body[-1].value is None) or _has_return(body[:-1]) \
+                    or _has_return(statement.orelse):
+                return None
+            rest = _restructure(list(statement.orelse) + statements[index + 1:])
+            if rest is None:
+                return None
+            then = body[:-1] or [ast.Pass()]
+            out.append(ast.If(test=statement.test, body=then, orelse=rest))
+            return out
+        if _has_return([statement]):
+            return None
+        out.append(statement)
+    return out
+
+
+class _Helper:
+    """A marked helper: its parameters, its body without returns (statement form) and, for a
+    pure helper ending in ``return value``, its statements and that value (expression form)."""
+
+    def __init__(self, function: ast.FunctionDef) -> None:
+        self.name = function.name
+        args = function.args
+        self.simple = not (args.vararg or args.kwarg or args.kwonlyargs or args.defaults or args.posonlyargs)
+        self.parameters = [a.arg for a in args.args]
+        self.body = _without_docstring(list(function.body))
+        self.statements = _restructure(self.body)
+        self.value: tuple[list[ast.stmt], ast.expr] | None = None
+        last = self.body[-1] if self.body else None
+        if isinstance(last, ast.Return) and last.value is not None and not _has_return(self.body[:-1]):
+            writes = {sub.value.id for node in self.body for sub in ast.walk(node)
+                      if isinstance(sub, ast.Subscript) and isinstance(sub.ctx, ast.Store) and isinstance(sub.value, ast.Name)}
+            if not writes & set(self.parameters):
+                self.value = (self.body[:-1], last.value)
+        self.stored = _stored_names(self.body)
+        self.locals = self.stored | set(self.parameters)
+        self.globals = _loaded_names(self.body) - self.locals
+        self.loops = any(isinstance(sub, (ast.For, ast.While)) for node in self.body for sub in ast.walk(node))
+        self.size = sum(1 for node in self.body for sub in ast.walk(node) if isinstance(sub, ast.stmt))
+
+
+class _Rename(ast.NodeTransformer):
+    def __init__(self, names: dict[str, ast.expr]) -> None:
+        self.names = names
+
+    def visit_Name(self, node: ast.Name) -> ast.expr:
+        replacement = self.names.get(node.id)
+        if replacement is None:
+            return node
+        if isinstance(replacement, ast.Name):
+            return ast.copy_location(ast.Name(id=replacement.id, ctx=node.ctx), node)
+        return copy.deepcopy(replacement)
+
+
+class _Flattener:
+    def __init__(self, tree: ast.Module, policy: Callable[[_Helper], bool]) -> None:
+        self.functions = {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
+        self.helpers = {name: _Helper(node) for name, node in self.functions.items() if _is_marked(node)}
+        self.policy = policy
+        self.counter = itertools.count()
+        self.done: set[str] = set()
+        self.active: set[str] = set()
+
+    # -------------------------------------------------------------- one instance of a helper
+    def _instance(self, helper: _Helper, call: ast.Call, caller_names: set[str],
+                  body: list[ast.stmt]) -> tuple[list[ast.stmt], dict[str, ast.expr]] | None:
+        if not self.policy(helper) or not helper.simple or call.keywords or len(call.args) != len(helper.parameters) \
+                or any(isinstance(a, ast.Starred) for a in call.args) or helper.globals & caller_names:
+            return None
+        tag = f"_i{next(self.counter)}_"
+        names: dict[str, ast.expr] = {}
+        prelude: list[ast.stmt] = []
+        for parameter, argument in zip(helper.parameters, call.args):
+            if isinstance(argument, ast.Name) and parameter not in helper.stored:
+                names[parameter] = argument
+            elif isinstance(argument, ast.Constant) and parameter not in helper.stored:
+                names[parameter] = argument
+            else:
+                local = tag + parameter
+                prelude.append(ast.Assign(targets=[ast.Name(id=local, ctx=ast.Store())], value=argument, lineno=0))
+                names[parameter] = ast.Name(id=local, ctx=ast.Load())
+        for local in helper.stored - set(names):
+            names[local] = ast.Name(id=tag + local, ctx=ast.Load())
+        renamer = _Rename(names)
+        return prelude + [renamer.visit(copy.deepcopy(s)) for s in body], names
+
+    # -------------------------------------------------------------- expressions
+    def _expression_calls(self, node: ast.AST) -> Iterator[ast.Call]:
+        """Calls of pure helpers in ``node``, not under ``and``/``or``/``if-else``/lambdas."""
+        if isinstance(node, (ast.BoolOp, ast.IfExp, ast.Lambda, ast.ListComp, ast.SetComp, ast.DictComp,
+                             ast.GeneratorExp)):
+            return
+        for child in ast.iter_child_nodes(node):
+            yield from self._expression_calls(child)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in self.helpers:
+            yield node
+
+    def _inline_expressions(self, statement: ast.stmt, fields: list[str], caller_names: set[str]) -> list[ast.stmt]:
+        prelude: list[ast.stmt] = []
+        replacements: dict[int, ast.expr] = {}
+        for name in fields:
+            value = getattr(statement, name, None)
+            parts = value if isinstance(value, list) else [value]
+            for part in parts:
+                if part is None:
+                    continue
+                for call in list(self._expression_calls(part)):
+                    self._flatten_helper(call.func.id)  # type: ignore[attr-defined]
+                    helper = self.helpers[call.func.id]  # type: ignore[attr-defined]
+                    if helper.value is None or any(id(a) in replacements for a in ast.walk(call) if a is not call):
+                        continue
+                    statements, result = helper.value
+                    instance = self._instance(helper, call, caller_names, [*statements, ast.Expr(value=result)])
+                    if instance is None:
+                        continue
+                    body, _ = instance
+                    last = body.pop()
+                    assert isinstance(last, ast.Expr)
+                    prelude.extend(body)
+                    replacements[id(call)] = last.value
+
+        class _Swap(ast.NodeTransformer):
+            def visit_Call(self, node: ast.Call) -> ast.expr:
+                self.generic_visit(node)
+                return replacements.get(id(node), node)
+
+        if not replacements:
+            return [statement]
+        swapped = _Swap().visit(statement)
+        return [*prelude, swapped]
+
+    # -------------------------------------------------------------- statements
+    def _block(self, statements: list[ast.stmt], caller_names: set[str]) -> list[ast.stmt]:
+        out: list[ast.stmt] = []
+        for statement in statements:
+            for name in ("body", "orelse", "finalbody"):
+                inner = getattr(statement, name, None)
+                if isinstance(inner, list) and inner and isinstance(inner[0], ast.stmt):
+                    setattr(statement, name, self._block(inner, caller_names))
+            if isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Call) \
+                    and isinstance(statement.value.func, ast.Name) and statement.value.func.id in self.helpers:
+                self._flatten_helper(statement.value.func.id)
+                helper = self.helpers[statement.value.func.id]
+                if helper.statements is not None:
+                    instance = self._instance(helper, statement.value, caller_names, helper.statements)
+                    if instance is not None:
+                        inlined, _ = instance
+                        out.extend(inlined or [ast.Pass()])
+                        continue
+                out.append(statement)
+                continue
+            fields = {ast.Assign: ["targets", "value"], ast.AugAssign: ["target", "value"], ast.Return: ["value"],
+                      ast.Expr: ["value"], ast.If: ["test"], ast.For: ["iter"], ast.AnnAssign: ["value"]}
+            out.extend(self._inline_expressions(statement, fields.get(type(statement), []), caller_names))
+        return out
+
+    def _flatten_function(self, function: ast.FunctionDef) -> None:
+        names = _stored_names(function.body) | {a.arg for a in function.args.args}
+        function.body = self._block(function.body, names)
+
+    def _flatten_helper(self, name: str) -> None:
+        """Inline into helper ``name`` the helpers it calls (once), and refresh its forms."""
+        if name in self.done or name in self.active:
+            return
+        self.active.add(name)
+        function = self.functions[name]
+        self._flatten_function(function)
+        self.helpers[name] = _Helper(function)
+        self.active.discard(name)
+        self.done.add(name)
+
+    def run(self) -> None:
+        # a helper is flattened when first inlined; one nobody calls stays as written
+        for name, function in self.functions.items():
+            if name not in self.helpers:
+                self._flatten_function(function)
+        for name in self.helpers:
+            self.functions[name].decorator_list = [copy.deepcopy(_PLAIN)]
+
+
+def straight(helper: _Helper) -> bool:
+    """The default policy: inline the helpers without loops (expressions, closed-form
+    solves, the bookkeeping of ``info``); a helper with loops (an LU factorisation, a
+    norm) stays a function of its own, compiled once. Measured on the RATTLE kernel of a
+    top in Euler angles: inlining the loops as well multiplies the basic blocks numba's
+    reaching-definitions analysis walks (its cost grows with blocks times variables), and
+    the compilation took 7 s instead of 3.5 s; inlining nothing took the same 3.5 s and
+    leaves the interpreted tier a Python call per expression."""
+    return not helper.loops
+
+
+def flatten_source(source: str, policy: Callable[[_Helper], bool] = straight) -> str:
+    """``source`` with every call of a helper marked ``inline="always"`` replaced by the
+    helper's body where ``policy`` says so (see the module docstring); every helper stays,
+    as a plain ``@numba.njit`` function without the mark, for the calls left and for direct
+    calls. A source without marks is returned unchanged."""
+    if 'inline="always"' not in source and "inline='always'" not in source:
+        return source
+    tree = ast.parse(source)
+    _Flattener(tree, policy).run()
+    ast.fix_missing_locations(tree)
+    return ast.unparse(tree) + "\n"
