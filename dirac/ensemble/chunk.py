@@ -12,8 +12,9 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.reductions import casimir_of, energy_of, make_reductions
-from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
+from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, AnyScene
 
 __all__ = ["advance_members", "compute_chunk", "warm_up", "KERNEL_LOCK"]
 
@@ -70,7 +71,7 @@ def _threads_for(work_per_call: int):
 
 
 def compute_chunk(
-    scene: EnsembleScene,
+    scene: AnyScene,
     start: int,
     stop: int,
     members: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
@@ -96,6 +97,10 @@ def compute_chunk(
         Array name -> array with ``stop - start`` rows (trajectory outputs have shape
         ``(n, samples, ...)``, reductions ``(n, ...)``).
     """
+    if isinstance(scene, GeneralEnsembleScene):
+        from dirac.ensemble.general_chunk import compute_general_chunk
+
+        return compute_general_chunk(scene, start, stop, members)  # type: ignore[arg-type]
     M, R, inertia = scene.source.members(start, stop) if members is None else members
     inv = np.ascontiguousarray(1.0 / inertia)
     n = stop - start

@@ -1,0 +1,374 @@
+"""The member loop of a general ensemble: the system's own step kernel, batched over members.
+
+:func:`compiled_ensemble` builds, once per process and scene, the system exactly as a
+single run does (:meth:`dirac.flows.mechanics.MechanicalSystem.from_lagrangian`: the same
+generated module, the same RATTLE or forced-RATTLE step loop) and appends to that module's
+source
+
+* ``ens_values`` / ``ens_conditions`` -- the reductions' expressions and the ``when``
+  conditions (``lhs - rhs``), straight-line code (:func:`dirac.codegen.kernel_source.emit_function`);
+* ``ens_locate`` -- regula falsi (Illinois) for the zero of one expression on the line
+  between two consecutive states;
+* ``ens_member`` -- one member from ``t = 0`` to ``t_end`` (or until its reductions are
+  decided): step by step, each step the module's own step loop called for one step at the
+  time a single run gives that step (``t_k + j dt`` on the sample grid ``t_k`` of
+  :func:`dirac.flows.integration.sample_times`), so a member's state equals a single
+  run's to the last bit;
+* ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``;
+* ``ens_momenta`` / ``ens_surface`` -- ``p = M(q) q_dot`` and the constraint residuals of
+  many initial states.
+
+The combined module is imported through :func:`dirac.codegen.numba_backend.import_source`
+(cached on disk under the hash of its source: compiled once per machine).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian, split_condition
+from dirac.errors import InputError
+
+__all__ = ["CompiledEnsemble", "compiled_ensemble", "FAILURES"]
+
+#: Codes of the ``failures`` array (0: the member completed).
+FAILURES: dict[int, str] = {
+    1: "Newton iteration did not converge (reduce dt)",
+    2: "non-finite state (the step diverged; reduce dt)",
+    3: "singular Newton matrix (the constraints are not independent here)",
+}
+
+_CACHE: dict[str, CompiledEnsemble] = {}
+
+
+@dataclass
+class CompiledEnsemble:
+    """The compiled pieces of one general ensemble scene (see the module docstring).
+
+    Attributes
+    ----------
+    mechanics : MechanicalSystem
+        The system with the scene's fixed parameter values.
+    module : module
+        The generated module with the ensemble loop appended.
+    fractions : numpy.ndarray
+        Sub-steps of the composition (fractions of ``dt``).
+    gamma : float
+        The conformal rate (``conformal-*`` methods), else 0.
+    layout : dict
+        Where each reduction's values sit in the kernel's arrays.
+    """
+
+    mechanics: Any
+    module: Any
+    fractions: np.ndarray
+    gamma: float
+    layout: dict
+    parameter_exprs: dict
+    variable_names: tuple[str, ...]
+
+
+def compiled_ensemble(scene: GeneralEnsembleScene) -> CompiledEnsemble:
+    """The compiled ensemble of ``scene`` (built once per process, then cached)."""
+    key = scene.fingerprint()
+    if key not in _CACHE:
+        _CACHE[key] = _build(scene)
+    return _CACHE[key]
+
+
+def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
+    import sympy
+
+    from dirac.codegen.numba_backend import import_source
+    from dirac.ensemble.general_scene import _state_names
+    from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
+    from dirac.flows.methods.registry import get_method
+    from dirac.model.expressions import parse_expression
+
+    lagrangian = load_lagrangian(scene.system, scene.base_dir)
+    fixed = {k: float(v) for k, v in scene.parameters.items() if not isinstance(v, str)}
+    placeholders = {k: 1.0 for k, v in scene.parameters.items() if isinstance(v, str)}
+    try:
+        mechanics = MechanicalSystem.from_lagrangian(lagrangian, {**placeholders, **fixed}, with_forces=scene.forced)
+    except NotMechanicalError as exc:
+        raise InputError(f"ensembles integrate L = 1/2 q_dot^T M(q) q_dot - V(q) with RATTLE: {exc}") from None
+    method = get_method(scene.method)
+    if scene.forced:
+        family, coefficients = method.data
+        fractions = np.asarray(coefficients, dtype=float)
+        if family == "conformal":
+            if placeholders:
+                raise InputError(f"[run] method = {scene.method!r} takes its damping rate from fixed parameter values; "
+                                 "with parameters that vary over the ensemble use forced-rattle-2 or forced-rattle-4")
+            if mechanics.conformal_rate is None:
+                raise InputError(f"[run] method = {scene.method!r} needs linear damping Q = -gamma M q_dot with a constant "
+                                 "mass; use forced-rattle-2 or forced-rattle-4")
+            step = "conformal_run(q, p, ta, c, gamma, fractions, dt, 1, tol, max_iter, info, wd)"
+        else:
+            step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, wd)"
+        gamma = float(mechanics.conformal_rate or 0.0)
+    else:
+        fractions = np.asarray(method.data, dtype=float)
+        name = "rattle_constant_mass" if mechanics.constant_mass is not None else "rattle_general"
+        step = f"{name}(q, p, ta, c, fractions, dt, 1, tol, max_iter, info)"
+        gamma = 0.0
+    state = _state_names(lagrangian)
+    exprs: list[Any] = []
+    conditions: list[tuple[Any, str]] = []
+    layout: dict[str, list] = {"cross": [], "ext": [], "poincare": []}
+    for reduction in scene.reductions:
+        parsed = [parse_expression(text, state, what=f"reduction {reduction.name}") for text in reduction.exprs]
+        if reduction.kind == "first_crossing":
+            group = []
+            for text, when in zip(parsed, reduction.whens):
+                exprs.append(text)
+                cond = -1
+                if when is not None:
+                    lhs, op, rhs = split_condition(when, reduction.name)
+                    left = parse_expression(lhs, state, what=f"reduction {reduction.name} when")
+                    right = parse_expression(rhs, state, what=f"reduction {reduction.name} when")
+                    value = left - right if op in (">", ">=") else right - left
+                    conditions.append((value, ">" if op in (">", "<") else ">="))
+                    cond = len(conditions) - 1
+                group.append((len(exprs) - 1, cond))
+            layout["cross"].append((reduction.name, group))
+        elif reduction.kind in ("max", "min"):
+            exprs.append(parsed[0])
+            layout["ext"].append((reduction.name, reduction.kind, len(exprs) - 1))
+        elif reduction.kind == "poincare":
+            exprs.append(parsed[0])
+            layout["poincare"].append((reduction.name, len(exprs) - 1, reduction.count))
+    kinds = {r.kind for r in scene.reductions}
+    n = len(scene.coordinate_names)
+    velocities = [state[f"{q}_dot"] for q in scene.coordinate_names]
+    used = set().union(*(e.free_symbols for e in exprs), *(c.free_symbols for c, _ in conditions)) if exprs else set()
+    needs_velocity = bool(used & set(velocities))
+    source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
+                              mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
+                              "constraint_error" in kinds)
+    module = import_source(mechanics.module.source + source)
+    variables = {name: sympy.Symbol(name, real=True) for name in scene.source.names}
+    parameter_exprs = {k: parse_expression(v, variables, what=f"[system] parameters.{k}")
+                       for k, v in scene.parameters.items() if isinstance(v, str)}
+    return CompiledEnsemble(mechanics, module, fractions, gamma, layout, parameter_exprs, scene.source.names)
+
+
+def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, exprs: list, conditions: list,
+                     layout: dict, step: str, n: int, m: int, needs_velocity: bool, energy: bool,
+                     constraint: bool) -> str:
+    from dirac.codegen.kernel_source import emit_function
+
+    q = list(lagrangian.coordinates)
+    p = [state[f"p_{s.name}"] for s in q]
+    v = [state[f"{s.name}_dot"] for s in q]
+    params = list(lagrangian.parameters)
+    arrays = [("q", q), ("p", p), ("v", v)]
+    scalars = [("t", state["t"])]
+    out = ["\n\n# ---- ensemble loop (dirac.ensemble.general_kernel) ----\n"]
+    out.append(emit_function("ens_values", "the reductions' expressions", arrays, scalars, exprs,
+                             (len(exprs),), params))
+    out.append(emit_function("ens_conditions", "the when conditions (lhs - rhs)", arrays, scalars,
+                             [c for c, _ in conditions], (len(conditions),), params))
+    velocity_body = "    velocity(q, p, t, c, v, work, piv)" if needs_velocity else "    return"
+    out.append(f'''
+@numba.njit(cache=True, inline="always")
+def ens_velocity(q, p, t, c, v, work, piv):
+    """v = M^-1 p when an expression uses velocities."""
+{velocity_body}
+
+
+@numba.njit(cache=True)
+def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
+    """Zero of expression e on the line between (qa, pa) at ta and (q, p) at ta + dt
+    (Illinois regula falsi); leaves the state there in qs, ps, vs, fs and returns its fraction."""
+    lo = 0.0
+    hi = 1.0
+    side = 0
+    size = abs(flo) + abs(fhi)
+    s = flo / (flo - fhi)
+    for _it in range(200):
+        for x in range({n}):
+            qs[x] = qa[x] + s * (q[x] - qa[x])
+            ps[x] = pa[x] + s * (p[x] - pa[x])
+        ts = ta + s * dt
+        ens_velocity(qs, ps, ts, c, vs, vw, vpiv)
+        ens_values(qs, ps, vs, ts, c, fs)
+        fm = fs[e]
+        if fm == 0.0 or abs(fm) <= 1e-16 * size or hi - lo <= 1e-16:
+            break
+        if (fm < 0.0) == (flo < 0.0):
+            lo = s
+            flo = fm
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+        else:
+            hi = s
+            fhi = fm
+            if side == -1:
+                flo *= 0.5
+            side = -1
+        s = (lo * fhi - hi * flo) / (fhi - flo)
+        if not (lo <= s <= hi):
+            s = 0.5 * (lo + hi)
+    return s
+''')
+    n_cross = len(layout["cross"])
+    n_ext = len(layout["ext"])
+    n_poin = len(layout["poincare"])
+    k_max = max([count for _, _, count in layout["poincare"]], default=1)
+    lines: list[str] = []
+
+    def w(depth: int, text: str) -> None:
+        lines.append("    " * depth + text)
+
+    w(0, "@numba.njit(cache=True)")
+    w(0, "def ens_member(i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,")
+    w(0, "               CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS):")
+    w(1, '"""One member from t = 0 to the end or until its reductions are decided (module docstring)."""')
+    w(1, "q = Q[i]")
+    w(1, "p = P[i]")
+    w(1, "c = C[i]")
+    w(1, "info = np.zeros(4)")
+    w(1, "wd = np.zeros(1)")
+    w(1, f"v = np.zeros({n})")
+    w(1, f"vw = np.empty(({n}, {n}))")
+    w(1, f"vpiv = np.zeros({n}, dtype=np.int64)")
+    for name in ("qa", "pa", "qs", "ps"):
+        w(1, f"{name} = np.empty({n})")
+    w(1, f"vs = np.zeros({n})")
+    nf = max(1, len(exprs))
+    w(1, f"f = np.zeros({nf})")
+    w(1, f"fa = np.zeros({nf})")
+    w(1, f"fs = np.zeros({nf})")
+    w(1, f"g = np.zeros({max(1, len(conditions))})")
+    w(1, f"res = np.zeros({max(1, 2 * m)})")
+    w(1, f"pc = np.zeros({max(1, n_poin)}, dtype=np.int64)")
+    w(1, "t0 = starts[0]")
+    w(1, "ens_velocity(q, p, t0, c, v, vw, vpiv)")
+    w(1, "ens_values(q, p, v, t0, c, f)")
+    for x, (_, _, e) in enumerate(layout["ext"]):
+        w(1, f"EXT[i, {x}] = f[{e}]")
+    if energy:
+        w(1, "e0 = energy(q, p, t0, c)")
+        w(1, "EERR[i] = 0.0")
+    if constraint:
+        w(1, "CERR[i] = 0.0")
+        if m:
+            w(1, "residuals(q, p, t0, c, res)")
+            w(1, f"for x in range({2 * m}):")
+            w(2, "if abs(res[x]) > CERR[i]:")
+            w(3, "CERR[i] = abs(res[x])")
+    w(1, "status = 0.0")
+    w(1, "steps = 0")
+    w(1, "stop = False")
+    w(1, "for k in range(starts.shape[0]):")
+    w(2, "a = starts[k]")
+    w(2, "for j in range(per_interval):")
+    w(3, f"for x in range({n}):")
+    w(4, "qa[x] = q[x]")
+    w(4, "pa[x] = p[x]")
+    w(3, f"for x in range({len(exprs)}):")
+    w(4, "fa[x] = f[x]")
+    w(3, "ta = a + j * dt")
+    w(3, step)
+    w(3, "if info[1] != 0.0:")
+    w(4, "status = 1.0")
+    w(4, "stop = True")
+    w(4, "break")
+    w(3, "steps += 1")
+    w(3, "tb = a + (j + 1) * dt")
+    w(3, "bad = False")
+    w(3, f"for x in range({n}):")
+    w(4, "if not (abs(q[x]) < np.inf and abs(p[x]) < np.inf):")
+    w(5, "bad = True")
+    w(3, "if bad:")
+    w(4, "status = 2.0")
+    w(4, "stop = True")
+    w(4, "break")
+    w(3, "ens_velocity(q, p, tb, c, v, vw, vpiv)")
+    w(3, "ens_values(q, p, v, tb, c, f)")
+    for x, (_, kind, e) in enumerate(layout["ext"]):
+        op = ">" if kind == "max" else "<"
+        w(3, f"if f[{e}] {op} EXT[i, {x}]:")
+        w(4, f"EXT[i, {x}] = f[{e}]")
+    for gi, (_, group) in enumerate(layout["cross"]):
+        w(3, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
+        w(4, "best = np.inf")
+        for e, cond in group:
+            w(4, f"if (fa[{e}] < 0.0 and f[{e}] >= 0.0) or (fa[{e}] > 0.0 and f[{e}] <= 0.0):")
+            w(5, f"s = ens_locate({e}, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, fa[{e}], f[{e}], vw, vpiv)")
+            if cond >= 0:
+                w(5, "ens_conditions(qs, ps, vs, ta + s * dt, c, g)")
+                w(5, f"if g[{cond}] {conditions[cond][1]} 0.0 and ta + s * dt < best:")
+            else:
+                w(5, "if ta + s * dt < best:")
+            w(6, "best = ta + s * dt")
+        w(4, "if best < np.inf:")
+        w(5, f"CROSS[i, {gi}] = best")
+    for pj, (_, e, count) in enumerate(layout["poincare"]):
+        w(3, f"if pc[{pj}] < {count} and fa[{e}] < 0.0 and f[{e}] >= 0.0:")
+        w(4, f"s = ens_locate({e}, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, fa[{e}], f[{e}], vw, vpiv)")
+        w(4, f"PT[i, {pj}, pc[{pj}]] = ta + s * dt")
+        w(4, f"for x in range({n}):")
+        w(5, f"PQ[i, {pj}, pc[{pj}], x] = qs[x]")
+        w(5, f"PP[i, {pj}, pc[{pj}], x] = ps[x]")
+        w(4, f"pc[{pj}] += 1")
+    decided = [f"CROSS[i, {gi}] == CROSS[i, {gi}]" for gi in range(n_cross)]
+    decided += [f"pc[{pj}] >= {count}" for pj, (_, _, count) in enumerate(layout["poincare"])]
+    if decided:
+        w(3, f"if early and {' and '.join(decided)}:")
+        w(4, "stop = True")
+        w(4, "break")
+    w(2, "if stop:")
+    w(3, "break")
+    if energy:
+        w(2, "err = abs(energy(q, p, ends[k], c) - wd[0] - e0)")
+        w(2, "if not (err <= EERR[i]):")
+        w(3, "EERR[i] = err")
+    if constraint and m:
+        w(2, "residuals(q, p, ends[k], c, res)")
+        w(2, f"for x in range({2 * m}):")
+        w(3, "if not (abs(res[x]) <= CERR[i]):")
+        w(4, "CERR[i] = abs(res[x])")
+    w(1, "STATUS[i] = status")
+    w(1, "STEPS[i] = steps")
+    out.append("\n".join(lines) + "\n")
+    out.append(f'''
+
+@numba.njit(cache=True, parallel=True)
+def ens_run(lo, hi, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
+            CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS):
+    """ens_member for members lo .. hi-1, in parallel over members (numba.prange)."""
+    for i in numba.prange(lo, hi):
+        ens_member(i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
+                   CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS)
+
+
+@numba.njit(cache=True)
+def ens_momenta(Q, QD, C, P):
+    """P[i] = M(Q[i], 0) QD[i]."""
+    Mw = np.empty(({n}, {n}))
+    for i in range(Q.shape[0]):
+        mass(Q[i], 0.0, C[i], Mw)
+        for a in range({n}):
+            acc = 0.0
+            for b in range({n}):
+                acc += Mw[a, b] * QD[i, b]
+            P[i, a] = acc
+
+
+@numba.njit(cache=True)
+def ens_surface(Q, P, C, OUT):
+    """OUT[i] = (chi, G M^-1 p + d chi/dt) at (Q[i], P[i], t = 0)."""
+    for i in range(Q.shape[0]):
+        residuals(Q[i], P[i], 0.0, C[i], OUT[i])
+
+
+#: shapes of the kernel's result arrays
+ENS_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
+''')
+    return "".join(out)
