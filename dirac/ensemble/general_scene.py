@@ -202,6 +202,7 @@ class GeneralEnsembleScene:
         return {
             "system": {k: v for k, v in self.system.items() if k != "file"},
             "system_digest": self.system_digest,
+            "coordinates": list(self.coordinate_names),
             "variables": self.source.describe(),
             "count": self.count,
             "initial": {"q": self.initial_q, self.rate_kind: self.initial_rates, "project": self.project},
@@ -236,7 +237,9 @@ def load_lagrangian(system: dict, base_dir: str | Path, where: str = "[system]")
             raise InputError(f"{where} file {str(system['file'])!r} does not exist; give a path relative to the scene file")
         return load_system(file)
     if "lagrangian" in system:
-        table = {k: v for k, v in system.items() if k not in ("file", "parameters")}
+        table = {k: v for k, v in system.items() if k != "file"}
+        if isinstance(table.get("parameters"), dict):  # values that vary over the ensemble are set per member
+            table["parameters"] = {k: 1.0 if isinstance(v, str) else v for k, v in table["parameters"].items()}
         return lagrangian_from_table(table, source=where)
     name = system.get("name")
     if not isinstance(name, str):
