@@ -177,7 +177,7 @@ def test_damped_pendulum_basins_from_energy(tmp_path):
                   'grid = { th0 = [-3.0, 3.0, 7], w0 = [-9.0, 9.0, 7] }\nreductions = ["energy_error"]', name="full.toml")
     assert run_ensemble(half, tmp_path / "half").complete and run_ensemble(full, tmp_path / "full").complete
     ratio = _arrays(tmp_path / "full")["energy_error"] / _arrays(tmp_path / "half")["energy_error"]
-    assert 3.0 < np.median(ratio) < 5.0
+    assert 3.9 < np.nanmedian(ratio) < 4.1  # the member at rest at th = 0 has no error at all (0 / 0)
 
 
 def _cli(scene, out):
