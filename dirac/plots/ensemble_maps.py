@@ -40,7 +40,7 @@ def draw_grid_map(values: np.ndarray, x: tuple[str, float, float], y: tuple[str,
     ax.set_xlabel(x[0])
     ax.set_ylabel(y[0])
     missing = int(np.sum(~np.isfinite(values)))
-    ax.set_title(title or f"{label} ({missing} of {values.size} members: none, white)")
+    ax.set_title(title or f"{label}: {missing} of {values.size} members without one (white)")
     fig.colorbar(image, ax=ax, label=label + (" (log scale)" if log else ""))
     fig.tight_layout()
     return save_figure(fig, path, dpi=110)
