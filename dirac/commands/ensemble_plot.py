@@ -47,10 +47,9 @@ def _draw(args: argparse.Namespace) -> str:
     from dirac.ensemble.plot import picture_data, plot_flip_times
     from dirac.plots.ensemble_maps import draw_grid_map, draw_section
 
-    try:
-        general = "reductions" in json.loads((Path(args.out) / "meta.json").read_text()).get("scene", {}) and \
-            isinstance(json.loads((Path(args.out) / "meta.json").read_text())["scene"]["reductions"], list)
-    except (OSError, ValueError):
+    try:  # a general system's ensemble names its ensemble variables; a rigid body's does not
+        general = "variables" in json.loads((Path(args.out) / "meta.json").read_text()).get("scene", {})
+    except (OSError, ValueError, AttributeError):
         general = False
     if not general:
         summary = plot_flip_times(args.out, args.image)

@@ -224,16 +224,11 @@ def measure_general(members: int = 1024, steps: int = 2000, dt: float = 2e-3, re
 
     Each figure is the best of ``repeats`` (CPU time for one thread, wall time for all).
     """
-    import numba
-    import numpy as np
-
-    from dirac.ensemble.general_chunk import initial_states, step_grid
-    from dirac.ensemble.general_kernel import compiled_ensemble
     from dirac.ensemble.general_scene import parse_general_scene
 
     side = int(round(members ** 0.5))
-    rows = []
     baseline = _prange_baseline()
+    rows = []
     for label, (system, q) in GENERAL_SYSTEMS.items():
         scene = parse_general_scene({
             "system": system, "initial": {"q": q},
@@ -241,55 +236,64 @@ def measure_general(members: int = 1024, steps: int = 2000, dt: float = 2e-3, re
             "ensemble": {"grid": {"a": [0.2, 0.6, side], "b": [0.2, 0.6, side]},
                          "reductions": [{"kind": "max", "expr": next(iter(q))}]},
         })
-        compiled = compiled_ensemble(scene)
-        module = compiled.module
-        Q, P, C = initial_states(scene, compiled, scene.source.members(0, scene.count))
-        starts, ends, per, step_dt = step_grid(scene)
-        kernel = module.rattle_constant_mass if compiled.mechanics.constant_mass is not None else module.rattle_general
-        count = scene.count
-        shapes = module.ENS_SHAPES
-
-        def ensemble(threads: int) -> float:
-            q, p = Q.copy(), P.copy()
-            arrays = (np.full((count, shapes[0]), np.nan), np.full((count, shapes[1]), np.nan), np.full(count, np.nan),
-                      np.full(count, np.nan), np.full((count, shapes[2], shapes[3]), np.nan),
-                      np.full((count, shapes[2], shapes[3], Q.shape[1]), np.nan),
-                      np.full((count, shapes[2], shapes[3], Q.shape[1]), np.nan), np.zeros(count), np.zeros(count))
-            numba.set_num_threads(threads)
-            clock = time.process_time if threads == 1 else time.perf_counter
-            start = clock()
-            module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False,
-                           *arrays)
-            return clock() - start
-
-        def single() -> float:
-            q, p, info = Q[0].copy(), P[0].copy(), np.zeros(4)
-            start = time.process_time()
-            kernel(q, p, 0.0, C[0], compiled.fractions, step_dt, count * steps, 1e-12, 50, info)
-            return time.process_time() - start
-
-        def prange() -> float:
-            q, p = Q.copy(), P.copy()
-            start = time.perf_counter()
-            baseline(kernel, q, p, C, compiled.fractions, step_dt, steps, 1e-12, 50)
-            return time.perf_counter() - start
-
-        threads = numba.get_num_threads()
-        try:
-            ensemble(1), single(), prange()  # compile and warm up
-            work = count * steps
-            row = {
-                "system": label,
-                "single_ns": 1e9 * min(single() for _ in range(repeats)) / work,
-                "ensemble_1_ns": 1e9 * min(ensemble(1) for _ in range(repeats)) / work,
-                "ensemble_rate": work / min(ensemble(threads) for _ in range(repeats)),
-                "prange_rate": work / min(prange() for _ in range(repeats)),
-                "threads": threads,
-            }
-        finally:
-            numba.set_num_threads(threads)
-        rows.append(row)
+        rows.append({"system": label, **_measure_scene(scene, steps, repeats, baseline)})
     return rows
+
+
+def _measure_scene(scene: Any, steps: int, repeats: int, baseline: Any) -> dict[str, Any]:
+    """The figures of :func:`measure_general` for one scene."""
+    import numba
+    import numpy as np
+
+    from dirac.ensemble.general_chunk import initial_states, step_grid
+    from dirac.ensemble.general_kernel import compiled_ensemble
+
+    compiled = compiled_ensemble(scene)
+    module = compiled.module
+    Q, P, C = initial_states(scene, compiled, scene.source.members(0, scene.count))
+    starts, ends, per, step_dt = step_grid(scene)
+    kernel = module.rattle_constant_mass if compiled.mechanics.constant_mass is not None else module.rattle_general
+    count = scene.count
+    shapes = module.ENS_SHAPES
+
+    def ensemble(threads: int) -> float:
+        q, p = Q.copy(), P.copy()
+        n = Q.shape[1]
+        arrays = (np.full((count, shapes[0]), np.nan), np.full((count, shapes[1]), np.nan), np.full(count, np.nan),
+                  np.full(count, np.nan), np.full((count, shapes[2], shapes[3]), np.nan),
+                  np.full((count, shapes[2], shapes[3], n), np.nan), np.full((count, shapes[2], shapes[3], n), np.nan),
+                  np.zeros(count), np.zeros(count))
+        numba.set_num_threads(threads)
+        clock = time.process_time if threads == 1 else time.perf_counter
+        start = clock()
+        module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False, *arrays)
+        return clock() - start
+
+    def single() -> float:
+        q, p, info = Q[0].copy(), P[0].copy(), np.zeros(4)
+        start = time.process_time()
+        kernel(q, p, 0.0, C[0], compiled.fractions, step_dt, count * steps, 1e-12, 50, info)
+        return time.process_time() - start
+
+    def prange() -> float:
+        q, p = Q.copy(), P.copy()
+        start = time.perf_counter()
+        baseline(kernel, q, p, C, compiled.fractions, step_dt, steps, 1e-12, 50)
+        return time.perf_counter() - start
+
+    threads = numba.get_num_threads()
+    try:
+        ensemble(1), single(), prange()  # compile and warm up
+        work = count * steps
+        return {
+            "single_ns": 1e9 * min(single() for _ in range(repeats)) / work,
+            "ensemble_1_ns": 1e9 * min(ensemble(1) for _ in range(repeats)) / work,
+            "ensemble_rate": work / min(ensemble(threads) for _ in range(repeats)),
+            "prange_rate": work / min(prange() for _ in range(repeats)),
+            "threads": threads,
+        }
+    finally:
+        numba.set_num_threads(threads)
 
 
 def format_general_table(rows: list[dict[str, Any]]) -> str:

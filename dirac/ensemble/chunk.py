@@ -7,21 +7,17 @@ times, gives the same bits.
 
 from __future__ import annotations
 
-import threading
 from contextlib import contextmanager
 
 import numpy as np
 
 from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.ensemble.reductions import casimir_of, energy_of, make_reductions
 from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, AnyScene
 
 __all__ = ["advance_members", "compute_chunk", "warm_up", "KERNEL_LOCK"]
 
-#: Serialises the parallel kernel within one process: numba's default ("workqueue")
-#: threading layer must not be entered by two threads at once (threaded dask workers),
-#: and one call already uses every thread numba is allowed.
-KERNEL_LOCK = threading.Lock()
 
 #: Member-steps below which one kernel call runs single-threaded (about 10 ms of work).
 #: Measured on a shared two-core machine: a scene of 20000 members with 2 steps per

@@ -17,6 +17,7 @@ import numpy as np
 
 from dirac.ensemble.general_kernel import CompiledEnsemble, compiled_ensemble
 from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError
 
 __all__ = ["check_initial_states", "compute_general_chunk", "initial_states", "step_grid"]
@@ -142,8 +143,6 @@ def check_initial_states(scene: GeneralEnsembleScene) -> None:
 def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                           values: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Integrate members ``start .. stop-1`` and return their arrays (:meth:`GeneralEnsembleScene.array_layout`)."""
-    from dirac.ensemble.chunk import KERNEL_LOCK
-
     compiled = compiled_ensemble(scene)
     if values is None:
         values = scene.source.members(start, stop)

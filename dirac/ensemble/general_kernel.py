@@ -25,7 +25,7 @@ The combined module is imported through :func:`dirac.codegen.numba_backend.impor
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -100,8 +100,8 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         raise InputError(f"ensembles integrate L = 1/2 q_dot^T M(q) q_dot - V(q) with RATTLE: {exc}") from None
     method = get_method(scene.method)
     if scene.forced:
-        family, coefficients = method.data
-        fractions = np.asarray(coefficients, dtype=float)
+        family, coefficients = cast(tuple[str, tuple[float, ...]], method.data)
+        fractions = np.array(coefficients, dtype=np.float64)
         if family == "conformal":
             if placeholders:
                 raise InputError(f"[run] method = {scene.method!r} takes its damping rate from fixed parameter values; "
@@ -114,7 +114,7 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
             step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, wd)"
         gamma = float(mechanics.conformal_rate or 0.0)
     else:
-        fractions = np.asarray(method.data, dtype=float)
+        fractions = np.array(cast(tuple[float, ...], method.data), dtype=np.float64)
         name = "rattle_constant_mass" if mechanics.constant_mass is not None else "rattle_general"
         step = f"{name}(q, p, ta, c, fractions, dt, 1, tol, max_iter, info)"
         gamma = 0.0

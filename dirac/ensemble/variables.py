@@ -112,7 +112,7 @@ class VariableSource:
             coordinates = np.unravel_index(point, self.grid_shape)
             columns += [axis.values()[j] for axis, j in zip(self.grid, coordinates)]
         for position, variable in enumerate(self.random):
-            columns.append(draw_range(variable, self.seed, FIRST_STREAM + position, start, stop))
+            columns.append(draw_range(variable, self.seed, FIRST_STREAM + position, start, stop))  # type: ignore[arg-type]  # draws like a Distribution
         if not columns:
             return np.empty((stop - start, 0))
         return np.ascontiguousarray(np.stack(columns, axis=1))
