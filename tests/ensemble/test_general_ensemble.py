@@ -250,3 +250,34 @@ def test_random_variables_do_not_depend_on_the_chunking(tmp_path):
     assert np.array_equal(a["g0"], b["g0"]) and np.array_equal(a["final_q"], b["final_q"])
     assert np.all((a["g0"] >= 9.0) & (a["g0"] < 10.0)) and len(set(a["g0"].tolist())) == 12
     assert np.array_equal(a["a"], np.repeat(0.1 + (0.3 - 0.1) * np.array([0.0, 0.5, 1.0]), 4))  # lo + (hi - lo) j / (n - 1)
+
+
+def test_killed_flip_map_run_resumes_bit_identically(tmp_path):
+    """'dirac ensemble' killed midway (SIGKILL) and rerun gives the uninterrupted run's bits."""
+    import os
+    import signal
+    import time
+
+    path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "dt = 0.002\nt_end = 60.0",
+                  f'grid = {{ a = [-3.0, 3.0, 12], b = [-3.0, 3.0, 12] }}\nchunk_size = 8\n'
+                  f'reductions = [{FLIP}, {{ kind = "max", name = "highest", expr = "y2" }}]')
+    out = tmp_path / "killed"
+    command = [sys.executable, "-m", "dirac", "ensemble", str(path), "--out", str(out), "--no-progress"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 240
+    try:
+        while len(list((out / "chunks").glob("chunk-*.json"))) < 2:
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() < deadline, "fewer than two chunks finished within 240 s"
+            time.sleep(0.005)
+    finally:
+        os.kill(process.pid, signal.SIGKILL)
+        process.wait()
+    done = len(list((out / "chunks").glob("chunk-*.json")))
+    assert 2 <= done < 18, "the run was not interrupted midway"
+    resumed = _cli(path, out)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"computed {18 - done} chunks, {done} already complete" in resumed.stdout
+    assert run_ensemble(path, tmp_path / "whole").complete
+    for name in ("flip_time", "highest"):
+        assert np.array_equal(_arrays(out)[name], _arrays(tmp_path / "whole")[name], equal_nan=True)
