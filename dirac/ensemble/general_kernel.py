@@ -10,8 +10,8 @@ source
 * ``ens_locate`` -- regula falsi (Illinois) for the zero of one expression on the line
   between two consecutive states;
 * ``ens_member`` -- one member from ``t = 0`` to ``t_end`` (or until its reductions are
-  decided): step by step, each step the module's own step loop called for one step at the
-  time a single run gives that step (``t_k + j dt`` on the sample grid ``t_k`` of
+  decided): step by step, each step the module's own step loop (its body pasted in, or the
+  loop called for one step) at the time a single run gives that step (``t_k + j dt`` on the sample grid ``t_k`` of
   :func:`dirac.flows.integration.sample_times`), so a member's state equals a single
   run's to the last bit;
 * ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``;
@@ -109,9 +109,9 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
             if mechanics.conformal_rate is None:
                 raise InputError(f"[run] method = {scene.method!r} needs linear damping Q = -gamma M q_dot with a constant "
                                  "mass; use forced-rattle-2 or forced-rattle-4")
-            step = "conformal_run(q, p, ta, c, gamma, fractions, dt, 1, tol, max_iter, info, wd)"
+            step = "conformal_run(q, p, ta, c, gamma, fractions, dt, 1, tol, max_iter, info, work_done)"
         else:
-            step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, wd)"
+            step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, work_done)"
         gamma = float(mechanics.conformal_rate or 0.0)
     else:
         fractions = np.array(cast(tuple[float, ...], method.data), dtype=np.float64)
@@ -149,21 +149,17 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
     velocities = [state[f"{q}_dot"] for q in scene.coordinate_names]
     used = set().union(*(e.free_symbols for e in exprs), *(c.free_symbols for c, _ in conditions)) if exprs else set()
     needs_velocity = bool(used & set(velocities))
-    source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
-                              mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
-                              "constraint_error" in kinds)
-    # the step loop is compiled into the member loop (numba inlines it at its IR level), so a
-    # one-step call costs no call and no reload of the state; the arithmetic is the same
+    # the step loop's body is pasted into the member loop when it has the usual shape (its work
+    # arrays then allocated once per member); else the loop is called for one step, compiled into
+    # the member loop (numba inlines it at its IR level); the arithmetic is the same either way
     system_source = mechanics.module.source
     for kernel in _STEP_KERNELS:
         system_source = system_source.replace(f"@numba.njit(cache=True)\ndef {kernel}(",
                                               f'@numba.njit(cache=True, inline="always")\ndef {kernel}(')
-    kernel_name = step.split("(")[0]
-    hoisted = _hoist_buffers(system_source, kernel_name)
-    if hoisted:  # its work arrays allocated once per member, not once per step
-        source = source.replace(step, step.replace(f"{kernel_name}(", "ens_step(").replace(")", ", buffers)"))
-        source = source.replace("    info = np.zeros(4)\n", "    info = np.zeros(4)\n    buffers = ens_step_buffers()\n", 1)
-        source = hoisted + source
+    pasted = _paste_step(system_source, step.split("(")[0])
+    source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
+                              mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
+                              "constraint_error" in kinds, pasted)
     module = import_source(system_source + source)
     variables = {name: sympy.Symbol(name, real=True) for name in scene.source.names}
     parameter_exprs = {k: parse_expression(v, variables, what=f"[system] parameters.{k}")
@@ -171,46 +167,42 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
     return CompiledEnsemble(mechanics, module, fractions, gamma, layout, parameter_exprs, scene.source.names)
 
 
-def _hoist_buffers(source: str, kernel: str) -> str:
-    """``ens_step_buffers()`` and ``ens_step(..., buffers)``: the step loop ``kernel`` of the
-    system's module with the work arrays it allocates on entry passed in instead (the same
-    statements otherwise), or ``""`` when it allocates none.
+def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[str]] | None:
+    """The step loop ``kernel`` of the system's module cut into the three parts the member
+    loop pastes in: its work-array allocations and the statements before its loop over steps
+    (once per member), and the body of that loop indented for the member's loop over steps
+    (once per step, with ``step = 0`` and ``n_steps = 1``), the same statements as in a
+    single run. None when the loop does not
+    have that shape (allocations, set-up, ``for step in range(n_steps):``, then only
+    ``report(...)``): the member loop then calls it.
 
     A one-step call of a loop that allocates two dozen small arrays spends most of its time
-    allocating (the angles' RATTLE: 3.5 x the per-step cost of a long run)."""
-    import re
-
+    allocating (the angles' RATTLE: 3.5 x the per-step cost of a long run), and passing
+    them in costs a reference count per array and step."""
     start = source.find(f"def {kernel}(")
     if start < 0:
-        return ""
-    signature = source[start:source.index("\n", start)]
-    doc_end = source.index('"""', source.index('"""', start) + 3) + 3
-    position = source.index("\n", doc_end) + 1
-    allocations = []
-    while True:
-        end = source.index("\n", position)
-        match = re.fullmatch(r"    (\w+) = (np\.(?:empty|zeros|ones)\(.*\))", source[position:end])
-        if match is None:
-            break
-        allocations.append((match.group(1), match.group(2)))
-        position = end + 1
-    if not allocations:
-        return ""
-    stop = source.find("\n@numba", position)
-    body = source[position:] if stop < 0 else source[position:stop]
-    names = ", ".join(name for name, _ in allocations)
-    lines = ["", "", "@numba.njit(cache=True)", "def ens_step_buffers():", f'    """The work arrays of {kernel}."""']
-    lines += [f"    {name} = {value}" for name, value in allocations]
-    lines += [f"    return ({names},)", "", "", '@numba.njit(cache=True, inline="always")',
-              signature.replace(f"def {kernel}(", "def ens_step(").replace("):", ", buffers):"),
-              f'    """{kernel} with its work arrays passed in (dirac.ensemble.general_kernel)."""',
-              f"    ({names},) = buffers"]
-    return "\n".join(lines) + "\n" + body.rstrip() + "\n"
+        return None
+    stop = source.find("\n@numba", start)
+    text = source[start:] if stop < 0 else source[start:stop]
+    doc_end = text.index('"""', text.index('"""') + 3) + 3
+    lines = text[text.index("\n", doc_end) + 1:].rstrip().split("\n")
+    loop = "    for step in range(n_steps):"
+    if loop not in lines:
+        return None
+    at = lines.index(loop)
+    head, rest = lines[:at], lines[at + 1:]
+    split = next((k for k, line in enumerate(rest) if line.strip() and not line.startswith("        ")), len(rest))
+    body, tail = rest[:split], rest[split:]
+    if [line.strip() for line in tail if line.strip()] != ["report(info, n_steps, False, evals, residual)"]:
+        return None
+    allocations = [line for line in head if "= np." in line]
+    prelude = [line for line in head if "= np." not in line]
+    return allocations, prelude, ["    " + line if line.strip() else line for line in body]  # one level deeper
 
 
 def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, exprs: list, conditions: list,
                      layout: dict, step: str, n: int, m: int, needs_velocity: bool, energy: bool,
-                     constraint: bool) -> str:
+                     constraint: bool, pasted: tuple[list[str], list[str], list[str]] | None = None) -> str:
     from dirac.codegen.kernel_source import emit_function
 
     q = list(lagrangian.coordinates)
@@ -278,116 +270,134 @@ def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
         lines.append("    " * depth + text)
 
     w(0, "@numba.njit(cache=True)")
-    w(0, "def ens_member(i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,")
+    w(0, "def ens_member(m_i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,")
     w(0, "               CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS):")
     w(1, '"""One member from t = 0 to the end or until its reductions are decided (module docstring)."""')
-    w(1, "q = Q[i]")
-    w(1, "p = P[i]")
-    w(1, "c = C[i]")
+    # the names of the step loop's arguments are the member's variables (q, p, t, c, info, work_done,
+    # n_steps, step): its body can be pasted in; the member's own names start with m_
+    w(1, "q = Q[m_i]")
+    w(1, "p = P[m_i]")
+    w(1, "c = C[m_i]")
     w(1, "info = np.zeros(4)")
-    w(1, "wd = np.zeros(1)")
-    w(1, f"v = np.zeros({n})")
-    w(1, f"vw = np.empty(({n}, {n}))")
-    w(1, f"vpiv = np.zeros({n}, dtype=np.int64)")
-    for name in ("qa", "pa", "qs", "ps"):
+    w(1, "work_done = np.zeros(1)")
+    w(1, "n_steps = 1")
+    w(1, "step = 0")
+    if pasted is not None:
+        allocations, prelude, _body = pasted
+        for line in [*allocations, *prelude]:
+            w(0, line)
+    w(1, f"m_v = np.zeros({n})")
+    w(1, f"m_vw = np.empty(({n}, {n}))")
+    w(1, f"m_vpiv = np.zeros({n}, dtype=np.int64)")
+    for name in ("m_qa", "m_pa", "m_qs", "m_ps"):
         w(1, f"{name} = np.empty({n})")
-    w(1, f"vs = np.zeros({n})")
+    w(1, f"m_vs = np.zeros({n})")
     nf = max(1, len(exprs))
-    w(1, f"f = np.zeros({nf})")
-    w(1, f"fa = np.zeros({nf})")
-    w(1, f"fs = np.zeros({nf})")
-    w(1, f"g = np.zeros({max(1, len(conditions))})")
-    w(1, f"res = np.zeros({max(1, 2 * m)})")
-    w(1, f"pc = np.zeros({max(1, n_poin)}, dtype=np.int64)")
-    w(1, "t0 = starts[0]")
-    w(1, "ens_velocity(q, p, t0, c, v, vw, vpiv)")
-    w(1, "ens_values(q, p, v, t0, c, f)")
+    w(1, f"m_f = np.zeros({nf})")
+    w(1, f"m_fa = np.zeros({nf})")
+    w(1, f"m_fs = np.zeros({nf})")
+    w(1, f"m_g = np.zeros({max(1, len(conditions))})")
+    w(1, f"m_res = np.zeros({max(1, 2 * m)})")
+    w(1, f"m_pc = np.zeros({max(1, n_poin)}, dtype=np.int64)")
+    w(1, "m_t0 = starts[0]")
+    w(1, "ens_velocity(q, p, m_t0, c, m_v, m_vw, m_vpiv)")
+    w(1, "ens_values(q, p, m_v, m_t0, c, m_f)")
     for x, (_, _, e) in enumerate(layout["ext"]):
-        w(1, f"EXT[i, {x}] = f[{e}]")
+        w(1, f"EXT[m_i, {x}] = m_f[{e}]")
     if energy:
-        w(1, "e0 = energy(q, p, t0, c)")
-        w(1, "EERR[i] = 0.0")
+        w(1, "m_e0 = energy(q, p, m_t0, c)")
+        w(1, "EERR[m_i] = 0.0")
     if constraint:
-        w(1, "CERR[i] = 0.0")
+        w(1, "CERR[m_i] = 0.0")
         if m:
-            w(1, "residuals(q, p, t0, c, res)")
-            w(1, f"for x in range({2 * m}):")
-            w(2, "if abs(res[x]) > CERR[i]:")
-            w(3, "CERR[i] = abs(res[x])")
-    w(1, "status = 0.0")
-    w(1, "steps = 0")
-    w(1, "stop = False")
-    w(1, "for k in range(starts.shape[0]):")
-    w(2, "a = starts[k]")
-    w(2, "for j in range(per_interval):")
-    w(3, f"for x in range({n}):")
-    w(4, "qa[x] = q[x]")
-    w(4, "pa[x] = p[x]")
-    w(3, f"for x in range({len(exprs)}):")
-    w(4, "fa[x] = f[x]")
-    w(3, "ta = a + j * dt")
-    w(3, step)
-    w(3, "if info[1] != 0.0:")
-    w(4, "status = 1.0")
-    w(4, "stop = True")
+            w(1, "residuals(q, p, m_t0, c, m_res)")
+            w(1, f"for m_x in range({2 * m}):")
+            w(2, "if abs(m_res[m_x]) > CERR[m_i]:")
+            w(3, "CERR[m_i] = abs(m_res[m_x])")
+    w(1, "m_status = 0.0")
+    w(1, "m_steps = 0")
+    w(1, "m_stop = False")
+    w(1, "STATUS[m_i] = 1.0  # until the member completes (a failing step returns from inside)")
+    w(1, "for m_k in range(starts.shape[0]):")
+    w(2, "m_a = starts[m_k]")
+    w(2, "for m_j in range(per_interval):")
+    w(3, f"for m_x in range({n}):")
+    w(4, "m_qa[m_x] = q[m_x]")
+    w(4, "m_pa[m_x] = p[m_x]")
+    w(3, f"for m_x in range({len(exprs)}):")
+    w(4, "m_fa[m_x] = m_f[m_x]")
+    w(3, "ta = m_a + m_j * dt")
+    if pasted is not None:
+        w(3, "t = ta")
+        for line in pasted[2]:
+            if line.strip() == "return":
+                indent = line[: len(line) - len(line.lstrip())]
+                w(0, f"{indent}STEPS[m_i] = m_steps")
+            w(0, line)
+    else:
+        w(3, step)
+        w(3, "if info[1] != 0.0:")
+        w(4, "m_status = 1.0")
+        w(4, "m_stop = True")
+        w(4, "break")
+    w(3, "m_steps += 1")
+    w(3, "tb = m_a + (m_j + 1) * dt")
+    w(3, "m_bad = False")
+    w(3, f"for m_x in range({n}):")
+    w(4, "if not (abs(q[m_x]) < np.inf and abs(p[m_x]) < np.inf):")
+    w(5, "m_bad = True")
+    w(3, "if m_bad:")
+    w(4, "m_status = 2.0")
+    w(4, "m_stop = True")
     w(4, "break")
-    w(3, "steps += 1")
-    w(3, "tb = a + (j + 1) * dt")
-    w(3, "bad = False")
-    w(3, f"for x in range({n}):")
-    w(4, "if not (abs(q[x]) < np.inf and abs(p[x]) < np.inf):")
-    w(5, "bad = True")
-    w(3, "if bad:")
-    w(4, "status = 2.0")
-    w(4, "stop = True")
-    w(4, "break")
-    w(3, "ens_velocity(q, p, tb, c, v, vw, vpiv)")
-    w(3, "ens_values(q, p, v, tb, c, f)")
+    w(3, "ens_velocity(q, p, tb, c, m_v, m_vw, m_vpiv)")
+    w(3, "ens_values(q, p, m_v, tb, c, m_f)")
     for x, (_, kind, e) in enumerate(layout["ext"]):
         op = ">" if kind == "max" else "<"
-        w(3, f"if f[{e}] {op} EXT[i, {x}]:")
-        w(4, f"EXT[i, {x}] = f[{e}]")
+        w(3, f"if m_f[{e}] {op} EXT[m_i, {x}]:")
+        w(4, f"EXT[m_i, {x}] = m_f[{e}]")
+    locate = "m_qa, m_pa, q, p, ta, dt, c, m_qs, m_ps, m_vs, m_fs"
     for gi, (_, group) in enumerate(layout["cross"]):
-        w(3, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
-        w(4, "best = np.inf")
+        w(3, f"if CROSS[m_i, {gi}] != CROSS[m_i, {gi}]:")
+        w(4, "m_best = np.inf")
         for e, cond in group:
-            w(4, f"if (fa[{e}] < 0.0 and f[{e}] >= 0.0) or (fa[{e}] > 0.0 and f[{e}] <= 0.0):")
-            w(5, f"s = ens_locate({e}, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, fa[{e}], f[{e}], vw, vpiv)")
+            w(4, f"if (m_fa[{e}] < 0.0 and m_f[{e}] >= 0.0) or (m_fa[{e}] > 0.0 and m_f[{e}] <= 0.0):")
+            w(5, f"m_s = ens_locate({e}, {locate}, m_fa[{e}], m_f[{e}], m_vw, m_vpiv)")
             if cond >= 0:
-                w(5, "ens_conditions(qs, ps, vs, ta + s * dt, c, g)")
-                w(5, f"if g[{cond}] {conditions[cond][1]} 0.0 and ta + s * dt < best:")
+                w(5, "ens_conditions(m_qs, m_ps, m_vs, ta + m_s * dt, c, m_g)")
+                w(5, f"if m_g[{cond}] {conditions[cond][1]} 0.0 and ta + m_s * dt < m_best:")
             else:
-                w(5, "if ta + s * dt < best:")
-            w(6, "best = ta + s * dt")
-        w(4, "if best < np.inf:")
-        w(5, f"CROSS[i, {gi}] = best")
+                w(5, "if ta + m_s * dt < m_best:")
+            w(6, "m_best = ta + m_s * dt")
+        w(4, "if m_best < np.inf:")
+        w(5, f"CROSS[m_i, {gi}] = m_best")
     for pj, (_, e, count) in enumerate(layout["poincare"]):
-        w(3, f"if pc[{pj}] < {count} and fa[{e}] < 0.0 and f[{e}] >= 0.0:")
-        w(4, f"s = ens_locate({e}, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, fa[{e}], f[{e}], vw, vpiv)")
-        w(4, f"PT[i, {pj}, pc[{pj}]] = ta + s * dt")
-        w(4, f"for x in range({n}):")
-        w(5, f"PQ[i, {pj}, pc[{pj}], x] = qs[x]")
-        w(5, f"PP[i, {pj}, pc[{pj}], x] = ps[x]")
-        w(4, f"pc[{pj}] += 1")
-    decided = [f"CROSS[i, {gi}] == CROSS[i, {gi}]" for gi in range(n_cross)]
-    decided += [f"pc[{pj}] >= {count}" for pj, (_, _, count) in enumerate(layout["poincare"])]
+        w(3, f"if m_pc[{pj}] < {count} and m_fa[{e}] < 0.0 and m_f[{e}] >= 0.0:")
+        w(4, f"m_s = ens_locate({e}, {locate}, m_fa[{e}], m_f[{e}], m_vw, m_vpiv)")
+        w(4, f"PT[m_i, {pj}, m_pc[{pj}]] = ta + m_s * dt")
+        w(4, f"for m_x in range({n}):")
+        w(5, f"PQ[m_i, {pj}, m_pc[{pj}], m_x] = m_qs[m_x]")
+        w(5, f"PP[m_i, {pj}, m_pc[{pj}], m_x] = m_ps[m_x]")
+        w(4, f"m_pc[{pj}] += 1")
+    decided = [f"CROSS[m_i, {gi}] == CROSS[m_i, {gi}]" for gi in range(n_cross)]
+    decided += [f"m_pc[{pj}] >= {count}" for pj, (_, _, count) in enumerate(layout["poincare"])]
     if decided:
         w(3, f"if early and {' and '.join(decided)}:")
-        w(4, "stop = True")
+        w(4, "m_stop = True")
         w(4, "break")
-    w(2, "if stop:")
+    w(2, "if m_stop:")
     w(3, "break")
     if energy:
-        w(2, "err = abs(energy(q, p, ends[k], c) - wd[0] - e0)")
-        w(2, "if not (err <= EERR[i]):")
-        w(3, "EERR[i] = err")
+        w(2, "m_err = abs(energy(q, p, ends[m_k], c) - work_done[0] - m_e0)")
+        w(2, "if not (m_err <= EERR[m_i]):")
+        w(3, "EERR[m_i] = m_err")
     if constraint and m:
-        w(2, "residuals(q, p, ends[k], c, res)")
-        w(2, f"for x in range({2 * m}):")
-        w(3, "if not (abs(res[x]) <= CERR[i]):")
-        w(4, "CERR[i] = abs(res[x])")
-    w(1, "STATUS[i] = status")
-    w(1, "STEPS[i] = steps")
+        w(2, "residuals(q, p, ends[m_k], c, m_res)")
+        w(2, f"for m_x in range({2 * m}):")
+        w(3, "if not (abs(m_res[m_x]) <= CERR[m_i]):")
+        w(4, "CERR[m_i] = abs(m_res[m_x])")
+    w(1, "STATUS[m_i] = m_status")
+    w(1, "STEPS[m_i] = m_steps")
     out.append("\n".join(lines) + "\n")
     out.append(f'''
 

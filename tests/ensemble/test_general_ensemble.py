@@ -281,3 +281,22 @@ def test_killed_flip_map_run_resumes_bit_identically(tmp_path):
     assert run_ensemble(path, tmp_path / "whole").complete
     for name in ("flip_time", "highest"):
         assert np.array_equal(_arrays(out)[name], _arrays(tmp_path / "whole")[name], equal_nan=True)
+
+
+def test_failed_members_are_nan_with_their_reason(tmp_path):
+    """With one Newton iteration per step, RATTLE's implicit stage converges only where the
+    first guess already solves it: the pendulum at rest at the bottom (no force, no motion).
+    Every other member fails with code 1 (Newton) and NaN reductions; that one completes."""
+    (tmp_path / "angles.toml").write_text(ANGLES)
+    path = _scene(tmp_path, '[system]\nfile = "angles.toml"\n', 'q = { th1 = "a", th2 = "b" }',
+                  "dt = 0.01\nt_end = 0.5\nmax_newton_iterations = 1",
+                  'grid = { a = [-0.5, 0.5, 3], b = [-0.5, 0.5, 3] }\n'
+                  'reductions = [{ kind = "max", name = "top", expr = "th1" }, "final"]')
+    assert run_ensemble(path, tmp_path / "out").complete
+    stored = _arrays(tmp_path / "out")
+    centre = (stored["a"] == 0.0) & (stored["b"] == 0.0)
+    assert np.array_equal(stored["failures"], np.where(centre, 0.0, 1.0))
+    assert np.all(np.isnan(stored["top"][~centre])) and np.all(np.isnan(stored["final_q"][~centre]))
+    assert stored["top"][centre] == 0.0 and np.array_equal(stored["final_q"][centre], [[0.0, 0.0]])
+    meta = json.loads((tmp_path / "out" / "meta.json").read_text())
+    assert meta["failure_codes"]["1"].startswith("Newton iteration did not converge")
