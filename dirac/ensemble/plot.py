@@ -184,7 +184,7 @@ def picture_data(out: str | Path, array: str | None = None, x: str | None = None
             column = coordinates.index(name[2:] if stored == "p" else name)
             points[axis] = _read_array(group, f"{array}_{stored}")[..., column].ravel()
         return {"kind": "section", "x": points["x"], "y": points["y"], "xlabel": x, "ylabel": y,
-                "title": f"Poincaré section {array}: {int(np.isfinite(points['x']).sum())} points"}
+                "title": f"Poincaré section {array!r}: {int(np.isfinite(points['x']).sum())} points"}
     if array not in scalar:
         raise InputError(f"{out} has no scalar reduction {array!r}; it has {', '.join(scalar + poincare) or 'none'}")
     grid = scene["variables"]["grid"]

@@ -224,7 +224,7 @@ def test_map_and_section_pictures(tmp_path):
                   '{ kind = "poincare", name = "section", expr = "x1", count = 3 }]')
     assert run_ensemble(path, tmp_path / "out").complete
     for args, expected in ([[], "map of flip_time: 5 x 4 members"], [["--array", "section", "--x", "x2", "--y", "p_x2"],
-                                                                      "Poincaré section section"]):
+                                                                      "Poincaré section 'section'"]):
         image = tmp_path / "picture.png"
         result = subprocess.run([sys.executable, "-m", "dirac", "ensemble-plot", str(tmp_path / "out"), "--out",
                                  str(image), *args], capture_output=True, text=True, timeout=120)
