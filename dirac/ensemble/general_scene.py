@@ -350,6 +350,10 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
     source = parse_variables(ensemble)
     import sympy
 
+    for name in source.names:
+        if name in ("failures", "steps", "t") or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+            raise InputError(f"[ensemble] variable {name!r}: give an identifier other than failures, steps and t "
+                             "(the store's own arrays)")
     variables = {name: sympy.Symbol(name, real=True) for name in source.names}
     hint = f"define it under [ensemble] grid or [ensemble.variables] (the ensemble variables are: {', '.join(source.names) or 'none'})"
 
