@@ -32,6 +32,7 @@ COMMANDS: dict[str, str] = {
     "run": "dirac.commands.run",
     "bench": "dirac.commands.bench",
     "ensemble": "dirac.commands.ensemble",
+    "ensemble-plot": "dirac.commands.ensemble_plot",
 }
 
 

@@ -24,7 +24,7 @@ ALLOWED: dict[str, set[str]] = {
     "rigidbody": {"errors", "validate", "compositions"},
     "flows": {"errors", "validate", "versions", "compositions", "model", "analysis", "codegen", "rigidbody"},
     "io": {"errors", "validate", "model", "rigidbody", "flows"},
-    "ensemble": {"errors", "validate", "versions", "rigidbody", "flows", "io"},
+    "ensemble": {"errors", "validate", "versions", "model", "codegen", "rigidbody", "flows", "io"},
     "bench": {"errors", "validate", "versions", "model", "rigidbody", "flows", "io"},
     "plots": {"errors", "lazy_exports"},
     "commands": {"errors", "validate", "versions", "model", "analysis", "rigidbody", "flows", "io", "ensemble",

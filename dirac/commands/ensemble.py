@@ -1,4 +1,4 @@
-"""``dirac ensemble SCENE.toml --out DIR``: run (or resume) an ensemble of rigid bodies.
+"""``dirac ensemble SCENE.toml --out DIR``: run (or resume) an ensemble of rigid bodies or of any system.
 
 Locally by default (all cores, no set-up); on a dask.distributed cluster with
 ``--scheduler ADDRESS`` or ``--cluster local``. Results go to a zarr store in ``DIR``;
@@ -19,11 +19,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare ``dirac ensemble`` and its options."""
     parser = subparsers.add_parser(
         "ensemble",
-        help="run an ensemble scene (many bodies, chunked, resumable)",
+        help="run an ensemble scene (many members of any system, chunked, resumable)",
         description="Run an ensemble scene: many free rigid bodies drawn from named distributions "
-        "(or read from a file), advanced in chunks by the batched Lie-Poisson kernels, results "
-        "written chunk by chunk to a zarr store in DIR. Rerun the same command to resume an "
-        "interrupted run (only missing chunks are computed). See docs/ensembles.md.",
+        "(or read from a file), advanced in chunks by the batched Lie-Poisson kernels, or many members "
+        "of any other system (a grid and/or random draws of ensemble variables) advanced by the system's "
+        "own RATTLE step batched over members; results written chunk by chunk to a zarr store in DIR. "
+        "Rerun the same command to resume an interrupted run (only missing chunks are computed). "
+        "See docs/ensembles.md and docs/ensembles_general.md.",
     )
     parser.add_argument("scene", metavar="SCENE.toml", help="ensemble scene file ([system], [initial], [run], [ensemble])")
     parser.add_argument("--out", metavar="DIR", required=True, help="output folder (zarr store data.zarr, meta.json)")

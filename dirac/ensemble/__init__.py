@@ -1,4 +1,4 @@
-"""Ensembles of rigid bodies: chunked batched flows, locally or on a dask cluster.
+"""Ensembles of rigid bodies and of any system: chunked batched flows, locally or on a dask cluster.
 
 Modules, one job each:
 
@@ -15,7 +15,12 @@ Modules, one job each:
 - :mod:`dirac.ensemble.arguments` -- errors that name :func:`run_ensemble`'s arguments;
 - :mod:`dirac.ensemble.engine` -- :func:`run_ensemble`: plan, run locally or on dask, resume;
 - :mod:`dirac.ensemble.bench` -- the throughput measurement of ``dirac bench --ensemble``;
-- :mod:`dirac.ensemble.plot` -- the flip-time figure.
+- :mod:`dirac.ensemble.plot` -- the flip-time figure; the data of a general ensemble's map or section;
+- :mod:`dirac.ensemble.variables` -- named ensemble variables: a grid and/or random draws;
+- :mod:`dirac.ensemble.general_scene` -- scenes of any other system, their reductions;
+- :mod:`dirac.ensemble.general_kernel` -- the system's own step batched over members (generated);
+- :mod:`dirac.ensemble.general_chunk` -- one chunk of such an ensemble;
+- :mod:`dirac.ensemble.kernel_lock` -- the lock around the parallel kernels.
 
 The command lines are in :mod:`dirac.commands` (``ensemble``, ``bench_ensemble``,
 ``ensemble_plot``).

@@ -174,3 +174,141 @@ def format_table(results: dict[str, Any]) -> str:
     )
     return "\n".join(lines)
 
+
+
+# ---------------------------------------------------------------- general systems
+#: The systems of the general-ensemble table: the double pendulum in Cartesian coordinates
+#: (two rods, constant-mass RATTLE) and in its two angles (configuration-dependent mass).
+GENERAL_SYSTEMS: dict[str, tuple[dict, dict]] = {
+    "double pendulum (x1, y1, x2, y2; 2 rods)": (
+        {"name": "double_pendulum"},
+        {"x1": "sin(a)", "y1": "-cos(a)", "x2": "sin(a) + sin(b)", "y2": "-cos(a) - cos(b)"},
+    ),
+    "double pendulum (th1, th2)": (
+        {"name": "double_pendulum_angles", "coordinates": ["th1", "th2"],
+         "parameters": {"m1": 1.0, "m2": 1.0, "g": 9.81, "l1": 1.0, "l2": 1.0},
+         "lagrangian": "(m1 + m2)/2*l1**2*th1_dot**2 + m2/2*l2**2*th2_dot**2 + m2*l1*l2*th1_dot*th2_dot*cos(th1 - th2)"
+                       " + (m1 + m2)*g*l1*cos(th1) + m2*g*l2*cos(th2)"},
+        {"th1": "a", "th2": "b"},
+    ),
+}
+
+
+def _prange_baseline():
+    """The hand-written baseline: ``numba.prange`` over members, each advanced by the
+    system's own RATTLE step loop for all its steps in one call (no reductions)."""
+    import numba
+    import numpy as np
+
+    @numba.njit(parallel=True, cache=False)
+    def run(step, Q, P, C, fractions, dt, n_steps, tol, max_iter):  # pragma: no cover - compiled
+        for i in numba.prange(Q.shape[0]):
+            info = np.zeros(4)
+            step(Q[i], P[i], 0.0, C[i], fractions, dt, n_steps, tol, max_iter, info)
+
+    return run
+
+
+def measure_general(members: int = 1024, steps: int = 2000, dt: float = 2e-3, repeats: int = 3) -> list[dict[str, Any]]:
+    """Per-member-step cost of a general ensemble against a single long run and a prange loop.
+
+    For each system of :data:`GENERAL_SYSTEMS`, members released at rest from a grid of
+    angles ``[0.2, 0.6]^2`` (none flips: every member runs every step), ``rattle-2``:
+
+    * *single run*: the system's compiled RATTLE loop (the kernel of ``dirac run``) for
+      ``members * steps`` steps of one member, ns per step;
+    * *ensemble, 1 thread*: the ensemble's member loop (one step at a time, a ``max``
+      reduction evaluated after every step), numba on one thread, ns per member-step;
+    * *ensemble* and *prange baseline*: all threads; the baseline is a hand-written
+      ``numba.prange`` loop over the members calling the same RATTLE loop for all steps.
+
+    Each figure is the best of ``repeats`` (CPU time for one thread, wall time for all).
+    """
+    from dirac.ensemble.general_scene import parse_general_scene
+
+    side = int(round(members ** 0.5))
+    baseline = _prange_baseline()
+    rows = []
+    for label, (system, q) in GENERAL_SYSTEMS.items():
+        scene = parse_general_scene({
+            "system": system, "initial": {"q": q},
+            "run": {"method": "rattle-2", "dt": dt, "t_end": steps * dt, "samples": 2},
+            "ensemble": {"grid": {"a": [0.2, 0.6, side], "b": [0.2, 0.6, side]},
+                         "reductions": [{"kind": "max", "expr": next(iter(q))}]},
+        })
+        rows.append({"system": label, **_measure_scene(scene, steps, repeats, baseline)})
+    return rows
+
+
+def _measure_scene(scene: Any, steps: int, repeats: int, baseline: Any) -> dict[str, Any]:
+    """The figures of :func:`measure_general` for one scene."""
+    import numba
+    import numpy as np
+
+    from dirac.ensemble.general_chunk import initial_states, step_grid
+    from dirac.ensemble.general_kernel import compiled_ensemble
+
+    compiled = compiled_ensemble(scene)
+    module = compiled.module
+    Q, P, C = initial_states(scene, compiled, scene.source.members(0, scene.count))
+    starts, ends, per, step_dt = step_grid(scene)
+    kernel = module.rattle_constant_mass if compiled.mechanics.constant_mass is not None else module.rattle_general
+    count = scene.count
+    shapes = module.ENS_SHAPES
+
+    def ensemble(threads: int) -> float:
+        q, p = Q.copy(), P.copy()
+        n = Q.shape[1]
+        arrays = (np.full((count, shapes[0]), np.nan), np.full((count, shapes[1]), np.nan), np.full(count, np.nan),
+                  np.full(count, np.nan), np.full((count, shapes[2], shapes[3]), np.nan),
+                  np.full((count, shapes[2], shapes[3], n), np.nan), np.full((count, shapes[2], shapes[3], n), np.nan),
+                  np.zeros(count), np.zeros(count))
+        numba.set_num_threads(threads)
+        clock = time.process_time if threads == 1 else time.perf_counter
+        start = clock()
+        module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False, *arrays)
+        return clock() - start
+
+    def single() -> float:
+        q, p, info = Q[0].copy(), P[0].copy(), np.zeros(4)
+        start = time.process_time()
+        kernel(q, p, 0.0, C[0], compiled.fractions, step_dt, count * steps, 1e-12, 50, info)
+        return time.process_time() - start
+
+    def prange() -> float:
+        q, p = Q.copy(), P.copy()
+        start = time.perf_counter()
+        baseline(kernel, q, p, C, compiled.fractions, step_dt, steps, 1e-12, 50)
+        return time.perf_counter() - start
+
+    threads = numba.get_num_threads()
+    try:
+        ensemble(1), single(), prange()  # compile and warm up
+        work = count * steps
+        return {
+            "single_ns": 1e9 * min(single() for _ in range(repeats)) / work,
+            "ensemble_1_ns": 1e9 * min(ensemble(1) for _ in range(repeats)) / work,
+            "ensemble_rate": work / min(ensemble(threads) for _ in range(repeats)),
+            "prange_rate": work / min(prange() for _ in range(repeats)),
+            "threads": threads,
+        }
+    finally:
+        numba.set_num_threads(threads)
+
+
+def format_general_table(rows: list[dict[str, Any]]) -> str:
+    """The general-ensemble table: cost per member-step against a single run and a prange loop."""
+    lines = [
+        "general systems, rattle-2, every member runs every step:",
+        f"{'system':<42} {'single run':>12} {'ensemble 1 thr':>15} {'ratio':>6} {'ensemble':>12} {'prange':>12} {'ratio':>6}",
+        f"{'':<42} {'ns/step':>12} {'ns/member-step':>15} {'':>6} {'member-st/s':>12} {'member-st/s':>12} {'':>6}",
+    ]
+    for row in rows:
+        lines.append(
+            f"{row['system']:<42} {row['single_ns']:>12.1f} {row['ensemble_1_ns']:>15.1f} "
+            f"{row['ensemble_1_ns'] / row['single_ns']:>6.2f} {row['ensemble_rate']:>12.3g} {row['prange_rate']:>12.3g} "
+            f"{row['ensemble_rate'] / row['prange_rate']:>6.2f}"
+        )
+    lines.append("targets: ensemble per member-step <= 1.2 x a single run; ensemble throughput >= 0.5 x the prange loop "
+                 f"({rows[0]['threads'] if rows else 0} threads)")
+    return "\n".join(lines)

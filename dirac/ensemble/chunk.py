@@ -7,20 +7,17 @@ times, gives the same bits.
 
 from __future__ import annotations
 
-import threading
 from contextlib import contextmanager
 
 import numpy as np
 
+from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.ensemble.reductions import casimir_of, energy_of, make_reductions
-from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
+from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, AnyScene
 
 __all__ = ["advance_members", "compute_chunk", "warm_up", "KERNEL_LOCK"]
 
-#: Serialises the parallel kernel within one process: numba's default ("workqueue")
-#: threading layer must not be entered by two threads at once (threaded dask workers),
-#: and one call already uses every thread numba is allowed.
-KERNEL_LOCK = threading.Lock()
 
 #: Member-steps below which one kernel call runs single-threaded (about 10 ms of work).
 #: Measured on a shared two-core machine: a scene of 20000 members with 2 steps per
@@ -70,7 +67,7 @@ def _threads_for(work_per_call: int):
 
 
 def compute_chunk(
-    scene: EnsembleScene,
+    scene: AnyScene,
     start: int,
     stop: int,
     members: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
@@ -96,6 +93,10 @@ def compute_chunk(
         Array name -> array with ``stop - start`` rows (trajectory outputs have shape
         ``(n, samples, ...)``, reductions ``(n, ...)``).
     """
+    if isinstance(scene, GeneralEnsembleScene):
+        from dirac.ensemble.general_chunk import compute_general_chunk
+
+        return compute_general_chunk(scene, start, stop, members)  # type: ignore[arg-type]
     M, R, inertia = scene.source.members(start, stop) if members is None else members
     inv = np.ascontiguousarray(1.0 / inertia)
     n = stop - start

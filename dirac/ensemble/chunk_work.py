@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from dirac.ensemble.chunk_plan import chunk_bounds
-from dirac.ensemble.scene import EnsembleScene
+from dirac.ensemble.scene import AnyScene
 from dirac.ensemble.store import EnsembleStore
 
 __all__ = ["ChunkWork", "Recorder"]
@@ -40,7 +40,7 @@ class ChunkWork:
         Receives each finished or failed chunk.
     """
 
-    scene: EnsembleScene
+    scene: AnyScene
     store: EnsembleStore
     missing: list[int]
     chunk_size: int

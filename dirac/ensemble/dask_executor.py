@@ -16,7 +16,7 @@ from typing import Any
 
 from dirac.ensemble.chunk import compute_chunk, warm_up
 from dirac.ensemble.chunk_work import ChunkWork
-from dirac.ensemble.scene import EnsembleScene
+from dirac.ensemble.scene import AnyScene
 from dirac.ensemble.store import EnsembleStore
 from dirac.errors import InputError
 
@@ -24,7 +24,7 @@ __all__ = ["QUIET_DASK", "dask_client", "local_cluster", "run_chunk", "run_dask"
 
 
 def run_chunk(
-    scene: EnsembleScene,
+    scene: AnyScene,
     root: str,
     index: int,
     start: int,

@@ -46,9 +46,10 @@ from dirac.ensemble.arguments import ArgumentError
 from dirac.ensemble.chunk_plan import chunk_count, default_chunk_size
 from dirac.ensemble.chunk_work import ChunkWork
 from dirac.ensemble.dask_executor import run_dask
+from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.local_executor import run_local
 from dirac.ensemble.run_record import RunRecord, new_meta
-from dirac.ensemble.scene import EnsembleScene, load_ensemble_scene
+from dirac.ensemble.scene import AnyScene, EnsembleScene, load_ensemble_scene
 from dirac.ensemble.store import FORMAT, EnsembleStore
 from dirac.errors import InputError
 
@@ -143,7 +144,7 @@ class _Progress:
 
 
 def run_ensemble(
-    scene: EnsembleScene | str | Path,
+    scene: AnyScene | str | Path,
     out: str | Path,
     *,
     chunk_size: int | None = None,
@@ -194,7 +195,7 @@ def run_ensemble(
         scheduler cannot be reached.
     """
     say = notify or (lambda message: None)
-    if not isinstance(scene, EnsembleScene):
+    if not isinstance(scene, (EnsembleScene, GeneralEnsembleScene)):
         scene = load_ensemble_scene(scene)
     _check_executor(scheduler, cluster)
     store = EnsembleStore(out)
@@ -204,6 +205,10 @@ def run_ensemble(
     chunk_size = _plan_chunk_size(scene, store, meta, chunk_size)
     n_chunks = chunk_count(scene.count, chunk_size)
     if meta is None:
+        if isinstance(scene, GeneralEnsembleScene):
+            from dirac.ensemble.general_chunk import check_initial_states
+
+            check_initial_states(scene)  # bad initial data: refused before anything is written
         meta = _create_store(scene, store, chunk_size, n_chunks)
     done = store.completed()
     missing = [i for i in range(n_chunks) if i not in done]
@@ -242,7 +247,7 @@ def _check_executor(scheduler: str | None, cluster: str | None) -> None:
         raise InputError("give scheduler=ADDRESS or cluster='local', not both")
 
 
-def _plan_chunk_size(scene: EnsembleScene, store: EnsembleStore, meta: dict | None, chunk_size: int | None) -> int:
+def _plan_chunk_size(scene: AnyScene, store: EnsembleStore, meta: dict | None, chunk_size: int | None) -> int:
     """Step 2: the chunk size: the stored one when resuming, else the asked or default one.
 
     Raises
@@ -266,7 +271,7 @@ def _plan_chunk_size(scene: EnsembleScene, store: EnsembleStore, meta: dict | No
     return min(chosen, scene.count)
 
 
-def _check_stored_scene(scene: EnsembleScene, store: EnsembleStore, meta: dict) -> None:
+def _check_stored_scene(scene: AnyScene, store: EnsembleStore, meta: dict) -> None:
     """Step 3, resuming: the store must hold an ensemble of this scene (same fingerprint)."""
     if meta.get("format") != FORMAT or meta.get("fingerprint") != scene.fingerprint():
         raise ArgumentError(
@@ -275,7 +280,7 @@ def _check_stored_scene(scene: EnsembleScene, store: EnsembleStore, meta: dict) 
         )
 
 
-def _create_store(scene: EnsembleScene, store: EnsembleStore, chunk_size: int, n_chunks: int) -> dict:
+def _create_store(scene: AnyScene, store: EnsembleStore, chunk_size: int, n_chunks: int) -> dict:
     """Step 3, a new ensemble: create the store and its ``meta.json``; return the meta."""
     meta = new_meta(scene, chunk_size, n_chunks)
     store.create(scene, chunk_size, {**meta, "complete": False, "chunks_complete": 0, "chunks_done": []})

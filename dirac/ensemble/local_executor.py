@@ -8,7 +8,9 @@ integrated. A failing chunk is tried ``retries + 1`` times, then reported (never
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Any
 
 from dirac.ensemble.chunk import compute_chunk
 from dirac.ensemble.chunk_work import ChunkWork
@@ -49,19 +51,20 @@ def run_local(work: ChunkWork) -> None:
         return None, {}, retries, error
 
     pending: tuple[int, Future[dict]] | None = None
+    draw: Callable[[int, int], Any] = scene.source.members
     bounds = [work.bounds(index) for index in missing]
     with (ThreadPoolExecutor(max_workers=1) as writer, ThreadPoolExecutor(max_workers=1) as drawer,
           ThreadPoolExecutor(max_workers=1) as computer):
         # draw the next chunk's members while this one is integrated (numpy's generators
         # and array operations release the GIL)
-        upcoming = drawer.submit(scene.source.members, *bounds[0]) if bounds else None
+        upcoming = drawer.submit(draw, *bounds[0]) if bounds else None
         for position, index in enumerate(missing):
             start, stop = bounds[position]
             try:
                 members = upcoming.result() if upcoming is not None else None
             except Exception:
                 members = None
-            upcoming = drawer.submit(scene.source.members, *bounds[position + 1]) if position + 1 < len(bounds) else None
+            upcoming = drawer.submit(draw, *bounds[position + 1]) if position + 1 < len(bounds) else None
             computing = computer.submit(attempts, start, stop, members)
             # the previous chunk is reported as soon as its write is done, while this one is integrated
             if pending is not None:

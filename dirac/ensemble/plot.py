@@ -126,3 +126,76 @@ def plot_flip_times(out: str | Path, image: str | Path) -> dict[str, float]:
     plt.close(fig)
     return summary
 
+
+
+def _open_results(out: str | Path) -> tuple[dict, zarr.Group]:
+    import zarr
+
+    try:
+        meta = json.loads((Path(out) / "meta.json").read_text())
+        group = zarr.open_group(str(Path(out) / "data.zarr"), mode="r")
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{out} holds no ensemble results ({exc}); run 'dirac ensemble SCENE --out {out}' first") from None
+    if not meta.get("complete"):
+        warn(f"{out}: the ensemble is not complete ({meta.get('chunks_complete')} of {meta.get('chunks_total')} chunks); "
+             "unfinished members are missing")
+    return meta, group
+
+
+def picture_data(out: str | Path, array: str | None = None, x: str | None = None, y: str | None = None) -> dict:
+    """What the picture of a general ensemble in ``out`` shows, read from its store.
+
+    A Poincaré section (a ``poincare`` reduction, or ``array`` naming one) gives
+    ``{"kind": "section", "x": ..., "y": ..., "xlabel", "ylabel"}``: the section points of
+    every member, ``x`` and ``y`` a coordinate or a momentum ``p_<q>`` (default the first
+    coordinate and its momentum). Otherwise a two-dimensional grid gives ``{"kind": "map",
+    "values": (n1, n2), "x": (name, lo, hi), "y": (name, lo, hi), "label"}`` of ``array``
+    (default the first scalar reduction: ``first_crossing``, ``max``, ``min``, ...).
+
+    Raises
+    ------
+    InputError
+        No results, an unknown array or coordinate, or a grid that is not two-dimensional.
+    """
+    meta, group = _open_results(out)
+    scene = meta.get("scene", {})
+    if "reductions" not in scene or not isinstance(scene["reductions"], list) or "variables" not in scene:
+        raise InputError(f"{out} holds a rigid-body ensemble: draw it with 'python -m dirac.commands.ensemble_plot'")
+    reductions = scene["reductions"]
+    coordinates = _coordinates(scene)
+    poincare = [r["name"] for r in reductions if r["kind"] == "poincare"]
+    scalar = [r["name"] for r in reductions if r["kind"] in ("first_crossing", "max", "min", "energy_error",
+                                                              "constraint_error")]
+    if array is None:
+        array = poincare[0] if poincare and not scalar else (scalar[0] if scalar else None)
+        if array is None:
+            raise InputError(f"{out} has no reduction to draw (first_crossing, max, min, poincare, ...)")
+    if array in poincare:
+        names = [*coordinates, *(f"p_{c}" for c in coordinates)]
+        x = x or coordinates[0]
+        y = y or f"p_{coordinates[0]}"
+        points = {}
+        for axis, name in (("x", x), ("y", y)):
+            if name not in names:
+                from dirac.validate import unknown_name_error
+
+                raise unknown_name_error("coordinate", name, names, f"--{axis}")
+            stored = "p" if name.startswith("p_") and name[2:] in coordinates else "q"
+            column = coordinates.index(name[2:] if stored == "p" else name)
+            points[axis] = _read_array(group, f"{array}_{stored}")[..., column].ravel()
+        return {"kind": "section", "x": points["x"], "y": points["y"], "xlabel": x, "ylabel": y,
+                "title": f"Poincaré section {array!r}: {int(np.isfinite(points['x']).sum())} points"}
+    if array not in scalar:
+        raise InputError(f"{out} has no scalar reduction {array!r}; it has {', '.join(scalar + poincare) or 'none'}")
+    grid = scene["variables"]["grid"]
+    if len(grid) != 2 or scene["variables"]["draws"] != 1 or scene["variables"]["random"]:
+        raise InputError(f"a map needs a two-dimensional grid (and no random draws); {out} has grid variables "
+                         f"{', '.join(grid) or 'none'}")
+    (xname, (xlo, xhi, nx)), (yname, (ylo, yhi, ny)) = grid.items()
+    values = _read_array(group, array).reshape(int(nx), int(ny))
+    return {"kind": "map", "values": values, "x": (xname, float(xlo), float(xhi)), "y": (yname, float(ylo), float(yhi)),
+            "label": array}
+
+
+def _coordinates(scene: dict) -> list[str]:
+    return [str(name) for name in scene["coordinates"]]

@@ -13,7 +13,9 @@ import time
 import uuid
 
 from dirac.ensemble.chunk_plan import chunk_bounds
-from dirac.ensemble.scene import EnsembleScene
+from dirac.ensemble.general_kernel import FAILURES
+from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.scene import AnyScene
 from dirac.ensemble.store import FORMAT, EnsembleStore, array_layout
 from dirac.versions import installed_versions
 
@@ -35,15 +37,21 @@ def _versions() -> dict[str, str]:
     return installed_versions(("dirac-mechanics", "numpy", "numba", "zarr", "dask", "distributed"), missing=None)
 
 
-def new_meta(scene: EnsembleScene, chunk_size: int, n_chunks: int) -> dict:
+def _system_name(scene: AnyScene) -> str:
+    if not isinstance(scene, GeneralEnsembleScene):
+        return "rigid_body"
+    return str(scene.system.get("name") or scene.system.get("file") or "inline system")
+
+
+def new_meta(scene: AnyScene, chunk_size: int, n_chunks: int) -> dict:
     """``meta.json`` of a new ensemble of ``scene`` in chunks of ``chunk_size`` (no run yet)."""
     return {
         "format": FORMAT,
         "fingerprint": scene.fingerprint(),
         "scene_file": scene.path,
         "scene": scene.describe(),
-        "system": "rigid_body",
-        "parameters": scene.describe()["distributions"],
+        "system": _system_name(scene),
+        "parameters": scene.describe()["parameters" if isinstance(scene, GeneralEnsembleScene) else "distributions"],
         "method": scene.method,
         "order": scene.order,
         "dt": scene.dt,
@@ -54,6 +62,7 @@ def new_meta(scene: EnsembleScene, chunk_size: int, n_chunks: int) -> dict:
         "arrays": {name: [scene.count, *shape] for name, shape in array_layout(scene).items()},
         "runs": [],
         "versions": _versions(),
+        **({"failure_codes": {str(k): v for k, v in FAILURES.items()}} if isinstance(scene, GeneralEnsembleScene) else {}),
     }
 
 
@@ -74,7 +83,7 @@ class RunRecord:
         The scheduler address or ``"local"`` (dask LocalCluster).
     """
 
-    def __init__(self, store: EnsembleStore, meta: dict, scene: EnsembleScene, chunk_size: int, n_chunks: int,
+    def __init__(self, store: EnsembleStore, meta: dict, scene: AnyScene, chunk_size: int, n_chunks: int,
                  done: dict[int, dict], executor: str, scheduler: str | None) -> None:
         self.store, self.meta, self.scene = store, meta, scene
         self.chunk_size, self.n_chunks, self.done = chunk_size, n_chunks, done
@@ -118,7 +127,7 @@ class RunRecord:
             self.run["chunks_computed"] += 1
             start, stop = chunk_bounds(self.scene.count, self.chunk_size, index)
             added = stop - start
-            self.member_steps += added * self.scene.steps
+            self.member_steps += int(marker.get("member_steps", added * self.scene.steps))
         else:
             self.failures[str(index)] = error
             self.failed[index] = error

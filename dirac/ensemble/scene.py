@@ -56,6 +56,7 @@ from dirac.ensemble.distributions import (
     Uniform,
     parse_distribution,
 )
+from dirac.ensemble.general_scene import GeneralEnsembleScene, is_general_scene, parse_general_scene
 from dirac.ensemble.sampling import MemberSource, open_member_file
 from dirac.errors import InputError, warn
 from dirac.io.scene import (
@@ -72,6 +73,7 @@ from dirac.validate import unknown_name_error
 __all__ = [
     "TRAJECTORY_OUTPUTS",
     "REDUCTIONS",
+    "AnyScene",
     "EnsembleScene",
     "load_ensemble_scene",
     "parse_ensemble_scene",
@@ -202,7 +204,11 @@ class EnsembleScene:
         return hashlib.sha256(text.encode()).hexdigest()
 
 
-def load_ensemble_scene(path: str | Path) -> EnsembleScene:
+#: An ensemble scene of either kind: the free rigid body's, or any other system's.
+AnyScene = EnsembleScene | GeneralEnsembleScene
+
+
+def load_ensemble_scene(path: str | Path) -> EnsembleScene | GeneralEnsembleScene:
     """Read and validate an ensemble scene file (TOML).
 
     Parameters
@@ -329,7 +335,8 @@ def _warn_triangle(distribution: object) -> None:
                 return
 
 
-def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | None = None) -> EnsembleScene:
+def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | None = None
+                         ) -> EnsembleScene | GeneralEnsembleScene:
     """Validate a parsed scene (a dict from TOML); see the module docstring for the keys.
 
     Parameters
@@ -350,6 +357,9 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
     InputError
         Any invalid or missing key, named with the fix.
     """
+    if is_general_scene(data):
+        return parse_general_scene(data, base_dir=base_dir, path=path)
+
     from dirac.rigidbody.inertia import (
         validate_inertia,
         validate_momentum,

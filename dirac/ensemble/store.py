@@ -26,8 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from dirac.ensemble.arguments import ArgumentError
+from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.reductions import reduction_arrays
-from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
+from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, AnyScene
 from dirac.errors import InputError
 
 __all__ = ["FORMAT", "EnsembleStore", "array_layout", "atomic_write_json"]
@@ -46,8 +47,10 @@ def atomic_write_json(path: Path, data: object) -> None:
     os.replace(tmp, path)
 
 
-def array_layout(scene: EnsembleScene) -> dict[str, tuple[int, ...]]:
+def array_layout(scene: AnyScene) -> dict[str, tuple[int, ...]]:
     """Array name -> shape of one member's entry, for every array the scene stores."""
+    if isinstance(scene, GeneralEnsembleScene):
+        return scene.array_layout()
     layout: dict[str, tuple[int, ...]] = {}
     for name in scene.outputs:
         layout[name] = (scene.samples, *TRAJECTORY_OUTPUTS[name])
@@ -81,7 +84,7 @@ class EnsembleStore:
         except (OSError, json.JSONDecodeError) as exc:
             raise InputError(f"{self.meta_path} is unreadable ({exc}); delete the folder to start over") from None
 
-    def create(self, scene: EnsembleScene, chunk_size: int, meta: dict) -> None:
+    def create(self, scene: AnyScene, chunk_size: int, meta: dict) -> None:
         """Create the folder, the zarr arrays (NaN-filled) and ``meta.json`` (last).
 
         Raises
@@ -159,6 +162,8 @@ class EnsembleStore:
         for name, values in arrays.items():
             target = zarr.open_array(str(self.data_path), path=name, mode="r+")
             target[start:stop] = values
+        if "steps" in arrays:  # members of a general ensemble may stop early
+            info = {**info, "member_steps": int(np.sum(arrays["steps"]))}
         marker = {
             "chunk": index,
             "start": start,

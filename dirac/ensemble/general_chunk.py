@@ -1,0 +1,204 @@
+"""One chunk of a general ensemble: members' initial states, the batched member loop, arrays.
+
+The initial states are evaluated from the scene's expressions of the ensemble variables
+(numpy, once per chunk), put on the constraint surface when ``project = true``, and
+advanced by ``ens_run`` of :mod:`dirac.ensemble.general_kernel` (the system's own
+compiled step, ``numba.prange`` over members). A member the kernel cannot continue is
+marked in ``failures`` (codes :data:`~dirac.ensemble.general_kernel.FAILURES`) and its
+reductions are NaN; the others complete.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from dirac.ensemble.general_kernel import CompiledEnsemble, compiled_ensemble
+from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.kernel_lock import KERNEL_LOCK
+from dirac.errors import InputError
+
+__all__ = ["check_initial_states", "compute_general_chunk", "initial_states", "step_grid"]
+
+#: Members whose initial states are checked at once by :func:`check_initial_states`.
+_CHECK_BLOCK = 65536
+
+
+def step_grid(scene: GeneralEnsembleScene) -> tuple[np.ndarray, np.ndarray, int, float]:
+    """``(starts, ends, steps per interval, dt)`` exactly as :func:`dirac.flows.integrate` cuts
+    ``[0, t_end]`` (its sample grid and step), so members step at the times a single run does."""
+    from dirac.flows.integration import sample_times
+
+    times = sample_times(scene.t_end, scene.samples)
+    spacing = float(times[1] - times[0])
+    per_interval = max(1, int(math.ceil(spacing / scene.dt_requested * (1.0 - 1e-12))))
+    return np.ascontiguousarray(times[:-1]), np.ascontiguousarray(times[1:]), per_interval, spacing / per_interval
+
+
+def _evaluate(expression: object, variables: tuple[str, ...], values: np.ndarray) -> np.ndarray:
+    """An expression (sympy, or a number) of the ensemble variables at each member's values."""
+    import sympy
+
+    if not isinstance(expression, sympy.Basic):
+        return np.full(values.shape[0], float(expression))  # type: ignore[arg-type]
+    symbols = [sympy.Symbol(name, real=True) for name in variables]
+    function = sympy.lambdify(symbols, expression, "numpy")
+    result = function(*(values[:, k] for k in range(len(variables))))
+    return np.broadcast_to(np.asarray(result, dtype=float), (values.shape[0],)).copy()
+
+
+def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Q, P, C)`` of members with the ensemble variables ``values`` (rows): positions,
+    momenta (``p = M(q) q_dot`` unless ``p`` is given) and parameter values; projected onto
+    the constraints when the scene says ``project = true``."""
+    import sympy
+
+    from dirac.model.expressions import parse_expression
+
+    count = values.shape[0]
+    names = scene.source.names
+    symbols = {name: sympy.Symbol(name, real=True) for name in names}
+
+    def column(value: float | str, where: str) -> np.ndarray:
+        if isinstance(value, str):
+            return _evaluate(parse_expression(value, symbols, what=where), names, values)
+        return np.full(count, float(value))
+
+    mechanics = compiled.mechanics
+    C = np.tile(np.asarray(mechanics.params, dtype=float), (count, 1))
+    for key, value in scene.parameters.items():
+        C[:, scene.parameter_names.index(key)] = column(value, f"[system] parameters.{key}")
+    n = len(scene.coordinate_names)
+    Q = np.empty((count, n))
+    rates = np.zeros((count, n))
+    for j, name in enumerate(scene.coordinate_names):
+        Q[:, j] = column(scene.initial_q[name], f"[initial] q.{name}")
+        if name in scene.initial_rates:
+            rates[:, j] = column(scene.initial_rates[name], f"[initial] {scene.rate_kind}.{name}")
+    bad = ~(np.all(np.isfinite(Q), axis=1) & np.all(np.isfinite(rates), axis=1) & np.all(np.isfinite(C), axis=1))
+    if np.any(bad):
+        first = int(np.argmax(bad))
+        raise InputError(f"the initial state or parameters of member {first} ({_where(names, values[first])}) are not "
+                         "finite; check the expressions in [initial] and [system] parameters")
+    if scene.rate_kind == "p":
+        P = rates
+    else:
+        P = np.empty((count, n))
+        compiled.module.ens_momenta(Q, rates, C, P)
+    if scene.project:
+        for i in range(count):
+            member = dataclasses.replace(mechanics, params=C[i].copy(), constant_mass=None)
+            try:
+                Q[i], P[i] = member.project(Q[i], P[i])
+            except InputError as exc:
+                raise InputError(f"member {i} ({_where(names, values[i])}): {exc}") from None
+    return np.ascontiguousarray(Q), np.ascontiguousarray(P), np.ascontiguousarray(C)
+
+
+def _where(names: tuple[str, ...], row: np.ndarray) -> str:
+    return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
+
+
+def check_initial_states(scene: GeneralEnsembleScene) -> None:
+    """Refuse, before anything is written, members whose initial state is off the constraint
+    surface (with ``project = false``), or not finite.
+
+    The test is a single scene's (:class:`dirac.flows.problems.ConstrainedProblem`):
+    ``|chi| <= 1e-9 (1 + |q|^2)`` and ``|G M^-1 p + d chi/dt| <= 1e-9 sqrt((1 + |q|^2)(1 + |p|^2))``.
+
+    Raises
+    ------
+    InputError
+        Naming the first offending member, its ensemble variables and the fix.
+    """
+    compiled = compiled_ensemble(scene)
+    m = compiled.mechanics.n_constraints
+    for start in range(0, scene.count, _CHECK_BLOCK):
+        stop = min(scene.count, start + _CHECK_BLOCK)
+        values = scene.source.members(start, stop)
+        Q, P, C = initial_states(scene, compiled, values)
+        if scene.project or m == 0:
+            continue
+        residual = np.empty((stop - start, 2 * m))
+        compiled.module.ens_surface(Q, P, C, residual)
+        qscale = 1.0 + np.einsum("ij,ij->i", Q, Q)
+        pscale = np.sqrt(qscale * (1.0 + np.einsum("ij,ij->i", P, P)))
+        off_q = np.any(np.abs(residual[:, :m]) > 1e-9 * qscale[:, None], axis=1)
+        off_p = np.any(np.abs(residual[:, m:]) > 1e-9 * pscale[:, None], axis=1)
+        off = off_q | off_p
+        if np.any(off):
+            i = int(np.argmax(off))
+            what = "q" if off_q[i] else f"{scene.rate_kind} (velocities not tangent)"
+            worst = float(np.max(np.abs(residual[i, :m] if off_q[i] else residual[i, m:])))
+            raise InputError(
+                f"[initial] {what} of member {start + i} ({_where(scene.source.names, values[i])}) is off the "
+                f"constraint surface (residual {worst:.3g}); give [initial] expressions on the surface or set "
+                "project = true in [initial]"
+            )
+
+
+def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
+                          values: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Integrate members ``start .. stop-1`` and return their arrays (:meth:`GeneralEnsembleScene.array_layout`)."""
+    compiled = compiled_ensemble(scene)
+    if values is None:
+        values = scene.source.members(start, stop)
+    Q, P, C = initial_states(scene, compiled, values)
+    count, n = Q.shape
+    starts, ends, per_interval, dt = step_grid(scene)
+    n_cross, n_ext, n_poin, k_max = compiled.module.ENS_SHAPES
+    CROSS = np.full((count, n_cross), np.nan)
+    EXT = np.full((count, n_ext), np.nan)
+    EERR = np.full(count, np.nan)
+    CERR = np.full(count, np.nan)
+    PT = np.full((count, n_poin, k_max), np.nan)
+    PQ = np.full((count, n_poin, k_max, n), np.nan)
+    PP = np.full((count, n_poin, k_max, n), np.nan)
+    STATUS = np.zeros(count)
+    STEPS = np.zeros(count)
+    Q0, P0 = Q.copy(), P.copy()
+    arguments = (Q, P, C, compiled.fractions, dt, starts, ends, per_interval, scene.newton_tolerance,
+                 scene.max_newton_iterations, compiled.gamma, scene.early_stop,
+                 CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS)
+    with KERNEL_LOCK:
+        try:
+            compiled.module.ens_run(0, count, *arguments)
+        except ZeroDivisionError:
+            # a singular Newton matrix in some member: redo the members one by one to find it
+            Q[:], P[:] = Q0, P0
+            for array in (CROSS, EXT, EERR, CERR, PT, PQ, PP):
+                array[:] = np.nan
+            for i in range(count):
+                try:
+                    compiled.module.ens_member(i, *arguments)
+                except ZeroDivisionError:
+                    STATUS[i] = 3.0
+    results: dict[str, np.ndarray] = {name: values[:, k].copy() for k, name in enumerate(scene.source.names)}
+    layout = compiled.layout
+    for index, (name, _group) in enumerate(layout["cross"]):
+        results[name] = CROSS[:, index]
+    for index, (name, _kind, _e) in enumerate(layout["ext"]):
+        results[name] = EXT[:, index]
+    for index, (name, _e, k) in enumerate(layout["poincare"]):
+        results[f"{name}_t"] = PT[:, index, :k]
+        results[f"{name}_q"] = PQ[:, index, :k]
+        results[f"{name}_p"] = PP[:, index, :k]
+    kinds = {r.kind for r in scene.reductions}
+    if "final" in kinds:
+        results["final_q"], results["final_p"] = Q, P
+    if "energy_error" in kinds:
+        results["energy_error"] = EERR
+    if "constraint_error" in kinds:
+        results["constraint_error"] = CERR
+    failed = STATUS != 0.0
+    if np.any(failed):
+        for name in list(results):
+            if name not in scene.source.names:
+                results[name] = np.array(results[name], dtype=float)
+                results[name][failed] = np.nan
+    results["failures"] = STATUS
+    results["steps"] = STEPS
+    return results

@@ -1,0 +1,436 @@
+"""The member loop of a general ensemble: the system's own step kernel, batched over members.
+
+:func:`compiled_ensemble` builds, once per process and scene, the system exactly as a
+single run does (:meth:`dirac.flows.mechanics.MechanicalSystem.from_lagrangian`: the same
+generated module, the same RATTLE or forced-RATTLE step loop) and appends to that module's
+source
+
+* ``ens_values`` / ``ens_conditions`` -- the reductions' expressions and the ``when``
+  conditions (``lhs - rhs``), straight-line code (:func:`dirac.codegen.kernel_source.emit_function`);
+* ``ens_locate`` -- regula falsi (Illinois) for the zero of one expression on the line
+  between two consecutive states;
+* ``ens_member`` -- one member from ``t = 0`` to ``t_end`` (or until its reductions are
+  decided): step by step, each step the module's own step loop (its body pasted in, or the
+  loop called for one step) at the time a single run gives that step (``t_k + j dt`` on the sample grid ``t_k`` of
+  :func:`dirac.flows.integration.sample_times`), so a member's state equals a single
+  run's to the last bit;
+* ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``;
+* ``ens_momenta`` / ``ens_surface`` -- ``p = M(q) q_dot`` and the constraint residuals of
+  many initial states.
+
+The combined module is imported through :func:`dirac.codegen.numba_backend.import_source`
+(cached on disk under the hash of its source: compiled once per machine).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, cast
+
+import numpy as np
+
+from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian, split_condition
+from dirac.errors import InputError
+
+__all__ = ["CompiledEnsemble", "compiled_ensemble", "FAILURES"]
+
+#: Codes of the ``failures`` array (0: the member completed).
+FAILURES: dict[int, str] = {
+    1: "Newton iteration did not converge (reduce dt)",
+    2: "non-finite state (the step diverged; reduce dt)",
+    3: "singular Newton matrix (the constraints are not independent here)",
+}
+
+_CACHE: dict[str, CompiledEnsemble] = {}
+
+#: The step loops a member loop calls (one step at a time).
+_STEP_KERNELS = ("rattle_constant_mass", "rattle_general", "forced_rattle_run", "conformal_run")
+
+
+@dataclass
+class CompiledEnsemble:
+    """The compiled pieces of one general ensemble scene (see the module docstring).
+
+    Attributes
+    ----------
+    mechanics : MechanicalSystem
+        The system with the scene's fixed parameter values.
+    module : module
+        The generated module with the ensemble loop appended.
+    fractions : numpy.ndarray
+        Sub-steps of the composition (fractions of ``dt``).
+    gamma : float
+        The conformal rate (``conformal-*`` methods), else 0.
+    layout : dict
+        Where each reduction's values sit in the kernel's arrays.
+    """
+
+    mechanics: Any
+    module: Any
+    fractions: np.ndarray
+    gamma: float
+    layout: dict
+    parameter_exprs: dict
+    variable_names: tuple[str, ...]
+
+
+def compiled_ensemble(scene: GeneralEnsembleScene) -> CompiledEnsemble:
+    """The compiled ensemble of ``scene`` (built once per process, then cached)."""
+    key = scene.fingerprint()
+    if key not in _CACHE:
+        _CACHE[key] = _build(scene)
+    return _CACHE[key]
+
+
+def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
+    import sympy
+
+    from dirac.codegen.numba_backend import import_source
+    from dirac.ensemble.general_scene import _state_names
+    from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
+    from dirac.flows.methods.registry import get_method
+    from dirac.model.expressions import parse_expression
+
+    lagrangian = load_lagrangian(scene.system, scene.base_dir)
+    fixed = {k: float(v) for k, v in scene.parameters.items() if not isinstance(v, str)}
+    placeholders = {k: 1.0 for k, v in scene.parameters.items() if isinstance(v, str)}
+    try:
+        mechanics = MechanicalSystem.from_lagrangian(lagrangian, {**placeholders, **fixed}, with_forces=scene.forced)
+    except NotMechanicalError as exc:
+        raise InputError(f"ensembles integrate L = 1/2 q_dot^T M(q) q_dot - V(q) with RATTLE: {exc}") from None
+    method = get_method(scene.method)
+    if scene.forced:
+        family, coefficients = cast(tuple[str, tuple[float, ...]], method.data)
+        fractions = np.array(coefficients, dtype=np.float64)
+        if family == "conformal":
+            if placeholders:
+                raise InputError(f"[run] method = {scene.method!r} takes its damping rate from fixed parameter values; "
+                                 "with parameters that vary over the ensemble use forced-rattle-2 or forced-rattle-4")
+            if mechanics.conformal_rate is None:
+                raise InputError(f"[run] method = {scene.method!r} needs linear damping Q = -gamma M q_dot with a constant "
+                                 "mass; use forced-rattle-2 or forced-rattle-4")
+            step = "conformal_run(q, p, ta, c, gamma, fractions, dt, 1, tol, max_iter, info, work_done)"
+        else:
+            step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, work_done)"
+        gamma = float(mechanics.conformal_rate or 0.0)
+    else:
+        fractions = np.array(cast(tuple[float, ...], method.data), dtype=np.float64)
+        name = "rattle_constant_mass" if mechanics.constant_mass is not None else "rattle_general"
+        step = f"{name}(q, p, ta, c, fractions, dt, 1, tol, max_iter, info)"
+        gamma = 0.0
+    state = _state_names(lagrangian)
+    exprs: list[Any] = []
+    conditions: list[tuple[Any, str]] = []
+    layout: dict[str, list] = {"cross": [], "ext": [], "poincare": []}
+    for reduction in scene.reductions:
+        parsed = [parse_expression(text, state, what=f"reduction {reduction.name}") for text in reduction.exprs]
+        if reduction.kind == "first_crossing":
+            group = []
+            for text, when in zip(parsed, reduction.whens):
+                exprs.append(text)
+                cond = -1
+                if when is not None:
+                    lhs, op, rhs = split_condition(when, reduction.name)
+                    left = parse_expression(lhs, state, what=f"reduction {reduction.name} when")
+                    right = parse_expression(rhs, state, what=f"reduction {reduction.name} when")
+                    value = left - right if op in (">", ">=") else right - left
+                    conditions.append((value, ">" if op in (">", "<") else ">="))
+                    cond = len(conditions) - 1
+                group.append((len(exprs) - 1, cond))
+            layout["cross"].append((reduction.name, group))
+        elif reduction.kind in ("max", "min"):
+            exprs.append(parsed[0])
+            layout["ext"].append((reduction.name, reduction.kind, len(exprs) - 1))
+        elif reduction.kind == "poincare":
+            exprs.append(parsed[0])
+            layout["poincare"].append((reduction.name, len(exprs) - 1, reduction.count))
+    kinds = {r.kind for r in scene.reductions}
+    n = len(scene.coordinate_names)
+    velocities = [state[f"{q}_dot"] for q in scene.coordinate_names]
+    used = set().union(*(e.free_symbols for e in exprs), *(c.free_symbols for c, _ in conditions)) if exprs else set()
+    needs_velocity = bool(used & set(velocities))
+    # the step loop's body is pasted into the member loop when it has the usual shape (its work
+    # arrays then allocated once per member); else the loop is called for one step, compiled into
+    # the member loop (numba inlines it at its IR level); the arithmetic is the same either way
+    system_source = mechanics.module.source
+    for kernel in _STEP_KERNELS:
+        system_source = system_source.replace(f"@numba.njit(cache=True)\ndef {kernel}(",
+                                              f'@numba.njit(cache=True, inline="always")\ndef {kernel}(')
+    pasted = _paste_step(system_source, step.split("(")[0])
+    source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
+                              mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
+                              "constraint_error" in kinds, pasted)
+    module = import_source(system_source + source)
+    variables = {name: sympy.Symbol(name, real=True) for name in scene.source.names}
+    parameter_exprs = {k: parse_expression(v, variables, what=f"[system] parameters.{k}")
+                       for k, v in scene.parameters.items() if isinstance(v, str)}
+    return CompiledEnsemble(mechanics, module, fractions, gamma, layout, parameter_exprs, scene.source.names)
+
+
+def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[str]] | None:
+    """The step loop ``kernel`` of the system's module cut into the three parts the member
+    loop pastes in: its work-array allocations and the statements before its loop over steps
+    (once per member), and the body of that loop indented for the member's loop over steps
+    (once per step, with ``step = 0`` and ``n_steps = 1``), the same statements as in a
+    single run. None when the loop does not
+    have that shape (allocations, set-up, ``for step in range(n_steps):``, then only
+    ``report(...)``): the member loop then calls it.
+
+    A one-step call of a loop that allocates two dozen small arrays spends most of its time
+    allocating (the angles' RATTLE: 3.5 x the per-step cost of a long run), and passing
+    them in costs a reference count per array and step."""
+    start = source.find(f"def {kernel}(")
+    if start < 0:
+        return None
+    stop = source.find("\n@numba", start)
+    text = source[start:] if stop < 0 else source[start:stop]
+    doc_end = text.index('"""', text.index('"""') + 3) + 3
+    lines = text[text.index("\n", doc_end) + 1:].rstrip().split("\n")
+    loop = "    for step in range(n_steps):"
+    if loop not in lines:
+        return None
+    at = lines.index(loop)
+    head, rest = lines[:at], lines[at + 1:]
+    split = next((k for k, line in enumerate(rest) if line.strip() and not line.startswith("        ")), len(rest))
+    body, tail = rest[:split], rest[split:]
+    if [line.strip() for line in tail if line.strip()] != ["report(info, n_steps, False, evals, residual)"]:
+        return None
+    allocations = [line for line in head if "= np." in line]
+    prelude = [line for line in head if "= np." not in line]
+    return allocations, prelude, ["    " + line if line.strip() else line for line in body]  # one level deeper
+
+
+def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, exprs: list, conditions: list,
+                     layout: dict, step: str, n: int, m: int, needs_velocity: bool, energy: bool,
+                     constraint: bool, pasted: tuple[list[str], list[str], list[str]] | None = None) -> str:
+    from dirac.codegen.kernel_source import emit_function
+
+    q = list(lagrangian.coordinates)
+    p = [state[f"p_{s.name}"] for s in q]
+    v = [state[f"{s.name}_dot"] for s in q]
+    params = list(lagrangian.parameters)
+    arrays = [("q", q), ("p", p), ("v", v)]
+    scalars = [("t", state["t"])]
+    out = ["\n\n# ---- ensemble loop (dirac.ensemble.general_kernel) ----\n"]
+    out.append(emit_function("ens_values", "the reductions' expressions", arrays, scalars, exprs,
+                             (len(exprs),), params))
+    out.append(emit_function("ens_conditions", "the when conditions (lhs - rhs)", arrays, scalars,
+                             [c for c, _ in conditions], (len(conditions),), params))
+    velocity_body = "    velocity(q, p, t, c, v, work, piv)" if needs_velocity else "    return"
+    out.append(f'''
+@numba.njit(cache=True, inline="always")
+def ens_velocity(q, p, t, c, v, work, piv):
+    """v = M^-1 p when an expression uses velocities."""
+{velocity_body}
+
+
+@numba.njit(cache=True)
+def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
+    """Zero of expression e on the line between (qa, pa) at ta and (q, p) at ta + dt
+    (Illinois regula falsi); leaves the state there in qs, ps, vs, fs and returns its fraction."""
+    lo = 0.0
+    hi = 1.0
+    side = 0
+    size = abs(flo) + abs(fhi)
+    s = flo / (flo - fhi)
+    for _it in range(200):
+        for x in range({n}):
+            qs[x] = qa[x] + s * (q[x] - qa[x])
+            ps[x] = pa[x] + s * (p[x] - pa[x])
+        ts = ta + s * dt
+        ens_velocity(qs, ps, ts, c, vs, vw, vpiv)
+        ens_values(qs, ps, vs, ts, c, fs)
+        fm = fs[e]
+        if fm == 0.0 or abs(fm) <= 1e-16 * size or hi - lo <= 1e-16:
+            break
+        if (fm < 0.0) == (flo < 0.0):
+            lo = s
+            flo = fm
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+        else:
+            hi = s
+            fhi = fm
+            if side == -1:
+                flo *= 0.5
+            side = -1
+        s = (lo * fhi - hi * flo) / (fhi - flo)
+        if not (lo <= s <= hi):
+            s = 0.5 * (lo + hi)
+    return s
+''')
+    n_cross = len(layout["cross"])
+    n_ext = len(layout["ext"])
+    n_poin = len(layout["poincare"])
+    k_max = max([count for _, _, count in layout["poincare"]], default=1)
+    lines: list[str] = []
+
+    def w(depth: int, text: str) -> None:
+        lines.append("    " * depth + text)
+
+    w(0, "@numba.njit(cache=True)")
+    w(0, "def ens_member(m_i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,")
+    w(0, "               CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS):")
+    w(1, '"""One member from t = 0 to the end or until its reductions are decided (module docstring)."""')
+    # the names of the step loop's arguments are the member's variables (q, p, t, c, info, work_done,
+    # n_steps, step): its body can be pasted in; the member's own names start with m_
+    w(1, "q = Q[m_i]")
+    w(1, "p = P[m_i]")
+    w(1, "c = C[m_i]")
+    w(1, "info = np.zeros(4)")
+    w(1, "work_done = np.zeros(1)")
+    w(1, "n_steps = 1")
+    w(1, "step = 0")
+    if pasted is not None:
+        allocations, prelude, _body = pasted
+        for line in [*allocations, *prelude]:
+            w(0, line)
+    w(1, f"m_v = np.zeros({n})")
+    w(1, f"m_vw = np.empty(({n}, {n}))")
+    w(1, f"m_vpiv = np.zeros({n}, dtype=np.int64)")
+    for name in ("m_qa", "m_pa", "m_qs", "m_ps"):
+        w(1, f"{name} = np.empty({n})")
+    w(1, f"m_vs = np.zeros({n})")
+    nf = max(1, len(exprs))
+    w(1, f"m_f = np.zeros({nf})")
+    w(1, f"m_fa = np.zeros({nf})")
+    w(1, f"m_fs = np.zeros({nf})")
+    w(1, f"m_g = np.zeros({max(1, len(conditions))})")
+    w(1, f"m_res = np.zeros({max(1, 2 * m)})")
+    w(1, f"m_pc = np.zeros({max(1, n_poin)}, dtype=np.int64)")
+    w(1, "m_t0 = starts[0]")
+    w(1, "ens_velocity(q, p, m_t0, c, m_v, m_vw, m_vpiv)")
+    w(1, "ens_values(q, p, m_v, m_t0, c, m_f)")
+    for x, (_, _, e) in enumerate(layout["ext"]):
+        w(1, f"EXT[m_i, {x}] = m_f[{e}]")
+    if energy:
+        w(1, "m_e0 = energy(q, p, m_t0, c)")
+        w(1, "EERR[m_i] = 0.0")
+    if constraint:
+        w(1, "CERR[m_i] = 0.0")
+        if m:
+            w(1, "residuals(q, p, m_t0, c, m_res)")
+            w(1, f"for m_x in range({2 * m}):")
+            w(2, "if abs(m_res[m_x]) > CERR[m_i]:")
+            w(3, "CERR[m_i] = abs(m_res[m_x])")
+    w(1, "m_status = 0.0")
+    w(1, "m_steps = 0")
+    w(1, "m_stop = False")
+    w(1, "STATUS[m_i] = 1.0  # until the member completes (a failing step returns from inside)")
+    w(1, "for m_k in range(starts.shape[0]):")
+    w(2, "m_a = starts[m_k]")
+    w(2, "for m_j in range(per_interval):")
+    w(3, f"for m_x in range({n}):")
+    w(4, "m_qa[m_x] = q[m_x]")
+    w(4, "m_pa[m_x] = p[m_x]")
+    w(3, f"for m_x in range({len(exprs)}):")
+    w(4, "m_fa[m_x] = m_f[m_x]")
+    w(3, "ta = m_a + m_j * dt")
+    if pasted is not None:
+        w(3, "t = ta")
+        for line in pasted[2]:
+            if line.strip() == "return":
+                indent = line[: len(line) - len(line.lstrip())]
+                w(0, f"{indent}STEPS[m_i] = m_steps")
+            w(0, line)
+    else:
+        w(3, step)
+        w(3, "if info[1] != 0.0:")
+        w(4, "m_status = 1.0")
+        w(4, "m_stop = True")
+        w(4, "break")
+    w(3, "m_steps += 1")
+    w(3, "tb = m_a + (m_j + 1) * dt")
+    w(3, "m_bad = False")
+    w(3, f"for m_x in range({n}):")
+    w(4, "if not (abs(q[m_x]) < np.inf and abs(p[m_x]) < np.inf):")
+    w(5, "m_bad = True")
+    w(3, "if m_bad:")
+    w(4, "m_status = 2.0")
+    w(4, "m_stop = True")
+    w(4, "break")
+    w(3, "ens_velocity(q, p, tb, c, m_v, m_vw, m_vpiv)")
+    w(3, "ens_values(q, p, m_v, tb, c, m_f)")
+    for x, (_, kind, e) in enumerate(layout["ext"]):
+        op = ">" if kind == "max" else "<"
+        w(3, f"if m_f[{e}] {op} EXT[m_i, {x}]:")
+        w(4, f"EXT[m_i, {x}] = m_f[{e}]")
+    locate = "m_qa, m_pa, q, p, ta, dt, c, m_qs, m_ps, m_vs, m_fs"
+    for gi, (_, group) in enumerate(layout["cross"]):
+        w(3, f"if CROSS[m_i, {gi}] != CROSS[m_i, {gi}]:")
+        w(4, "m_best = np.inf")
+        for e, cond in group:
+            w(4, f"if (m_fa[{e}] < 0.0 and m_f[{e}] >= 0.0) or (m_fa[{e}] > 0.0 and m_f[{e}] <= 0.0):")
+            w(5, f"m_s = ens_locate({e}, {locate}, m_fa[{e}], m_f[{e}], m_vw, m_vpiv)")
+            if cond >= 0:
+                w(5, "ens_conditions(m_qs, m_ps, m_vs, ta + m_s * dt, c, m_g)")
+                w(5, f"if m_g[{cond}] {conditions[cond][1]} 0.0 and ta + m_s * dt < m_best:")
+            else:
+                w(5, "if ta + m_s * dt < m_best:")
+            w(6, "m_best = ta + m_s * dt")
+        w(4, "if m_best < np.inf:")
+        w(5, f"CROSS[m_i, {gi}] = m_best")
+    for pj, (_, e, count) in enumerate(layout["poincare"]):
+        w(3, f"if m_pc[{pj}] < {count} and m_fa[{e}] < 0.0 and m_f[{e}] >= 0.0:")
+        w(4, f"m_s = ens_locate({e}, {locate}, m_fa[{e}], m_f[{e}], m_vw, m_vpiv)")
+        w(4, f"PT[m_i, {pj}, m_pc[{pj}]] = ta + m_s * dt")
+        w(4, f"for m_x in range({n}):")
+        w(5, f"PQ[m_i, {pj}, m_pc[{pj}], m_x] = m_qs[m_x]")
+        w(5, f"PP[m_i, {pj}, m_pc[{pj}], m_x] = m_ps[m_x]")
+        w(4, f"m_pc[{pj}] += 1")
+    decided = [f"CROSS[m_i, {gi}] == CROSS[m_i, {gi}]" for gi in range(n_cross)]
+    decided += [f"m_pc[{pj}] >= {count}" for pj, (_, _, count) in enumerate(layout["poincare"])]
+    if decided:
+        w(3, f"if early and {' and '.join(decided)}:")
+        w(4, "m_stop = True")
+        w(4, "break")
+    w(2, "if m_stop:")
+    w(3, "break")
+    if energy:
+        w(2, "m_err = abs(energy(q, p, ends[m_k], c) - work_done[0] - m_e0)")
+        w(2, "if not (m_err <= EERR[m_i]):")
+        w(3, "EERR[m_i] = m_err")
+    if constraint and m:
+        w(2, "residuals(q, p, ends[m_k], c, m_res)")
+        w(2, f"for m_x in range({2 * m}):")
+        w(3, "if not (abs(m_res[m_x]) <= CERR[m_i]):")
+        w(4, "CERR[m_i] = abs(m_res[m_x])")
+    w(1, "STATUS[m_i] = m_status")
+    w(1, "STEPS[m_i] = m_steps")
+    out.append("\n".join(lines) + "\n")
+    out.append(f'''
+
+@numba.njit(cache=True, parallel=True)
+def ens_run(lo, hi, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
+            CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS):
+    """ens_member for members lo .. hi-1, in parallel over members (numba.prange)."""
+    for i in numba.prange(lo, hi):
+        ens_member(i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
+                   CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS)
+
+
+@numba.njit(cache=True)
+def ens_momenta(Q, QD, C, P):
+    """P[i] = M(Q[i], 0) QD[i]."""
+    Mw = np.empty(({n}, {n}))
+    for i in range(Q.shape[0]):
+        mass(Q[i], 0.0, C[i], Mw)
+        for a in range({n}):
+            acc = 0.0
+            for b in range({n}):
+                acc += Mw[a, b] * QD[i, b]
+            P[i, a] = acc
+
+
+@numba.njit(cache=True)
+def ens_surface(Q, P, C, OUT):
+    """OUT[i] = (chi, G M^-1 p + d chi/dt) at (Q[i], P[i], t = 0)."""
+    for i in range(Q.shape[0]):
+        residuals(Q[i], P[i], 0.0, C[i], OUT[i])
+
+
+#: shapes of the kernel's result arrays
+ENS_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
+''')
+    return "".join(out)

@@ -1,0 +1,480 @@
+"""Ensemble scenes of any system a scene accepts (not only the free rigid body).
+
+```toml
+[system]
+file = "double_pendulum_angles.toml"      # or name = "double_pendulum", or an inline system
+parameters = { g = 9.81, l2 = "1 + 0.1*s" }   # values may be expressions of the ensemble variables
+
+[initial]
+q = { x1 = "sin(a)", y1 = "-cos(a)", x2 = "sin(a) + sin(b)", y2 = "-cos(a) - cos(b)" }
+q_dot = {}                                # or p = {...}; omitted entries are 0
+project = false                           # true: project each member onto the constraints
+
+[run]
+method = "rattle-2"                       # rattle-2/4/6/8; forced systems: forced-rattle-2/4, conformal-2/4
+dt = 2e-3
+t_end = 10.0
+samples = 101                             # energy and constraint errors are checked at these times
+
+[ensemble]
+grid = { a = [-3.0, 3.0, 256], b = [-3.0, 3.0, 256] }
+reductions = [
+  { kind = "first_crossing", name = "flip_time", expr = ["x1", "x2 - x1"], when = ["y1 > 0", "y2 - y1 > 0"] },
+  "energy_error",
+]
+```
+
+Reductions (each stores arrays indexed by member; a failed member is NaN, its reason in
+``failures``):
+
+* ``first_crossing`` -- ``expr`` (one expression or a list): the first time one of them
+  changes sign with its ``when`` condition true (``"A > B"``, ``>=``, ``<``, ``<=``; one per
+  expression or none), located between the two steps bracketing it by regula falsi on
+  the straight line between the two states; NaN if none by ``t_end``.
+* ``max`` / ``min`` -- of ``expr`` over every step (``t = 0`` included).
+* ``final`` -- ``q`` and ``p`` at ``t_end`` (arrays ``final_q``, ``final_p``).
+* ``energy_error`` -- ``max_k |E(t_k) - W(t_k) - E(0)|`` over the sample times (``W`` the
+  work of the forces; 0 for an unforced system).
+* ``constraint_error`` -- ``max_k`` of ``max(|chi|, |G M^{-1} p + d chi/dt|)`` over the samples.
+* ``poincare`` -- the first ``count`` upward zero crossings of ``expr``
+  (``expr(t_k) < 0 <= expr(t_{k+1})``): the time and the state on the line between the
+  two steps where ``expr = 0`` (arrays ``<name>_t`` (count,), ``<name>_q``, ``<name>_p``
+  (count, n)); NaN where fewer crossings happened.
+
+Expressions of reductions use the coordinates, their velocities ``<q>_dot``, momenta
+``p_<q>``, the parameters and ``t``. A member whose reductions are all decided (its
+crossings found) stops early when the scene asks for nothing that needs the rest of the
+run (``max``, ``min``, ``final``, ``energy_error``, ``constraint_error``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dirac.ensemble.variables import VariableSource, parse_variables
+from dirac.errors import InputError
+from dirac.io.scene import reject_unknown_keys, scene_number
+from dirac.validate import unknown_name_error
+
+__all__ = ["GeneralEnsembleScene", "ReductionSpec", "parse_general_scene", "is_general_scene", "REDUCTION_KINDS"]
+
+#: Reduction kinds and the keys each takes besides ``kind`` and ``name``.
+REDUCTION_KINDS: dict[str, set[str]] = {
+    "first_crossing": {"expr", "when"},
+    "max": {"expr"},
+    "min": {"expr"},
+    "final": set(),
+    "energy_error": set(),
+    "constraint_error": set(),
+    "poincare": {"expr", "count"},
+}
+
+#: Kinds that need the whole run (a member asking for one never stops early).
+WHOLE_RUN = {"max", "min", "final", "energy_error", "constraint_error"}
+
+_RUN_KEYS = {"t_end", "method", "dt", "samples", "outputs", "newton_tolerance", "max_newton_iterations"}
+_ENSEMBLE_KEYS = {"grid", "variables", "count", "seed", "chunk_size", "reductions", "reduction"}
+_INITIAL_KEYS = {"q", "q_dot", "p", "project"}
+_SYSTEM_KEYS = {"name", "file", "parameters", "coordinates", "lagrangian", "constraints", "forces", "description",
+                "time"}
+
+_COMPARISON = re.compile(r"^(.*?)(>=|<=|>|<)(.*)$")
+
+
+def is_general_scene(data: dict) -> bool:
+    """Whether an ensemble scene's ``[system]`` is anything but the built-in free rigid body."""
+    system = data.get("system", {})
+    if not isinstance(system, dict):
+        return False
+    return bool({"file", "lagrangian"} & set(system)) or system.get("name", "rigid_body") != "rigid_body"
+
+
+@dataclass(frozen=True)
+class ReductionSpec:
+    """One reduction of a general ensemble scene (module docstring).
+
+    Attributes
+    ----------
+    kind : str
+    name : str
+        The array name (or stem: ``final``, ``poincare``).
+    exprs : tuple of str
+    whens : tuple of (str or None)
+        One per expression (``first_crossing``).
+    count : int
+        Crossings kept (``poincare``).
+    """
+
+    kind: str
+    name: str
+    exprs: tuple[str, ...] = ()
+    whens: tuple[str | None, ...] = ()
+    count: int = 0
+
+    def arrays(self, n: int) -> dict[str, tuple[int, ...]]:
+        """Array name -> shape of one member's entry (``n`` coordinates)."""
+        if self.kind == "final":
+            return {"final_q": (n,), "final_p": (n,)}
+        if self.kind == "poincare":
+            return {f"{self.name}_t": (self.count,), f"{self.name}_q": (self.count, n), f"{self.name}_p": (self.count, n)}
+        return {self.name: ()}
+
+    def describe(self) -> dict[str, object]:
+        return {"kind": self.kind, "name": self.name, "expr": list(self.exprs),
+                "when": [w or "" for w in self.whens], "count": self.count}
+
+
+@dataclass(frozen=True)
+class GeneralEnsembleScene:
+    """A validated ensemble scene of a general system (module docstring).
+
+    The system itself is rebuilt from ``system`` (the scene's table) in every process that
+    computes chunks (:func:`dirac.ensemble.general_kernel.compiled_ensemble`, cached per
+    process), so the scene is plain data that pickles to dask workers.
+    """
+
+    system: dict
+    base_dir: str
+    coordinate_names: tuple[str, ...]
+    parameter_names: tuple[str, ...]
+    forced: bool
+    source: VariableSource
+    initial_q: dict
+    initial_rates: dict
+    rate_kind: str
+    parameters: dict
+    project: bool
+    method: str
+    order: int
+    dt: float
+    dt_requested: float
+    t_end: float
+    samples: int
+    steps_per_sample: int
+    reductions: tuple[ReductionSpec, ...]
+    newton_tolerance: float = 1e-12
+    max_newton_iterations: int = 50
+    chunk_size: int | None = None
+    path: str | None = None
+    outputs: tuple[str, ...] = field(default=())
+    system_digest: str = ""
+
+    general = True
+
+    @property
+    def count(self) -> int:
+        return self.source.count
+
+    @property
+    def steps(self) -> int:
+        """Steps per member when it runs to ``t_end``."""
+        return self.steps_per_sample * (self.samples - 1)
+
+    @property
+    def early_stop(self) -> bool:
+        """Whether a member stops once its crossings are found."""
+        return not any(r.kind in WHOLE_RUN for r in self.reductions)
+
+    def times(self) -> np.ndarray:
+        from dirac.flows.integration import sample_times
+
+        return sample_times(self.t_end, self.samples)
+
+    def array_layout(self) -> dict[str, tuple[int, ...]]:
+        """Array name -> shape of one member's entry, for every array the store holds."""
+        n = len(self.coordinate_names)
+        layout: dict[str, tuple[int, ...]] = {name: () for name in self.source.names}
+        for reduction in self.reductions:
+            layout.update(reduction.arrays(n))
+        layout["failures"] = ()
+        layout["steps"] = ()
+        return layout
+
+    def describe(self) -> dict[str, object]:
+        return {
+            "system": {k: v for k, v in self.system.items() if k != "file"},
+            "system_digest": self.system_digest,
+            "coordinates": list(self.coordinate_names),
+            "variables": self.source.describe(),
+            "count": self.count,
+            "initial": {"q": self.initial_q, self.rate_kind: self.initial_rates, "project": self.project},
+            "parameters": self.parameters,
+            "method": self.method,
+            "order": self.order,
+            "dt": self.dt,
+            "dt_requested": self.dt_requested,
+            "t_end": self.t_end,
+            "samples": self.samples,
+            "steps_per_sample": self.steps_per_sample,
+            "newton_tolerance": self.newton_tolerance,
+            "max_newton_iterations": self.max_newton_iterations,
+            "reductions": [r.describe() for r in self.reductions],
+        }
+
+    def fingerprint(self) -> str:
+        """SHA-256 of :meth:`describe` (a resumed run must match it)."""
+        return hashlib.sha256(json.dumps(self.describe(), sort_keys=True, default=str).encode()).hexdigest()
+
+
+def load_lagrangian(system: dict, base_dir: str | Path, where: str = "[system]") -> Any:
+    """The Lagrangian of a scene's ``[system]`` table: ``name``, ``file`` or an inline system."""
+    from dirac.model.system_file import lagrangian_from_table
+    from dirac.model.systems import builtin_systems, load_system
+
+    if "file" in system:
+        file = Path(str(system["file"]))
+        if not file.is_absolute():
+            file = Path(base_dir) / file
+        if not file.exists():
+            raise InputError(f"{where} file {str(system['file'])!r} does not exist; give a path relative to the scene file")
+        return load_system(file)
+    if "lagrangian" in system:
+        table = {k: v for k, v in system.items() if k != "file"}
+        if isinstance(table.get("parameters"), dict):  # values that vary over the ensemble are set per member
+            table["parameters"] = {k: 1.0 if isinstance(v, str) else v for k, v in table["parameters"].items()}
+        return lagrangian_from_table(table, source=where)
+    name = system.get("name")
+    if not isinstance(name, str):
+        raise InputError(f"{where} needs name (a built-in system), file (a system file) or an inline system")
+    if name == "heavy_top":
+        raise InputError(f"{where} name = 'heavy_top': heavy-top ensembles are not available yet; "
+                         "write the top as a system file (Euler angles) or run single scenes")
+    known = builtin_systems()
+    if name not in known:
+        raise unknown_name_error("system", name, [*known, "rigid_body"], f"{where} name", hint="or give file = a system file")
+    return load_system(name)
+
+
+def _expression_value(value: object, where: str) -> float | str:
+    if isinstance(value, str):
+        return value
+    return scene_number(value, where)
+
+
+def _table_of_values(value: object, key: str, names: tuple[str, ...]) -> dict[str, float | str]:
+    where = f"[initial] {key}"
+    if isinstance(value, list):
+        if len(value) != len(names):
+            raise InputError(f"{where} has {len(value)} entries; give one per coordinate ({', '.join(names)})")
+        value = dict(zip(names, value))
+    if not isinstance(value, dict):
+        raise InputError(f"{where} must be a table {{ {names[0]} = ... }} (numbers or expressions of the ensemble variables)")
+    for name in value:
+        if name not in names:
+            raise unknown_name_error("coordinate", name, names, where)
+    return {name: _expression_value(v, f"{where}.{name}") for name, v in value.items()}
+
+
+def _reduction(item: object, position: int) -> ReductionSpec:
+    where = f"[ensemble] reduction {position + 1}"
+    if isinstance(item, str):
+        item = {"kind": item}
+    if not isinstance(item, dict) or "kind" not in item:
+        raise InputError(f"{where} must be a kind ({', '.join(REDUCTION_KINDS)}) or a table with kind = ...")
+    kind = item["kind"]
+    if kind not in REDUCTION_KINDS:
+        raise unknown_name_error("reduction", str(kind), REDUCTION_KINDS, where)
+    reject_unknown_keys(item, {"kind", "name", *REDUCTION_KINDS[kind]}, f"{where} ({kind})")
+    name = item.get("name", kind)
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        raise InputError(f"{where}: name = {name!r} must be an identifier (letters, digits, _)")
+    exprs: tuple[str, ...] = ()
+    whens: tuple[str | None, ...] = ()
+    count = 0
+    if "expr" in REDUCTION_KINDS[kind]:
+        raw = item.get("expr")
+        if raw is None:
+            raise InputError(f"{where} ({kind}) needs expr = \"...\" (an expression of the state)")
+        listed = raw if isinstance(raw, list) and kind == "first_crossing" else [raw]
+        if not listed or not all(isinstance(e, str) for e in listed):
+            raise InputError(f"{where} ({kind}): expr must be a string" + (" or a list of strings" if kind == "first_crossing" else ""))
+        exprs = tuple(listed)
+    if kind == "first_crossing":
+        when = item.get("when")
+        if when is None:
+            whens = (None,) * len(exprs)
+        else:
+            listed_when = when if isinstance(when, list) else [when]
+            if len(listed_when) != len(exprs) or not all(isinstance(w, str) for w in listed_when):
+                raise InputError(f"{where}: give one when = \"A > B\" per expression ({len(exprs)}), as a list of strings")
+            whens = tuple(w if w.strip() else None for w in listed_when)
+    if kind == "poincare":
+        count = item.get("count", 1)
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise InputError(f"{where} (poincare): count = {count!r} must be an integer >= 1")
+    return ReductionSpec(str(kind), name, exprs, whens, int(count))
+
+
+def split_condition(text: str, where: str) -> tuple[str, str, str]:
+    """``"A > B"`` -> ``("A", ">", "B")``; refuses a condition without one comparison."""
+    match = _COMPARISON.match(text)
+    if match is None or any(op in match.group(3) for op in "<>"):
+        raise InputError(f"{where}: when = {text!r} must compare two expressions once: 'A > B', 'A >= B', 'A < B' or 'A <= B'")
+    return match.group(1), match.group(2), match.group(3)
+
+
+def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None = None) -> GeneralEnsembleScene:
+    """Validate an ensemble scene of a general system (module docstring).
+
+    Every expression is parsed here against the names it may use, so a misspelt or
+    undefined name is refused before anything runs.
+
+    Raises
+    ------
+    InputError
+        Any invalid key or value, named with the fix.
+    """
+    from dirac.flows.mechanics import resolve_parameters
+    from dirac.model.expressions import parse_expression
+
+    for section in ("system", "initial", "run", "ensemble"):
+        if not isinstance(data.get(section), dict):
+            raise InputError(f"an ensemble scene needs a [{section}] table; see docs/ensembles.md")
+    reject_unknown_keys(data, {"system", "initial", "run", "ensemble"}, "the scene", kind="section")
+    system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
+    reject_unknown_keys(system, _SYSTEM_KEYS, "[system]")
+    reject_unknown_keys(initial, _INITIAL_KEYS, "[initial]")
+    reject_unknown_keys(run, _RUN_KEYS, "[run]")
+    reject_unknown_keys(ensemble, _ENSEMBLE_KEYS, "[ensemble]")
+    lagrangian = load_lagrangian(system, base_dir)
+    names = tuple(s.name for s in lagrangian.coordinates)
+    parameter_names = tuple(s.name for s in lagrangian.parameters)
+    source = parse_variables(ensemble)
+    import sympy
+
+    for name in source.names:
+        if name in ("failures", "steps", "t") or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+            raise InputError(f"[ensemble] variable {name!r}: give an identifier other than failures, steps and t "
+                             "(the store's own arrays)")
+    variables = {name: sympy.Symbol(name, real=True) for name in source.names}
+    hint = f"define it under [ensemble] grid or [ensemble.variables] (the ensemble variables are: {', '.join(source.names) or 'none'})"
+
+    def check(text: float | str, where: str) -> None:
+        if isinstance(text, str):
+            parse_expression(text, variables, what=where, unknown_hint=hint)
+
+    overrides = system.get("parameters", {})
+    if not isinstance(overrides, dict):
+        raise InputError("[system] parameters must be a table, e.g. { l = 2.0 }")
+    parameters: dict[str, float | str] = {}
+    for key, value in overrides.items():
+        if key not in parameter_names:
+            raise unknown_name_error("parameter", key, parameter_names, f"[system] parameters of {lagrangian.name!r}")
+        parameters[key] = _expression_value(value, f"[system] parameters.{key}")
+        check(parameters[key], f"[system] parameters.{key}")
+    resolve_parameters(lagrangian, {k: 1.0 for k in parameters})  # every parameter has a value
+    if "q" not in initial:
+        raise InputError(f"[initial] lacks q (the coordinates {', '.join(names)})")
+    initial_q = _table_of_values(initial["q"], "q", names)
+    missing = [n for n in names if n not in initial_q]
+    if missing:
+        raise InputError(f"[initial] q lacks {', '.join(missing)}")
+    if "q_dot" in initial and "p" in initial:
+        raise InputError("[initial] gives both q_dot and p; give one of them")
+    rate_kind = "p" if "p" in initial else "q_dot"
+    rates = _table_of_values(initial.get(rate_kind, {}), rate_kind, names)
+    for key, value in [*((f"[initial] q.{k}", v) for k, v in initial_q.items()),
+                       *((f"[initial] {rate_kind}.{k}", v) for k, v in rates.items())]:
+        check(value, key)
+    project = initial.get("project", False)
+    if not isinstance(project, bool):
+        raise InputError(f"[initial] project = {project!r} must be true or false")
+
+    forced = bool(lagrangian.is_forced)
+    method, order = _method(run, forced)
+    if "dt" not in run:
+        raise InputError("[run] needs 'dt' (the fixed step)")
+    dt = scene_number(run["dt"], "[run] dt", positive=True)
+    if "t_end" not in run:
+        raise InputError("[run] needs 't_end'")
+    t_end = scene_number(run["t_end"], "[run] t_end", positive=True)
+    samples = run.get("samples", 101)
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
+        raise InputError(f"[run] samples = {samples!r} must be an integer >= 2")
+    outputs = run.get("outputs", [])
+    if outputs:
+        raise InputError("[run] outputs (full trajectories) are not stored by ensembles of general systems; "
+                         "ask for reductions (final, max, min, poincare, ...) under [ensemble] reductions")
+    spacing = t_end / (samples - 1)
+    steps_per_sample = max(1, math.ceil(spacing / dt * (1.0 - 1e-12)))
+    tolerance = scene_number(run.get("newton_tolerance", 1e-12), "[run] newton_tolerance", positive=True)
+    iterations = run.get("max_newton_iterations", 50)
+    if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
+        raise InputError(f"[run] max_newton_iterations = {iterations!r} must be an integer >= 1")
+
+    listed = ensemble.get("reductions", [])
+    tables = ensemble.get("reduction", [])
+    if not isinstance(listed, list) or not isinstance(tables, list):
+        raise InputError("[ensemble] reductions must be a list (of kinds or tables); [[ensemble.reduction]] tables")
+    reductions = tuple(_reduction(item, i) for i, item in enumerate([*listed, *tables]))
+    if not reductions:
+        raise InputError(f"the scene asks for nothing: give [ensemble] reductions (from {', '.join(REDUCTION_KINDS)})")
+    state = _state_names(lagrangian)
+    taken: dict[str, str] = {name: "an ensemble variable" for name in source.names}
+    for reduction in reductions:
+        for array in reduction.arrays(len(names)):
+            if array in taken or array in ("failures", "steps", "t"):
+                raise InputError(f"[ensemble] reduction {reduction.kind!r}: the array name {array!r} is taken "
+                                 f"({taken.get(array, 'by the store')}); give it another name = ...")
+            taken[array] = f"reduction {reduction.kind}"
+        for k, text in enumerate(reduction.exprs):
+            where = f"[ensemble] reduction {reduction.name} expr"
+            parse_expression(text, state, what=where, unknown_hint="reductions use coordinates, <q>_dot, p_<q>, parameters and t")
+            when = reduction.whens[k] if reduction.whens else None
+            if when is not None:
+                for side in split_condition(when, where)[0::2]:
+                    parse_expression(side, state, what=f"[ensemble] reduction {reduction.name} when",
+                                     unknown_hint="conditions use coordinates, <q>_dot, p_<q>, parameters and t")
+    chunk_size = ensemble.get("chunk_size")
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
+        raise InputError(f"[ensemble] chunk_size = {chunk_size!r} must be an integer >= 1")
+    digest = ""
+    if "file" in system:
+        file = Path(str(system["file"]))
+        file = file if file.is_absolute() else Path(base_dir) / file
+        digest = hashlib.sha256(file.read_bytes()).hexdigest()
+    return GeneralEnsembleScene(
+        system=dict(system), base_dir=str(Path(base_dir).resolve()), coordinate_names=names,
+        parameter_names=parameter_names, forced=forced, source=source, initial_q=initial_q,
+        initial_rates=rates, rate_kind=rate_kind, parameters=parameters, project=project, method=method,
+        order=order, dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end, samples=samples,
+        steps_per_sample=steps_per_sample, reductions=reductions, newton_tolerance=tolerance,
+        max_newton_iterations=iterations, chunk_size=chunk_size, path=path, system_digest=digest,
+    )
+
+
+def _state_names(lagrangian: Any) -> dict[str, Any]:
+    """The names a reduction may use -> symbols: coordinates, ``<q>_dot``, ``p_<q>``, parameters, ``t``."""
+    import sympy
+
+    names: dict[str, Any] = {}
+    for s in lagrangian.coordinates:
+        names[s.name] = s
+        names[f"{s.name}_dot"] = sympy.Symbol(f"{s.name}_dot", real=True)
+        names[f"p_{s.name}"] = sympy.Symbol(f"p_{s.name}", real=True)
+    for s in lagrangian.parameters:
+        names[s.name] = s
+    names["t"] = lagrangian.time if lagrangian.time is not None else sympy.Symbol("t", real=True)
+    return names
+
+
+def _method(run: dict, forced: bool) -> tuple[str, int]:
+    from dirac.flows.methods.registry import get_method
+
+    usable = ["forced-rattle-2", "forced-rattle-4", "conformal-2", "conformal-4"] if forced else \
+        ["rattle-2", "rattle-4", "rattle-6", "rattle-8"]
+    name = run.get("method", "auto")
+    if name == "auto":
+        name = usable[0]
+    if name not in usable:
+        kind = "a forced system" if forced else "an ensemble of this system"
+        raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {usable}")
+    return str(name), int(get_method(name).order)
