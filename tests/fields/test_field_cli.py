@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from field_catalog import MAXWELL_DENSITY
+from dirac.fields.catalog import MAXWELL_DENSITY
 
 MAXWELL_FILE = f'''[field]
 name = "maxwell"

@@ -9,7 +9,9 @@ counted per mode.
 from __future__ import annotations
 
 import sympy
-from field_catalog import (
+
+import dirac
+from dirac.fields.catalog import (
     chern_simons,
     fierz_pauli,
     klein_gordon,
@@ -18,8 +20,6 @@ from field_catalog import (
     maxwell_chern_simons,
     proca,
 )
-
-import dirac
 
 
 def _counts(analysis):
