@@ -66,3 +66,8 @@ def field_theory_table(runs: list[tuple[str, list[dict]]]) -> tuple[str, float]:
         lines.append(f"  {name:24s} {str(r['stages']):14s} {r['first']:5d} {r['second']:6d} {r['dof']:6d} "
                      f"{r.get('gauge', 0):5d} {cpu:7.2f} {wall:7.2f}")
     return "\n".join(lines), worst
+
+
+if __name__ == "__main__":  # python -m dirac.bench.field_theories [REPEATS]: the table alone
+    table, _ = field_theory_table(field_theory_runs(int(sys.argv[1]) if len(sys.argv) > 1 else 3))
+    print(table)

@@ -303,7 +303,12 @@ class FieldAnalysis(_Brackets):
         mode_conditions = []
         for text in conditions:
             mode_conditions.extend(self._mode_condition(text))
-        fixed = self.mode.fix_gauge(mode_conditions)
+        try:
+            fixed = self.mode.fix_gauge(mode_conditions)
+        except InputError as exc:  # the engine speaks of mode variables: say which conditions they come from
+            raise InputError(f"gauge conditions {', '.join(map(str, conditions))} (Fourier modes "
+                             f"{', '.join(map(str, mode_conditions))}, <field>_re/_im the real and imaginary parts of "
+                             f"a mode): {exc}") from None
         return GaugeFixedField(self, fixed, tuple(str(c) for c in conditions))
 
     def _mode_condition(self, text: str | sympy.Expr) -> list[sympy.Expr]:
@@ -317,7 +322,7 @@ class FieldAnalysis(_Brackets):
         params = {p.name: p for p in theory.parameters}
         time_derivatives = {f"{f}_t": "a gauge condition is a function on phase space: use the momenta p_<field>, "
                             "not time derivatives" for f in theory.field_names}
-        expr = parse_expression(str(text), {**names, **params}, what=f"gauge condition {text!r}", refused=time_derivatives)
+        expr = parse_expression(str(text), {**names, **params}, what="gauge condition", refused=time_derivatives)
         expr = sympy.expand(expr)
         variables = list(names.values())
         try:

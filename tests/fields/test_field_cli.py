@@ -87,3 +87,28 @@ def test_lattice_flag_on_a_nonlinear_theory(tmp_path, run_cli):
     data = json.loads(out)
     assert len(data["second_class"]) == 16 and data["physical_degrees_of_freedom"] == 8
     assert data["coordinates"][:3] == ["n1_0", "n2_0", "n3_0"]
+
+
+def test_gauge_errors_speak_of_the_conditions_given(tmp_path, run_cli):
+    path = _write(tmp_path, MAXWELL_FILE)
+    status, _, err = run_cli("analyze", path, "--gauge", "p_A0")
+    assert status == 2 and err.startswith("error: gauge conditions p_A0") and "fixes nothing" in err
+    status, _, err = run_cli("analyze", path, "--gauge", "A1_t")
+    assert status == 2 and "use the momenta p_<field>, not time derivatives" in err
+    status, _, err = run_cli("analyze", path, "--gauge", "A0**2")
+    assert status == 2 and "must be linear and homogeneous" in err
+    status, _, err = run_cli("analyze", path, "--cases")
+    assert status == 2 and err.startswith("error:")
+
+
+def test_json_gauge_generator_terms_in_position_space(tmp_path, run_cli):
+    """Castellani's generator of Maxwell, by hand: G = int (eps_dot pi^0 - eps d_i pi_i), so G_0 = -d_i pi_i
+    and G_1 = pi^0 (the terms multiply eps and eps_dot)."""
+    status, out, _ = run_cli("analyze", _write(tmp_path, MAXWELL_FILE), "--json")
+    assert json.loads(out)["gauge_generators"] == [{"terms": ["-d_x(p_A1) - d_y(p_A2) - d_z(p_A3)", "p_A0"]}]
+
+
+def test_lattice_flag_refused_for_a_mechanical_system(tmp_path, run_cli):
+    path = _write(tmp_path, '[system]\nname = "p"\ncoordinates = ["x"]\nlagrangian = "x_dot**2/2"\n', "p.toml")
+    status, _, err = run_cli("analyze", path, "--lattice", "4")
+    assert status == 2 and "--lattice needs a field theory" in err
