@@ -426,7 +426,8 @@ class FieldAnalysis(_Brackets):
         for case in self.parameter_cases:
             if case.error is None:
                 d = case.to_json()
-                rows.append(rf"\text{{{case.condition}}} &\quad \text{{{d['physical_degrees_of_freedom']} per mode}} \\")
+                condition = case.condition.replace("_", r"\_")
+                rows.append(rf"\text{{{condition}}} &\quad \text{{{d['physical_degrees_of_freedom']} per mode}} \\")
         return "\\begin{align*}\n" + "\n".join(rows) + "\n\\end{align*}"
 
     def __repr__(self) -> str:

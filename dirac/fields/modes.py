@@ -163,8 +163,18 @@ def latex_of_operator(name: str) -> str:
         name = rest[:-1]
     from dirac.model.lagrangian import latex_name
 
-    base = latex_name(name) if not name.startswith("epsilon") else name.replace("epsilon", r"\epsilon")
+    base = _latex_epsilon(name) if name.startswith("epsilon") else latex_name(name)
     return " ".join([*parts, base])
+
+
+def _latex_epsilon(name: str) -> str:
+    """``epsilon_2_tt`` -> ``\\ddot{\\epsilon}_{2}``: a gauge parameter and its time derivatives."""
+    pieces = name.split("_")[1:]
+    dots = len(pieces.pop()) if pieces and set(pieces[-1]) == {"t"} else 0
+    base = r"\epsilon"
+    if dots:
+        base = {1: r"\dot", 2: r"\ddot", 3: r"\dddot"}.get(dots, rf"\partial_t^{{{dots}}}") + "{" + base + "}"
+    return base + (f"_{{{pieces[0]}}}" if pieces else "")
 
 
 @dataclass

@@ -200,6 +200,9 @@ class FieldTheory:
         chis = [sympy.sympify(c) for c in constraints]
         density, chis = _plain(density, chis, field_names, [TIME_DIRECTION, *space])
         known = set(field_names) | {derivative_name(f, d) for f in field_names for d in [TIME_DIRECTION, *space]}
+        used = sorted({s.name for e in [density, *chis] for s in e.free_symbols})
+        probe = cls(name, tuple(space), tuple(sympy.Symbol(f, real=True) for f in field_names), sympy.Integer(0), {})
+        _check_derivatives(str(density), probe, "density", names=[u for u in used if u not in known])
         if parameters is None:
             free = set().union(*(e.free_symbols for e in [density, *chis]))
             parameters = {s.name: None for s in sorted(free, key=lambda s: s.name) if s.name not in known}
@@ -285,10 +288,11 @@ def _checked_names(name: Any, space: Any, fields: Any, parameters: Any) -> tuple
     return tuple(space), list(fields), parameters
 
 
-def _check_derivatives(text: str, theory: FieldTheory, what: str) -> None:
-    """Clear errors for ``A1_w`` (an undeclared direction) and ``A1_xx`` (a higher derivative)."""
+def _check_derivatives(text: str, theory: FieldTheory, what: str, names: Iterable[str] | None = None) -> None:
+    """Clear errors for ``A1_w`` (an undeclared direction) and ``A1_xx`` (a higher derivative)
+    among the names ``text`` uses (or ``names``, for sympy input)."""
     known = set(theory.variables) | set(theory.parameter_symbols)
-    for used in _names_in(text):
+    for used in (_names_in(text) if names is None else names):
         if used in known or "_" not in used:
             continue
         base, _, suffix = used.partition("_")

@@ -45,7 +45,7 @@ def test_text_and_latex(tmp_path, run_cli):
     assert "physical degrees of freedom per spatial point: 2" in out
     assert "delta A0 = epsilon_t" in out
     status, out, _ = run_cli("analyze", path, "--latex")
-    assert status == 0 and r"\partial_{x} p_{A_{1}}" in out
+    assert status == 0 and r"\partial_{x} p_{A_{1}}" in out and r"\delta A_{0} &= \dot{\epsilon}" in out
 
 
 def test_gauge_in_the_density_syntax_gives_the_transverse_delta(tmp_path, run_cli):

@@ -37,6 +37,12 @@ def test_derivative_along_an_undeclared_direction_is_named():
         dirac.FieldTheory.from_strings("m", ["x"], ["A0", "A1"], "(A1_t - A0_x)**2/2 - A1_y**2")
 
 
+def test_sympy_input_with_an_undeclared_direction_is_refused_not_taken_for_a_parameter():
+    phi_t, phi_y = sympy.symbols("phi_t phi_y")
+    with pytest.raises(InputError, match="along 'y', which is not a declared direction"):
+        dirac.FieldTheory.from_sympy("kg", ["x"], ["phi"], phi_t**2 / 2 - phi_y**2 / 2)
+
+
 def test_second_derivative_is_refused_saying_only_first_ones_are_taken():
     with pytest.raises(InputError, match="only first derivatives are taken"):
         dirac.FieldTheory.from_strings("m", ["x"], ["phi"], "phi_t**2/2 - phi_xx**2")
