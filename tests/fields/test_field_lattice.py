@@ -93,3 +93,18 @@ def test_sigma_model_with_rattle_keeps_the_sphere_and_the_energy_to_second_order
         errors.append(np.abs(energy - energy[0]).max())
     slope = np.polyfit(np.log(steps), np.log(errors), 1)[0]
     assert 1.8 < slope < 2.2, (errors, slope)
+
+
+def test_maxwell_on_a_lattice_keeps_its_gauge_invariance():
+    """Non-compact abelian fields on sites with forward differences keep a lattice gauge
+    invariance. Hand count, 1+1 on N = 4 sites: L = a sum_n (A1_dot_n - (A0_{n+1} - A0_n)/a)^2/2;
+    p_A0_n = 0 (N primary); their preservation gives the lattice Gauss laws p_A1_{n-1} - p_A1_n = 0,
+    whose sum over the ring vanishes identically: N - 1 = 3 independent secondaries. All 2N - 1 = 7
+    are first class; dof = (4N - 2(2N - 1))/2 = 1 (the zero mode of A1, as in the continuum's k = 0
+    case); one gauge parameter per site: delta A0_n = eps_dot_n, delta A1_n = (eps_{n+1} - eps_n)/a."""
+    from dirac.fields.catalog import maxwell_1p1
+
+    a = dirac.analyze(dirac.lattice(maxwell_1p1(), sites=4, spacing=0.5))
+    assert ([len(s) for s in a.stages], len(a.first_class), len(a.second_class)) == ([4, 3], 7, 0)
+    assert a.physical_degrees_of_freedom == 1
+    assert len(a.gauge_generators) == 4
