@@ -9,8 +9,8 @@ each spatial derivative by the **forward difference**
 and the action by ``L = (prod_j a_j) sum_n density(n)``. Holonomic constraints of the
 theory hold at every site, with one multiplier each (the engine's extended Lagrangian).
 
-What a lattice keeps and loses (Rothe, *Lattice Gauge Theories*, chs. 2-5; Montvay-Münster,
-*Quantum Fields on a Lattice*, sect. 4.4): the time evolution and the local constraints are
+What a lattice keeps and loses (H. J. Rothe, *Lattice Gauge Theories: An Introduction*;
+I. Montvay and G. Münster, *Quantum Fields on a Lattice*): the time evolution and the local constraints are
 exact, and so are global symmetries acting site by site (the O(3) rotations of the sigma
 model). A gauge field written as non-compact variables on sites with forward differences
 keeps a lattice gauge invariance ``delta A_0 = d_t eps``, ``delta A_j = (eps(n + e_j) -

@@ -20,8 +20,7 @@ count per spatial point, and the counts per point are the pair's divided by 2. T
 even: space translations act on the pair as the rotations ``a -> e^{i theta} a``, which map
 each real constraint ``Re F`` to its partner ``Im F``. The zero mode ``k = 0`` is real
 (``a(0) = conj(a(0))``): its Lagrangian is ``Q(a, a_dot, 0)`` in one real variable per field,
-and its counts are per mode, not halved (Henneaux–Teitelboim, sect. 19.1 on the zero
-modes of electromagnetism).
+and its counts are per mode, not halved.
 
 Back to position space. A real linear function ``c`` of the pair's phase space is the real
 part ``Re F`` of ``F = sum_a alpha_a(k) a_a + beta_a(k) pi_a`` with ``alpha_a = dc/du_a - i

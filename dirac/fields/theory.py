@@ -5,8 +5,8 @@ spatial directions ``space`` (any number, none included), and a Lagrangian densi
 ``L(phi, d_t phi, d_j phi)`` in the fields and their **first** derivatives, written
 ``A1_t`` (time) and ``A0_x`` (along ``x``). Higher derivatives are not taken: a density
 with second derivatives must be rewritten with auxiliary fields first. The action is
-``S = int dt d^d x L`` (Henneaux–Teitelboim, *Quantization of Gauge Systems*, sect. 3.3;
-Sundermeyer, *Constrained Dynamics*, ch. 4).
+``S = int dt d^d x L`` (Henneaux–Teitelboim, *Quantization of Gauge Systems*;
+Sundermeyer, *Constrained Dynamics*).
 
 Optional holonomic constraints ``chi(phi) = 0`` hold at every point (the O(3) sigma
 model's ``phi . phi = 1``); they are imposed on a lattice (:func:`dirac.fields.lattice.lattice`).

@@ -70,7 +70,7 @@ def test_sigma_model_counts_on_a_ring_of_64_sites():
 
 @pytest.mark.slow
 def test_sigma_model_with_rattle_keeps_the_sphere_and_the_energy_to_second_order():
-    """RATTLE (Andersen 1983; Hairer-Lubich-Wanner, Geometric Numerical Integration, sect. VII.1.4)
+    """RATTLE (Andersen, J. Comput. Phys. 52 (1983) 24; Hairer-Lubich-Wanner, Geometric Numerical Integration, ch. VII)
     keeps the holonomic constraints to the Newton tolerance at every step and the energy to
     O(dt^2): halving dt divides the energy error by 4 (a fit of log error against log dt has slope 2)."""
     sites = 64

@@ -113,7 +113,7 @@ def test_pure_chern_simons_has_no_local_degree_of_freedom():
 
 
 def test_fierz_pauli_five_polarisations():
-    """Hinterbichler, Rev. Mod. Phys. 84 (2012) 671, sect. II.B: the massive graviton has 5
+    """Hinterbichler, Rev. Mod. Phys. 84 (2012) 671, sect. II: the massive graviton has 5
     degrees of freedom, all constraints second class. Hand count of the chain: h00 and h0i enter
     without their own time derivatives once the terms d_t h_0mu d_i h_ij are read as momenta, so
     p_h0mu - (spatial derivatives of h) = 0 (4 primary); their preservation gives 4 secondary
