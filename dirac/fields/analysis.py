@@ -10,7 +10,6 @@ transformations, and Dirac brackets as the Fourier coefficient of the delta func
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -30,7 +29,7 @@ from dirac.fields.theory import TIME_DIRECTION, FieldTheory
 from dirac.model.expressions import parse_expression
 from dirac.model.lagrangian import momentum_name
 
-__all__ = ["FieldAnalysis", "FieldGauge", "FieldCase", "analyze_field_theory"]
+__all__ = ["FieldAnalysis", "FieldGauge", "FieldCase", "GaugeFixedField", "analyze_field_theory"]
 
 
 def _text(expr: sympy.Expr) -> str:
@@ -216,6 +215,10 @@ class FieldAnalysis(_Brackets):
         self.constraints = [c for s in stages for c in s]
         self.first_class = _select(self.mapping, mode.first_class)
         self.second_class = _select(self.mapping, mode.second_class)
+        if (len(self.first_class), len(self.second_class)) != (self.first_class_count, self.second_class_count):
+            raise AnalysisError(f"{self.name}: the classes of the mode pair do not pair up into local constraints "
+                                f"({len(self.first_class)} and {len(self.second_class)} local constraints against "
+                                f"{self.first_class_count} first and {self.second_class_count} second class per point)")
 
     @property
     def gauge_generators(self) -> list[FieldGauge]:
@@ -268,7 +271,6 @@ class FieldAnalysis(_Brackets):
     # ------------------------------------------------------------------ cases
     def _cases(self, progress: Callable[[str], None] | None) -> list[FieldCase]:
         from dirac.analysis.components import analyze
-        from dirac.analysis.constraint_analysis import ConstraintAnalysis  # noqa: F401  (the engine's result type)
 
         cases: list[FieldCase] = []
         if self.zero_mode is not None:
@@ -503,9 +505,4 @@ def analyze_field_theory(theory: FieldTheory, progress: Callable[[str], None] | 
     if not isinstance(theory, FieldTheory):
         raise InputError(f"analyze_field_theory() needs a dirac.FieldTheory, not {type(theory).__name__}")
     return FieldAnalysis(theory, progress=progress)
-
-
-def dumps(analysis: FieldAnalysis | GaugeFixedField) -> str:
-    return json.dumps(analysis.to_json(), indent=2)
-
 
