@@ -172,3 +172,13 @@ def test_poisson_bracket_per_mode_is_the_canonical_delta():
     """{A_i(x), pi_j(y)} = delta_ij delta(x - y): the Fourier coefficient is delta_ij (no k)."""
     a = dirac.analyze(maxwell())
     assert a.poisson_bracket("A1", "p_A1") == 1 and a.poisson_bracket("A1", "p_A2") == 0
+
+
+def test_chern_simons_bracket_of_the_two_spatial_components():
+    """By hand: up to a total time derivative L = kappa A2 d_t A1 - kappa A0 B, so A1 and kappa A2 are
+    canonically conjugate: {A1(x), A2(y)}_D = (1/kappa) delta(x - y), a constant Fourier coefficient
+    1/kappa; the second-class pair p_A1 - kappa A2/2, p_A2 + kappa A1/2 halves {A1, p_A1}_D to 1/2."""
+    a = dirac.analyze(chern_simons())
+    kappa = sympy.Symbol("kappa", real=True)
+    assert sympy.simplify(a.dirac_bracket("A1", "A2") - 1 / kappa) == 0
+    assert a.dirac_bracket("A1", "p_A1") == sympy.Rational(1, 2)
