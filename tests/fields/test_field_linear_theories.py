@@ -59,6 +59,8 @@ def test_maxwell_1p1_has_no_propagating_photon():
     a = dirac.analyze(maxwell_1p1())
     assert _counts(a) == ([1, 1], 2, 0, 0)
     assert [str(c) for c in a.stages[1]] == ["d_x(p_A1)"]
+    (gauge,) = a.gauge_generators  # delta A0 = d_t eps, delta A1 = d_x eps, as in 3+1
+    assert {k: str(v) for k, v in gauge.delta.items()} == {"A0": "epsilon_t", "A1": "d_x(epsilon)"}
     assert _case(a, "k_x = 0") == ([1], 1, 0, 1)
 
 
@@ -107,6 +109,8 @@ def test_pure_chern_simons_has_no_local_degree_of_freedom():
     (6 - 2 - 2)/2 = 1 (the zero modes of A1 and A2 are canonically conjugate: the holonomies)."""
     a = dirac.analyze(chern_simons())
     assert _counts(a) == ([3, 1], 2, 2, 0)
+    (gauge,) = a.gauge_generators  # G = int (eps_dot pi^0 - eps (d_i phi_i + kappa B)): delta A_mu = d_mu eps
+    assert [str(gauge.delta[f]) for f in ("A0", "A1", "A2")] == ["epsilon_t", "d_x(epsilon)", "d_y(epsilon)"]
     assert _case(a, "k_x = k_y = 0") == ([3], 1, 2, 1)
     (vanishing,) = [c for c in a.parameter_cases if c.condition == "kappa = 0"]
     assert vanishing.error is not None and "vanishes" in vanishing.error
