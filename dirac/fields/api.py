@@ -20,6 +20,7 @@ def analyze(
     progress: Callable[[str], None] | None = None,
     assume: Sequence[str] = (),
     cases: bool = False,
+    **options: Any,
 ) -> Any:
     """Run the Dirac–Bergmann algorithm on a Lagrangian, or on a field theory mode by mode.
 
@@ -27,7 +28,8 @@ def analyze(
     ----------
     system
         A :class:`dirac.Lagrangian` (see :func:`dirac.analysis.components.analyze` for
-        ``progress``, ``assume`` and ``cases``), or a :class:`dirac.FieldTheory` whose
+        ``progress``, ``assume``, ``cases`` and any further keyword ``options``, passed on
+        unchanged), or a :class:`dirac.FieldTheory` whose
         density is quadratic with constant coefficients: then a
         :class:`~dirac.fields.analysis.FieldAnalysis` with the counts per spatial point,
         constraints in position space, gauge transformations and the special wave vectors
@@ -45,10 +47,10 @@ def analyze(
         from dirac.errors import InputError
         from dirac.fields.analysis import analyze_field_theory
 
-        if assume:
-            raise InputError("assume= is for mechanical systems; a field theory is analysed for a generic wave vector "
-                             "with its special wave vectors as cases")
+        if assume or options:
+            raise InputError(f"{'assume=' if assume else ', '.join(options) + '='} is for mechanical systems; a field "
+                             "theory is analysed for a generic wave vector with its special wave vectors as cases")
         return analyze_field_theory(system, progress=progress)
     from dirac.analysis.components import analyze as analyze_lagrangian
 
-    return analyze_lagrangian(system, progress=progress, assume=assume, cases=cases)
+    return analyze_lagrangian(system, progress=progress, assume=assume, cases=cases, **options)
