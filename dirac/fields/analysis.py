@@ -155,9 +155,7 @@ class FieldAnalysis(_Brackets):
     stages, constraints, first_class, second_class
         Constraints in position space (``d_x(...)`` notation), one per constraint per point.
     constraints_per_stage, first_class_count, second_class_count, physical_degrees_of_freedom
-        Counts per spatial point.
-    gauge_generators
-        :class:`FieldGauge` list: local gauge transformations.
+        Counts per spatial point (the local gauge transformations: :attr:`gauge_generators`).
     parameter_cases
         :class:`FieldCase` list: ``k = 0`` and every special wave vector or parameter value.
     """

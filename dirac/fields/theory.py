@@ -55,6 +55,8 @@ def _names_in(text: str) -> list[str]:
 class FieldTheory:
     """Real fields on ``space`` with a Lagrangian density in the fields and first derivatives.
 
+    Build one with :meth:`from_strings` or :meth:`from_sympy`, which validate the input.
+
     Parameters
     ----------
     name
@@ -72,8 +74,6 @@ class FieldTheory:
         Holonomic constraints ``chi(phi) = 0`` at every point (fields and parameters only).
     description
         One line on the theory.
-
-    Use :meth:`from_strings` or :meth:`from_sympy`: both validate the input.
     """
 
     name: str
