@@ -48,6 +48,9 @@ __all__ = [
     "read_results",
     "plot",
     "TIME",
+    "FieldTheory",
+    "lattice",
+    "load_field_theory",
 ]
 
 #: public name -> module that defines it (imported on first access)
@@ -55,7 +58,7 @@ _LAZY: dict[str, str] = {
     "Lagrangian": "dirac.model.lagrangian",
     "load_system": "dirac.model.systems",
     "builtin_systems": "dirac.model.systems",
-    "analyze": "dirac.analysis.components",
+    "analyze": "dirac.fields.api",
     "integrate": "dirac.flows.integration",
     "RigidBodyProblem": "dirac.flows.problems",
     "HeavyTopProblem": "dirac.flows.problems",
@@ -67,6 +70,9 @@ _LAZY: dict[str, str] = {
     "read_results": "dirac.io.results",
     "plot": "dirac.plots.results",
     "TIME": "dirac.model.expressions",
+    "FieldTheory": "dirac.fields.theory",
+    "lattice": "dirac.fields.lattice",
+    "load_field_theory": "dirac.fields.files",
 }
 
 

@@ -107,6 +107,17 @@ def run_benchmark(quick: bool, json_path: str | None = None, plot_path: str | No
             notes.append(format_brackets_at_point(bracket_rows))
         except Exception as exc:  # one failed measurement must not hide the others
             notes.append(f"brackets at a point: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
+        say("field theories: the linear theories analysed mode by mode")
+        try:
+            from dirac.bench.field_theories import FIELD_THEORY_TARGET_SECONDS, field_theory_runs, field_theory_table
+            from dirac.bench.targets import Target
+
+            table, worst = field_theory_table(field_theory_runs(1 if quick else 3))
+            measured.append(Target("analysis: slowest linear field theory (s CPU)", worst, "s",
+                                   FIELD_THEORY_TARGET_SECONDS, "<=", "dirac.analyze(theory) in a fresh process"))
+            notes.append(table)
+        except Exception as exc:  # one failed measurement must not hide the others
+            notes.append(f"field theories: not measured ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})")
         say("codegen scale: chain first call and per-step cost against N, cold first results")
         try:
             from dirac.bench.codegen_scale import codegen_scale_targets

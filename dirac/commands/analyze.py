@@ -57,6 +57,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="also analyse every special parameter set (and special sets of those): the case tree, generic case first "
         "(JSON key parameter_cases)",
     )
+    parser.add_argument(
+        "--lattice",
+        metavar="N",
+        default=None,
+        help="for a field theory ([field] system file): analyse it on a periodic lattice of N sites per direction "
+        "(or N1,N2,... one per direction), forward differences; needed for a density that is not quadratic",
+    )
+    parser.add_argument("--spacing", metavar="A", type=float, default=1.0,
+                        help="lattice spacing with --lattice (default 1)")
     output = parser.add_mutually_exclusive_group()
     output.add_argument("--json", action="store_true", help="print one JSON object (stages, classes, multipliers, degrees of freedom)")
     output.add_argument("--latex", action="store_true", help="print the analysis as LaTeX")
@@ -126,8 +135,15 @@ def _at_special(system: str, params: dict[str, float], report: Callable[[str], N
 
 def main(args: argparse.Namespace) -> int:
     from dirac.analysis.components import analyze
+    from dirac.fields.files import is_field_file
     from dirac.model.systems import load_system
 
+    if is_field_file(args.system):  # a [field] table: the field-theory road (dirac.fields)
+        from dirac.commands.analyze_field import field_main
+
+        return field_main(args, parse_params(args.param), stage_printer(getattr(args, "verbosity", 0)))
+    if getattr(args, "lattice", None) is not None:
+        raise InputError(f"--lattice needs a field theory (a system file with a [field] table); {args.system!r} is not one")
     if getattr(args, "cases", False) and args.latex:
         raise InputError("--cases works with the text and the --json output, not with --latex: drop one of them")
     if getattr(args, "cases", False) and args.gauge:

@@ -44,6 +44,11 @@ def read_system_file(path: str | Path) -> Lagrangian:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"system file {str(path)!r} is not valid TOML: {exc}") from None
+    if "system" not in data and "field" in data:
+        raise InputError(
+            f"system file {str(path)!r} has a [field] table: it is a field theory, not a mechanical system; read it "
+            "with dirac.load_field_theory(path) and analyse it with dirac.analyze, or run dirac analyze FILE"
+        )
     return lagrangian_from_table(data.get("system"), source=str(path))
 
 
