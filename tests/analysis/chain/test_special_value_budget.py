@@ -5,11 +5,13 @@ held on ``x^2/a^2 + y^2/b^2 - 1 = 0`` (multiplier ``lambda_1``), by hand:
 ``p = m v / sqrt(1 - v^2/c^2)`` inverts to ``v = c p / sqrt(m^2 c^2 + p^2)`` and
 ``H_c = c sqrt(m^2 c^2 + p^2) + lambda_1 chi`` with ``chi = x^2/a^2 + y^2/b^2 - 1``. The
 Hessian in ``(x_dot, y_dot, lambda_1_dot)`` has rank 2: stage 1 is ``p_lambda_1 = 0``;
-``{p_lambda_1, H_c} = -chi``: stage 2 is ``chi``; ``{chi, H_c} = 2 c (x p_x/a^2 + y p_y/b^2)
-/ sqrt(m^2 c^2 + p^2)``: stage 3, the velocity along the normal; its bracket with ``H_T``
-contains ``lambda_1`` with the coefficient ``-{psi, chi}``-type term
-``4 c (x^2/a^4 + y^2/b^4) / sqrt(...) != 0``: stage 4 fixes ``lambda_1`` and the multiplier
-``u`` of ``p_lambda_1``. The 4 x 4 bracket matrix of the four constraints is invertible
+``{p_lambda_1, H_c} = -chi``: stage 2 is ``chi``; with ``s = sqrt(m^2 c^2 + p^2)``,
+``{chi, H_c} = 2 c (x p_x/a^2 + y p_y/b^2) / s``: stage 3 is ``psi``, the velocity along the
+normal; ``{psi, H_c}`` holds ``lambda_1 {psi, chi}`` with ``{chi, psi} = 4 c (x^2/a^4 +
+y^2/b^4) / s`` on the surface (the derivative of ``1/s`` multiplies ``psi ~ 0``), non-zero
+for ``c != 0``: stage 4 is a condition that fixes ``lambda_1``, and its bracket with
+``p_lambda_1`` (the same non-zero factor) fixes the multiplier ``u`` of ``p_lambda_1``.
+The 4 x 4 bracket matrix of the four constraints is invertible
 (its Pfaffian is the product of ``{p_lambda_1, stage 4}`` and ``{chi, stage 3}``, both
 non-zero), so all four are second class and ``(6 - 4)/2 = 1`` degree of freedom remains.
 At ``c = 0``, ``H_c = lambda_1 chi`` only: ``{chi, H_c} = 0`` ends the chain at stage 2,
