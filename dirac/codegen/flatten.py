@@ -254,8 +254,10 @@ class _Flattener:
             return
         self.active.add(name)
         function = self.functions[name]
+        written = self.helpers[name].size
         self._flatten_function(function)
         self.helpers[name] = _Helper(function)
+        self.helpers[name].size = written  # the policy judges a helper as written, not with its callees inlined
         self.active.discard(name)
         self.done.add(name)
 
