@@ -9,7 +9,7 @@ without the marks, where each helper is a separately compiled function). Here th
 inlining is done once on the Python source, before numba sees it, where the policy
 (:func:`straight`) says it pays: each such call of a marked helper becomes the helper's
 body with its locals renamed, so numba types and lowers each kernel and the few helpers
-left as functions once (the top's kernel in about 3.5 s), and the interpreter runs the
+left as functions once (the top's kernel in about 4-5 s), and the interpreter runs the
 same text.
 
 The rewriting keeps the floating-point operations and their order (the syntax tree is
@@ -271,22 +271,23 @@ class _Flattener:
 
 
 #: helpers with loops kept as functions of their own: the dense LU (its loops over a matrix
-#: are most of a kernel's basic blocks) and RATTLE's stage residual (called at three places
-#: of the step loop: inlined, it would be copied three times)
-SEPARATE = frozenset({"lu_factor", "lu_solve", "rattle_residual"})
-#: statements of a helper with loops that is still inlined
-SMALL = 16
+#: are most of a kernel's basic blocks, and it is called at many places)
+SEPARATE = frozenset({"lu_factor", "lu_solve"})
+#: statements (as written) of a helper with loops that is still inlined
+SMALL = 40
 
 
 def straight(helper: _Helper) -> bool:
     """The default policy: inline the helpers without loops (expressions, closed-form
-    solves, the bookkeeping of ``info``) and the small ones with loops (a norm, ``v = M^-1 p``,
-    RATTLE's closing projection), but not those of :data:`SEPARATE`. Measured on the RATTLE
-    kernel of a top in Euler angles: inlining every helper multiplies the basic blocks that
-    numba's reaching-definitions analysis walks (its cost grows with blocks times variables)
-    and the compilation took 17 s; inlining none, or only the loop-free ones, compiles in
-    about 3.5 s but a step costs 1.6 times as much (every call passes a dozen arrays); this
-    policy compiles in the same time and a step costs 1.1-1.2 times the fully inlined one."""
+    solves, the bookkeeping of ``info``) and those with loops up to :data:`SMALL`
+    statements (a norm, ``v = M^-1 p``, RATTLE's stage residual and closing projection),
+    but not the LU of :data:`SEPARATE`. Measured on the RATTLE kernel of a top in Euler
+    angles (CPU, 2 cores under load): inlining every helper multiplies the basic blocks
+    that numba's reaching-definitions analysis walks (its cost grows with blocks times
+    variables) and the compilation took 17 s; inlining only the loop-free ones compiles
+    in about 4 s but a step costs 1.6 times numba's own inlining (every call passes a dozen
+    arrays); this policy compiles in about 5 s and a step costs about half of it (2.0 us
+    against 3.2-3.9 us)."""
     return not helper.loops or (helper.size <= SMALL and helper.name not in SEPARATE)
 
 
