@@ -18,7 +18,7 @@ import sympy
 from dirac.analysis.brackets.dirac_bracket import DiracBracket
 from dirac.analysis.chain.assumptions import parse_assumptions
 from dirac.analysis.chain.constraint_chain import ConstraintChain
-from dirac.analysis.chain.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
+from dirac.analysis.chain.special_values import RankUse, SpecialValue, special_parameter_values
 from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.core.algebra import tidy
