@@ -15,6 +15,16 @@ candidates, each checked by evaluating the rank again with the
 parameter at that value (on points of the surface of the constraints at that value).
 Factors that vanish only on the constraint surface are not searched.
 
+The ranks searched are those of every stage, not only the last one's: each stage that
+added constraints fixed multipliers with its own block of ``{Phi_a, phi_k}`` over the
+constraints known then (:attr:`~dirac.analysis.chain.constraint_chain.ConstraintChain.stage_pivots`),
+decided on that stage's surface (:attr:`RankUse.surface`). Where that block's rank drops the
+chain goes another way from there on: in Fierz-Pauli the mass term gives the secondaries of
+``h0i`` a bracket with the primaries, so stage 2 fixes their multipliers and the chain goes
+on to stages 3 and 4; at ``m = 0`` that block vanishes, the chain stops at stage 2 and the
+theory is linearised Einstein (8 first class instead of 10 second class). Blocks larger
+than :data:`MAX_BLOCK` are scanned numerically at :data:`SCAN_VALUES` (with a note), not skipped.
+
 Entries with radicals (``sqrt(c**2 m**2 + p**2)`` of a relativistic particle) are not
 handed to sympy's domain of arbitrary expressions, where a 4 x 4 determinant takes
 minutes: each radical becomes a new symbol with its defining relation, removed again by a
