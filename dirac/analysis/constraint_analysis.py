@@ -18,7 +18,7 @@ import sympy
 from dirac.analysis.brackets.dirac_bracket import DiracBracket
 from dirac.analysis.chain.assumptions import parse_assumptions
 from dirac.analysis.chain.constraint_chain import ConstraintChain
-from dirac.analysis.chain.special_values import MAX_BLOCK, RankUse, SpecialValue, special_parameter_values
+from dirac.analysis.chain.special_values import RankUse, SpecialValue, special_parameter_values
 from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.core.algebra import tidy
@@ -370,52 +370,57 @@ class ConstraintAnalysis:
         return fix_gauge(self, conditions)
 
     def _special_values(self, chain: ConstraintChain, C: sympy.Matrix, second: list[int], seed: int) -> tuple[list[SpecialValue], list[str]]:
-        """Parameter values where the rank of the Hessian, of ``A_PQ`` or of ``C`` drops (:mod:`dirac.analysis.chain.special_values`)."""
+        """Parameter values where a rank the analysis used drops (:mod:`dirac.analysis.chain.special_values`).
+
+        The ranks searched: the Hessian's, that of the consistency matrix ``A_PQ`` of every
+        stage (the earlier stages' too: at ``m = 0`` Fierz-Pauli's stage-2 block, which fixes
+        the multipliers of ``h0i`` through the mass term, vanishes and the chain stops there,
+        although the last stage's matrix still has the generic rank on the generic surface)
+        and that of the second-class block of ``C``. Blocks larger than ``MAX_BLOCK`` are
+        scanned numerically (with a note).
+        """
         space = self._space
         uses = []
-        large: list[str] = []
         unsearched: list[str] = []
         params = set(self.parameters)
         W = self.hessian
-        P, Q = chain.pivots
-        small = 0 < len(P) <= MAX_BLOCK
-        A = sympy.Matrix([[chain._rows(c)[1][k] for k in range(len(chain.primary))] for c in self.constraints]) if small else None
-        for label, size, block in (
-            ("Hessian", self.hessian_rank, W),
-            ("consistency matrix {Phi_a, phi_k}", len(P), A[P, Q] if A is not None else None),
-            ("bracket matrix C", len(second), C[second, second] if 0 < len(second) <= MAX_BLOCK else None),
-        ):
-            if not size:
-                continue
-            if size > MAX_BLOCK:
-                large.append(f"{label} ({size}x{size})")
-                continue
-            if block is None or not block.free_symbols & params:
-                continue
-            if label == "Hessian" and block.free_symbols & set(self.lagrangian.velocities):
+        everything = self.constraints + self.reducible_constraints
+        K = len(chain.primary)
+
+        def consistency(n: int) -> sympy.Matrix:
+            return sympy.Matrix([[chain._rows(c)[1][k] for k in range(K)] for c in chain.constraints[:n]])
+
+        if self.hessian_rank and W.free_symbols & params:
+            if W.free_symbols & set(self.lagrangian.velocities):
                 unsearched.append(
                     "special parameter values: not searched in the Hessian, which depends on the velocities "
                     "(L is not quadratic in them)"
                 )
-                continue
-            if label == "Hessian":
+            else:
                 points = [self._numerics.random_point() for _ in range(3)]
                 values = self._numerics.evaluate(list(W), points).reshape(len(points), *W.shape)
                 S = independent_rows(list(values), list(range(W.shape[0])))
-                uses.append(RankUse(label, W[S, S], W, len(S), on_surface=False))
-            elif A is not None and label.startswith("consistency"):
-                uses.append(RankUse(label, A[P, Q], A, len(P), on_surface=True))
-            else:
-                uses.append(RankUse(label, C[second, second], C, len(second), on_surface=True))
-        notes = [
-            f"special parameter values: not searched in the {', '.join(large)}: blocks larger than "
-            f"{MAX_BLOCK}x{MAX_BLOCK} are too large for a symbolic determinant"
-        ] if large else []
-        everything = self.constraints + self.reducible_constraints
+                uses.append(RankUse("Hessian", W[S, S], W, len(S), on_surface=False))
+        # the earlier stages: each on the surface of the constraints it knew
+        for stage, n, rows, cols in getattr(chain, "stage_pivots", []):
+            if not rows:
+                continue
+            A = consistency(n)
+            if not A[rows, cols].free_symbols & params:
+                continue
+            uses.append(RankUse(f"consistency matrix {{Phi_a, phi_k}} of stage {stage}", A[rows, cols], A, len(rows),
+                                on_surface=True, surface=chain.constraints[:n]))
+        P, Q = chain.pivots
+        if P:
+            A = consistency(len(chain.constraints))
+            if A[P, Q].free_symbols & params:
+                uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True))
+        if second and C[second, second].free_symbols & params:
+            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True))
         found, skipped = special_parameter_values(
             space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time
         )
-        return found, notes + unsearched + skipped
+        return found, unsearched + skipped
 
     # ------------------------------------------------------------------ brackets
     def poisson_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str) -> sympy.Expr:

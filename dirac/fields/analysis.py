@@ -410,6 +410,9 @@ class FieldAnalysis(_Brackets):
         if self.parameter_cases:
             lines.append("special cases (counts per mode):")
             lines.extend(f"  {c.summary()}" for c in self.parameter_cases)
+        # what the special-value search of the mode pair did not search symbolically (or at all) is said
+        lines.extend(f"note (mode pair): {n}" for n in getattr(self.mode, "notes", [])
+                     if n.startswith("special parameter values:"))
         return "\n".join(lines)
 
     def to_latex(self) -> str:

@@ -152,6 +152,20 @@ def test_linearised_einstein_two_graviton_polarisations_and_diffeomorphisms():
     assert _case(a, "k_x = k_y = k_z = 0") == ([4], 4, 0, 6)
 
 
+def test_fierz_pauli_massless_case_is_linearised_einstein():
+    """At m = 0 Hinterbichler's (2.1) is linearised Einstein: the hand count of
+    test_linearised_einstein_two_graviton_polarisations_and_diffeomorphisms above (4 primary,
+    4 secondary that commute with H, all 8 first class, dof (20 - 2*8)/2 = 2). The structure
+    changes at stage 2: for m != 0 the mass term gives the h0i secondaries a non-zero bracket
+    with the primaries (the consistency block of stage 2 fixes their multipliers), at m = 0
+    that block vanishes and the chain stops there. So m = 0 must be a special parameter value
+    of Fierz-Pauli, found in the stage-2 block, with the linearised-Einstein counts."""
+    a = dirac.analyze(fierz_pauli())
+    assert _case(a, "m = 0") == ([4, 4], 8, 0, 2)
+    (special,) = [s for s in a.mode.special_parameter_values if s.equation == "m = 0"]
+    assert "consistency matrix {Phi_a, phi_k} of stage 2 drops" in special.where
+
+
 def test_coulomb_gauge_bracket_is_the_transverse_delta():
     """In Coulomb gauge (A0 = 0, d_i A_i = 0) the Dirac bracket of Maxwell is
     {A_i(x), pi_j(y)}_D = (delta_ij - d_i d_j / laplacian) delta(x - y): its Fourier coefficient is

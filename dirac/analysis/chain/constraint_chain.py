@@ -177,6 +177,10 @@ class ConstraintChain:
     hessian_rank: int = 0
     #: divisions by functions that are no branch: the elimination of multipliers at a stage (:meth:`_cleared`)
     divisions: list[Division] = field(default_factory=list)
+    #: the rank decisions of the stages before the last: ``(s, n, rows, cols)`` for each stage ``s`` that added
+    #: constraints, the pivot rows and multiplier columns of ``{Phi_a, phi_k}`` over its first ``n`` constraints
+    #: (stages ``1..s``); searched for special parameter values (:mod:`dirac.analysis.chain.special_values`)
+    stage_pivots: list[tuple[int, int, list[int], list[int]]] = field(default_factory=list)
 
     @property
     def constraints(self) -> list[sympy.Expr]:
@@ -290,6 +294,7 @@ class ConstraintChain:
         points = self._stage_points(primary, []) if primary else []
         base_grads = self._independent(primary, [], points) if primary else []
         self.stages = [[primary[i] for i in base_grads]] if primary else []
+        self.stage_pivots = []
         if primary and len(base_grads) < len(primary):
             raise AnalysisError("the primary constraints are not independent; the analysis cannot proceed")
         limit = max_stages or (self.phase_space.dimension + 2)
@@ -348,6 +353,7 @@ class ConstraintChain:
                 continue
             if not chosen:
                 break
+            self.stage_pivots.append((len(self.stages), len(constraints), list(pivots_rows), list(pivot_cols)))
             self.stages.append([candidates[i] for i in chosen])
             self._keep_reducible(candidates, chosen)
             points = self._stage_points()

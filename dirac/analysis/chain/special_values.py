@@ -15,6 +15,16 @@ candidates, each checked by evaluating the rank again with the
 parameter at that value (on points of the surface of the constraints at that value).
 Factors that vanish only on the constraint surface are not searched.
 
+The ranks searched are those of every stage, not only the last one's: each stage that
+added constraints fixed multipliers with its own block of ``{Phi_a, phi_k}`` over the
+constraints known then (:attr:`~dirac.analysis.chain.constraint_chain.ConstraintChain.stage_pivots`),
+decided on that stage's surface (:attr:`RankUse.surface`). Where that block's rank drops the
+chain goes another way from there on: in Fierz-Pauli the mass term gives the secondaries of
+``h0i`` a bracket with the primaries, so stage 2 fixes their multipliers and the chain goes
+on to stages 3 and 4; at ``m = 0`` that block vanishes, the chain stops at stage 2 and the
+theory is linearised Einstein (8 first class instead of 10 second class). Blocks larger
+than :data:`MAX_BLOCK` are scanned numerically at :data:`SCAN_VALUES` (with a note), not skipped.
+
 Entries with radicals (``sqrt(c**2 m**2 + p**2)`` of a relativistic particle) are not
 handed to sympy's domain of arbitrary expressions, where a 4 x 4 determinant takes
 minutes: each radical becomes a new symbol with its defining relation, removed again by a
@@ -39,7 +49,8 @@ from dirac.errors import AnalysisError
 
 __all__ = ["SpecialValue", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
 
-#: blocks larger than this are not searched (their determinants are too large)
+#: blocks larger than this are not searched symbolically (their determinants are too large): they are scanned
+#: numerically at :data:`SCAN_VALUES` instead (:func:`_scan`)
 MAX_BLOCK = 4
 
 #: CPU seconds the symbolic search of all the blocks of one analysis may take (:func:`special_parameter_values`)
@@ -150,6 +161,16 @@ class RankUse:
     matrix: sympy.Matrix
     rank: int
     on_surface: bool
+    #: the constraints whose surface the rank was decided on, when not all of them (an earlier stage's surface)
+    surface: Sequence[sympy.Expr] | None = None
+
+    def constraints(self, constraints_at: Callable[[dict], list[sympy.Expr]], substitution: dict) -> list[sympy.Expr]:
+        """The constraints of this decision's surface with ``substitution`` (``[]`` off the surface)."""
+        if not self.on_surface:
+            return []
+        if self.surface is not None:
+            return [c.subs(substitution) for c in self.surface]
+        return constraints_at(substitution)
 
 
 def _numerator_of_determinant(block: sympy.Matrix) -> sympy.Expr:
@@ -385,14 +406,12 @@ def special_parameter_values(
             found[key].append(change)
 
     cut: list[RankUse] = []
+    large: list[RankUse] = []
     for use in uses:
         if use.rank == 0 or not (use.block.free_symbols & set(parameters)):
             continue
         if use.block.shape[0] > MAX_BLOCK:
-            notes.append(
-                f"special parameter values: not searched in the {use.label} (its {use.block.shape[0]}x"
-                f"{use.block.shape[0]} block is too large for a symbolic determinant)"
-            )
+            large.append(use)  # too large for a symbolic determinant: the numeric road
             continue
         try:
             with clock.interrupting():
@@ -423,10 +442,15 @@ def special_parameter_values(
                 f"special parameter values: candidates of the {use.label} not checked (the search ran over its "
                 f"budget of {clock.seconds:g} s CPU): {', '.join(dict.fromkeys(unchecked))}; the rank may drop there"
             )
-    if cut:
+    if cut or large:
         scan = CpuBudget(SCAN_SECONDS if scan_budget is None else scan_budget)
         for use in cut:
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, clock.seconds, scan, record))
+            why = f"the symbolic search in the {use.label} ran over its budget of {clock.seconds:g} s CPU and was not finished"
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record))
+        for use in large:
+            n = use.block.shape[0]
+            why = f"the {use.label} was not searched symbolically (its {n}x{n} block is larger than {MAX_BLOCK}x{MAX_BLOCK})"
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record))
     return [replace(values[key], where="; ".join(w)) for key, w in found.items()], notes
 
 
@@ -475,11 +499,11 @@ def _scan(
     constraints_at: Callable[[dict], list[sympy.Expr]],
     seed: int,
     time: sympy.Symbol | None,
-    seconds: float,
+    why: str,
     scan: CpuBudget,
     record: Callable[[RankUse, sympy.Symbol, sympy.Expr, int | None, sympy.Expr | None], None],
 ) -> str:
-    """The numeric road of a block whose symbolic search ran over its budget; returns the note that says so.
+    """The numeric road of a block not searched symbolically (over the budget, or too large); returns the note.
 
     The rank of ``use.matrix`` is evaluated with one parameter of the block at a time set
     to each of :data:`SCAN_VALUES` (the other parameters at their generic values); a drop
@@ -488,7 +512,7 @@ def _scan(
     params = sorted(use.block.free_symbols & set(space.parameters), key=lambda s: s.name)
     scanned: list[str] = []
     left_out: list[str] = []
-    scanner = _Scanner(space, generic, use, constraints_at({}) if use.on_surface else [], seed, time)
+    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time)
     for p in params:
         done = True
         for value in SCAN_VALUES:
@@ -503,8 +527,7 @@ def _scan(
         (scanned if done else left_out).append(p.name)
     shown = ", ".join(str(v) for v in SCAN_VALUES)
     note = (
-        f"special parameter values: the symbolic search in the {use.label} ran over its budget of {seconds:g} s CPU "
-        f"and was not finished; scanned numerically instead: "
+        f"special parameter values: {why}; scanned numerically instead: "
         + (f"{', '.join(scanned)} at {shown} (one at a time, the others generic)" if scanned else "nothing")
         + "; other values and curves of several parameters (such as b = a**2) were not searched"
     )
@@ -571,7 +594,7 @@ def _rank_at(
     for p, value in substitution.items():
         numbers[p] = float(sympy.re(value.subs(generic)))
     matrix = use.matrix.subs(substitution)
-    constraints = constraints_at(substitution) if use.on_surface else []
+    constraints = use.constraints(constraints_at, substitution)
     if any(e.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo) for e in [*matrix, *constraints]):
         return UNDEFINED  # a denominator vanishes: the expressions are undefined there, not of lower rank
     if matrix.shape[0] == 0 or matrix.shape[1] == 0:
