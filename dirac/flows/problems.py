@@ -230,6 +230,10 @@ class HeavyTopProblem(RigidBodyProblem):
 class ConstrainedProblem:
     """A holonomically constrained mechanical system with initial positions and momenta (or velocities).
 
+    A system with generalized forces (``Lagrangian(..., forces=...)``) gives a
+    :class:`ForcedProblem` (without impulses): ``rattle-2/4`` then run as
+    ``forced-rattle-2/4``, ``midpoint`` and the scipy methods on the forced Dirac field.
+
     Parameters
     ----------
     mechanics : dirac.Lagrangian or dirac.flows.mechanics.MechanicalSystem
@@ -248,10 +252,6 @@ class ConstrainedProblem:
     project : bool
         Put the initial data on the constraint surface first (as ``project = true`` in a
         scene): the closest point in the metric ``M`` (:meth:`MechanicalSystem.project`).
-
-    A system with generalized forces (``Lagrangian(..., forces=...)``) gives a
-    :class:`ForcedProblem` (without impulses): ``rattle-2/4`` then run as
-    ``forced-rattle-2/4``, ``midpoint`` and the scipy methods on the forced Dirac field.
 
     Raises
     ------
