@@ -353,6 +353,7 @@ class ConstraintChain:
             points = self._stage_points()
             settled = False
         self.points = points
+        self._check_legendre_divisors(points)  # the final surface (the primary one may hold such points: 228)
         self.pivots = (pivots_rows, pivot_cols)
         if pivots_rows:
             self._check_consistent_rank(A_num, pivots_rows)
@@ -398,7 +399,6 @@ class ConstraintChain:
             constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=self._minors(constraints, whole)
         )
         self._check_hessian_rank(points)
-        self._check_legendre_divisors(points)
         return points
 
     def _check_legendre_divisors(self, points: list[np.ndarray]) -> None:
@@ -421,10 +421,10 @@ class ConstraintChain:
         values = np.abs(self.numerics.evaluate(self._legendre_divisors, points))
         scales = self.numerics.term_scale(self._legendre_divisors, points)
         for k, f in enumerate(self._legendre_divisors):
-            hit = ~(values[:, k] > ROUND_OFF * scales[:, k])  # also NaN
+            hit = values[:, k] <= ROUND_OFF * scales[:, k]  # NaN (undefined) is left to the rank checks
             if np.any(hit):
                 raise AnalysisError(
-                    f"the constraint surface found at stage {len(self.stages)} has a part where the Legendre map divides "
+                    f"the constraint surface has a part where the Legendre map divides "
                     f"by zero ({f} = 0 at {int(np.sum(hit))} of {len(points)} sample points): the canonical Hamiltonian and "
                     f"the consistency conditions are singular there, so that part cannot be analysed with the rest; set it "
                     f"aside with --assume \"{f} != 0\" (in Python assume=[\"{f} != 0\"]) or analyse it as a system of its own"
