@@ -229,19 +229,22 @@ def _refuse_vanishing_pivot_block(blocks: Sequence[np.ndarray]) -> None:
     (``p1 = 0``, ``2 p1^2 - p1 p2 + 4 q1^2 - q1 = 0`` is the union of ``q1 = 0`` and ``q1 = 1/4``,
     and ``det A_PQ = 4 p1^2 - p1 p2 - 8 q1^2 + q1`` vanishes on the first).
     """
-    for k, block in enumerate(blocks):
-        if not block.size:
-            continue
-        size = np.max(np.abs(block))
-        smallest = np.linalg.svd(block, compute_uv=False)[-1]
-        if size > 0 and smallest <= PIVOT_BLOCK_ZERO * size:
-            raise AnalysisError(
-                f"the multipliers' solution divides by zero at {k + 1} of the {len(blocks)} sample points of the constraint "
-                "surface (the block of {Phi_a, phi_k} it inverts is singular there, relative size "
-                f"{smallest / size:.1e}): the surface has a part on which the multipliers are fixed otherwise (a constraint "
-                "that factors once the others are put in, or a rank that changes); analyse each part as a system of its own "
-                "(--assume picks one)"
-            )
+    blocks = [b for b in blocks if b.size]
+    if not blocks:
+        return
+    # relative to the largest entry at any point: a block that is small everywhere at one point (q1 ~ 1e-13 where
+    # it is 0.25 at the others) is as singular as one with a small singular value
+    size = max(float(np.max(np.abs(b))) for b in blocks)
+    smallest = [float(np.linalg.svd(block, compute_uv=False)[-1]) for block in blocks]
+    singular = [v for v in smallest if size > 0 and v <= PIVOT_BLOCK_ZERO * size]
+    if singular:
+        raise AnalysisError(
+            f"the multipliers' solution divides by zero at {len(singular)} of the {len(blocks)} sample points of the constraint "
+            "surface (the block of {Phi_a, phi_k} it inverts is singular there, relative size "
+            f"{min(singular) / size:.1e}): the surface has a part on which the multipliers are fixed otherwise (a constraint "
+            "that factors once the others are put in, or a rank that changes); analyse each part as a system of its own "
+            "(--assume picks one)"
+        )
 
 
 def general_multiplier_solution(
