@@ -94,6 +94,9 @@ FACTOR_TERMS = 24
 #: a variable at most this large at every sample point spans a suspected singular locus (:meth:`ConstraintChain._off_singular_locus`)
 LOCUS_SIZE = 1e-2
 
+#: largest block of pivot rows whose exact coefficients are solved to find what the elimination divides by (:meth:`ConstraintChain._cleared`)
+MAX_CLEARED_BLOCK = 2
+
 #: length (characters) above which a stage's reducibility note is given briefly (counts, the relation, a few shown)
 LONG_NOTE = 2000
 
@@ -282,6 +285,7 @@ class ConstraintChain:
         self._hessian: EntryBlock | None = None
         self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock]] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
+        self._varying: dict[int, bool] = {}  # row -> whether its coefficients in the pivot rows vary between points
         self._legendre_divisors: list[sympy.Expr] | None = None  # the factors of the denominator of H_c (found on first use)
         #: divisor -> whether it is a branch (None: it does not vanish on the surface), decided once per chain
         self._judged: dict[tuple[sympy.Expr, int], bool | None] = {}
@@ -920,6 +924,9 @@ class ConstraintChain:
         coeff = np.array([np.linalg.lstsq(A[np.ix_(P, Q)].T, A[row, Q], rcond=None)[0] for A in A_num])
         scale = 1 + np.max(np.abs(coeff), axis=1, keepdims=True)
         used = [k for k in range(len(P)) if not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
+        # coefficients equal at every point are numbers: no division by a function to check (:meth:`_cleared`)
+        varying = [k for k in used if np.ptp(coeff[:, k]) > 1e-9 * (1 + np.max(np.abs(coeff[:, k])))]
+        self._varying[row] = bool(varying)
         return [k for k in used if not b_zero[P[k]]], used
 
     def _coefficients(self, row: int, used: list[int], constraints: list[sympy.Expr], P: list[int], Q: list[int], A_num: np.ndarray) -> list[sympy.Expr]:
@@ -929,6 +936,8 @@ class ConstraintChain:
         (:func:`weak_solve`); ``[]`` when every entry involved is a number (no division by a
         function) or no such block is found.
         """
+        if len(used) > MAX_CLEARED_BLOCK:
+            return []  # a symbolic solve of a larger block costs more than the stage (the rigid body (228): 2x)
         rows = [P[k] for k in used]
         entries = [[self._rows(constraints[p])[1][q] for q in Q] for p in rows]
         target = [self._rows(constraints[row])[1][q] for q in Q]
@@ -965,7 +974,7 @@ class ConstraintChain:
         branch ``y = 1/2``.
         """
         if coefficients is None:
-            coefficients = self._coefficients(row, used, constraints, P, Q, A_num) if used else []
+            coefficients = self._coefficients(row, used, constraints, P, Q, A_num) if used and self._varying.get(row) else []
         stage = len(self.stages) + 1
         branches = []
         for division in divisions_of(coefficients, stage, "the elimination of multipliers divides by zero", self.phase_space.variables):
