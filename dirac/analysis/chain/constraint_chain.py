@@ -1003,7 +1003,7 @@ class ConstraintChain:
         for b, A in zip(b_num, A_num):
             augmented = np.hstack([A, b[:, None]])
             scale = np.max(np.abs(augmented)) or 1.0
-            if numeric_rank(augmented / scale) != numeric_rank(A / scale):
+            if numeric_rank(augmented / scale, scale=1.0) != numeric_rank(A / scale, scale=1.0):  # one scale: round-off is no rank
                 return False
         return True
 
