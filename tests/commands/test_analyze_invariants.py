@@ -117,8 +117,8 @@ def _solvable(b: np.ndarray, A: np.ndarray) -> bool:
     from dirac.analysis.core.numeric import numeric_rank
 
     augmented = np.hstack([A, b[:, None]])
-    scale = np.max(np.abs(augmented)) or 1.0
-    return numeric_rank(augmented / scale) == numeric_rank(A / scale)
+    scale = np.max(np.abs(augmented)) or 1.0  # one scale for both: round-off in A is no rank
+    return numeric_rank(augmented / scale) == numeric_rank(A / scale, scale=1.0)
 
 
 def chain_violations(analysis) -> list[str]:
@@ -142,7 +142,7 @@ def chain_violations(analysis) -> list[str]:
         generic_rows = [A for A in chain._numeric_rows(surface, generic)[1] if np.all(np.isfinite(A))]
         if not generic_rows:
             continue
-        rank = max(numeric_rank(A / (np.max(np.abs(A)) or 1.0)) for A in generic_rows)
+        rank = max(numeric_rank(A, scale=float(np.max(np.abs(A), initial=0.0))) for A in generic_rows)
         points = list(generic)
         for f in dict.fromkeys(divisors):
             try:
@@ -150,10 +150,12 @@ def chain_violations(analysis) -> list[str]:
             except DiracError:
                 continue
         b_num, A_num = chain._numeric_rows(surface, points)
-        for z, b, A in zip(points, b_num, A_num):
-            if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-                continue  # on the zero set of a divisor of H_c or of the constraints: no regular point
-            if numeric_rank(A / (np.max(np.abs(A)) or 1.0)) != rank or not _solvable(b, A):
+        sizes = [max(np.max(np.abs(A), initial=0.0), np.max(np.abs(b), initial=0.0)) for b, A in zip(b_num, A_num)]
+        typical = float(np.median(sizes[: len(generic)])) or 1.0
+        for z, b, A, size in zip(points, b_num, A_num, sizes):
+            if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))) or size > 1e6 * typical:
+                continue  # on (or next to) the zero set of a divisor of H_c or of the constraints: no regular point
+            if numeric_rank(A / size if size else A, scale=1.0) != rank or not _solvable(b, A):
                 continue
             if not following:
                 continue

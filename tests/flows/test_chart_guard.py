@@ -39,25 +39,23 @@ def _euler_top() -> ConstrainedProblem:
     return ConstrainedProblem(L, q0=[0.0, 0.4, 0.0], qdot0=[0.0, 0.0, 2.0])
 
 
-def test_the_guard_measures_sin_theta_squared():
-    """The Hadamard ratio ``|det W| / prod |W_i|`` at ``psi = 0``: ``W`` there is, by hand,
-    ``[[B s^2 + C c^2, 0, C c], [0, A, 0], [C c, 0, C]]`` (``s, c = sin, cos theta``), with
-    ``det W = A B C s^2``; its ratio is ``A B C s^2 / (|W_1| A |W_3|)``."""
+def test_the_guard_measures_the_distance_to_sin_theta_zero():
+    """``det W = A B C sin(theta)^2`` (module docstring): the locus is ``sin(theta) = 0`` and the
+    first-order distance to it is ``|sin(theta)| / |cos(theta)| = |tan(theta)|`` (radians),
+    whatever ``phi`` and ``psi``."""
     guard = chart_guard(_euler_top().mechanics)
     assert guard is not None and guard.locus == "sin(theta) = 0"
-    A, B, C = 1.0, 0.8, 0.5
-    for theta in (0.4, 1e-3):
-        s, c = np.sin(theta), np.cos(theta)
-        rows = [np.hypot(B * s**2 + C * c**2, C * c), A, np.hypot(C * c, C)]
-        assert guard.ratio(np.array([0.3, theta, 0.0])) == pytest.approx(A * B * C * s**2 / np.prod(rows), rel=1e-9)
+    for theta in (0.4, 1e-3, -0.2):
+        q = np.array([[0.3, theta, 1.1], [2.0, 0.7, -0.5]])
+        assert guard.distance(q) == pytest.approx(min(abs(np.tan(theta)), np.tan(0.7)), rel=1e-12)
 
 
 @pytest.mark.parametrize("method, dt", [("auto", None), ("rattle-2", 0.01)])
 def test_a_run_through_the_singularity_stops_and_names_it(method, dt):
     """The default run used to fail with "Newton iteration did not converge ... reduce dt" at
     ``t = 62.11``, and ``rattle-2`` passed ``theta = 4e-4`` with a 1 % energy error and no word.
-    Both stop just before (``sin(theta)^2`` below ``1e-4`` of its size), naming the locus,
-    the time and another chart."""
+    Both stop just before (``|tan(theta)|`` below ``1e-2``), naming the locus, the time and
+    another chart."""
     options = {} if dt is None else {"dt": dt}
     with pytest.raises(CoordinateSingularityError, match=r"sin\(theta\) = 0") as caught:
         integrate(_euler_top(), method, t_end=70.0, samples=701, **options)

@@ -94,6 +94,9 @@ FACTOR_TERMS = 24
 #: a variable at most this large at every sample point spans a suspected singular locus (:meth:`ConstraintChain._off_singular_locus`)
 LOCUS_SIZE = 1e-2
 
+#: largest block of pivot rows whose exact coefficients are solved to find what the elimination divides by (:meth:`ConstraintChain._cleared`)
+MAX_CLEARED_BLOCK = 2
+
 #: length (characters) above which a stage's reducibility note is given briefly (counts, the relation, a few shown)
 LONG_NOTE = 2000
 
@@ -286,6 +289,7 @@ class ConstraintChain:
         self._hessian: EntryBlock | None = None
         self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock]] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
+        self._varying: dict[int, bool] = {}  # row -> whether its coefficients in the pivot rows vary between points
         self._legendre_divisors: list[sympy.Expr] | None = None  # the factors of the denominator of H_c (found on first use)
         #: divisor -> whether it is a branch (None: it does not vanish on the surface), decided once per chain
         self._judged: dict[tuple[sympy.Expr, int], bool | None] = {}
@@ -359,6 +363,7 @@ class ConstraintChain:
             points = self._stage_points()
             settled = False
         self.points = points
+        self._check_legendre_divisors(points)  # the final surface (the primary one may hold such points: 228)
         self.pivots = (pivots_rows, pivot_cols)
         if pivots_rows:
             self._check_consistent_rank(A_num, pivots_rows)
@@ -404,7 +409,6 @@ class ConstraintChain:
             constraints + reducible, SAMPLE_POINTS, regular=len(constraints), minors=self._minors(constraints, whole)
         )
         self._check_hessian_rank(points)
-        self._check_legendre_divisors(points)
         return points
 
     def _check_legendre_divisors(self, points: list[np.ndarray]) -> None:
@@ -427,10 +431,10 @@ class ConstraintChain:
         values = np.abs(self.numerics.evaluate(self._legendre_divisors, points))
         scales = self.numerics.term_scale(self._legendre_divisors, points)
         for k, f in enumerate(self._legendre_divisors):
-            hit = ~(values[:, k] > ROUND_OFF * scales[:, k])  # also NaN
+            hit = values[:, k] <= ROUND_OFF * scales[:, k]  # NaN (undefined) is left to the rank checks
             if np.any(hit):
                 raise AnalysisError(
-                    f"the constraint surface found at stage {len(self.stages)} has a part where the Legendre map divides "
+                    f"the constraint surface has a part where the Legendre map divides "
                     f"by zero ({f} = 0 at {int(np.sum(hit))} of {len(points)} sample points): the canonical Hamiltonian and "
                     f"the consistency conditions are singular there, so that part cannot be analysed with the rest; set it "
                     f"aside with --assume \"{f} != 0\" (in Python assume=[\"{f} != 0\"]) or analyse it as a system of its own"
@@ -926,6 +930,9 @@ class ConstraintChain:
         coeff = np.array([np.linalg.lstsq(A[np.ix_(P, Q)].T, A[row, Q], rcond=None)[0] for A in A_num])
         scale = 1 + np.max(np.abs(coeff), axis=1, keepdims=True)
         used = [k for k in range(len(P)) if not np.all(np.abs(coeff[:, k]) <= 1e-9 * scale[:, 0])]
+        # coefficients equal at every point are numbers: no division by a function to check (:meth:`_cleared`)
+        varying = [k for k in used if np.ptp(coeff[:, k]) > 1e-9 * (1 + np.max(np.abs(coeff[:, k])))]
+        self._varying[row] = bool(varying)
         return [k for k in used if not b_zero[P[k]]], used
 
     def _coefficients(self, row: int, used: list[int], constraints: list[sympy.Expr], P: list[int], Q: list[int], A_num: np.ndarray) -> list[sympy.Expr]:
@@ -935,6 +942,8 @@ class ConstraintChain:
         (:func:`weak_solve`); ``[]`` when every entry involved is a number (no division by a
         function) or no such block is found.
         """
+        if len(used) > MAX_CLEARED_BLOCK:
+            return []  # a symbolic solve of a larger block costs more than the stage (the rigid body (228): 2x)
         rows = [P[k] for k in used]
         entries = [[self._rows(constraints[p])[1][q] for q in Q] for p in rows]
         target = [self._rows(constraints[row])[1][q] for q in Q]
@@ -971,7 +980,7 @@ class ConstraintChain:
         branch ``y = 1/2``.
         """
         if coefficients is None:
-            coefficients = self._coefficients(row, used, constraints, P, Q, A_num) if used else []
+            coefficients = self._coefficients(row, used, constraints, P, Q, A_num) if used and self._varying.get(row) else []
         stage = len(self.stages) + 1
         branches = []
         for division in divisions_of(coefficients, stage, "the elimination of multipliers divides by zero", self.phase_space.variables):
@@ -1000,7 +1009,7 @@ class ConstraintChain:
         for b, A in zip(b_num, A_num):
             augmented = np.hstack([A, b[:, None]])
             scale = np.max(np.abs(augmented)) or 1.0
-            if numeric_rank(augmented / scale) != numeric_rank(A / scale):
+            if numeric_rank(augmented / scale, scale=1.0) != numeric_rank(A / scale, scale=1.0):  # one scale: round-off is no rank
                 return False
         return True
 

@@ -217,33 +217,6 @@ def unsolved_multipliers(
     )
 
 
-#: smallest singular value of the pivot block ``A_PQ`` (relative to its largest entry) at a sample point
-PIVOT_BLOCK_ZERO = 1e-9
-
-
-def _refuse_vanishing_pivot_block(blocks: Sequence[np.ndarray]) -> None:
-    """Refuse when ``A_PQ`` is singular at a sample point: the solution ``U = -A_PQ^{-1} b_P`` divides by zero there.
-
-    ``det A_PQ`` is the divisor of every entry of ``U`` and ``V_a``; a sample point where it
-    vanishes lies on a part of the surface where the multipliers are solved otherwise
-    (``p1 = 0``, ``2 p1^2 - p1 p2 + 4 q1^2 - q1 = 0`` is the union of ``q1 = 0`` and ``q1 = 1/4``,
-    and ``det A_PQ = 4 p1^2 - p1 p2 - 8 q1^2 + q1`` vanishes on the first).
-    """
-    for k, block in enumerate(blocks):
-        if not block.size:
-            continue
-        size = np.max(np.abs(block))
-        smallest = np.linalg.svd(block, compute_uv=False)[-1]
-        if size > 0 and smallest <= PIVOT_BLOCK_ZERO * size:
-            raise AnalysisError(
-                f"the multipliers' solution divides by zero at {k + 1} of the {len(blocks)} sample points of the constraint "
-                "surface (the block of {Phi_a, phi_k} it inverts is singular there, relative size "
-                f"{smallest / size:.1e}): the surface has a part on which the multipliers are fixed otherwise (a constraint "
-                "that factors once the others are put in, or a rank that changes); analyse each part as a system of its own "
-                "(--assume picks one)"
-            )
-
-
 def general_multiplier_solution(
     multipliers: tuple[sympy.Symbol, ...],
     primary: list[sympy.Expr],
@@ -295,7 +268,6 @@ def general_multiplier_solution(
         )
     A_num_Q = [A[:, Q] for A in A_num]
     weakly_solvable(A_num_Q, B_num)  # a system singular at a sample point is refused now, not on first use
-    _refuse_vanishing_pivot_block(A_num_Q)
 
     def solve() -> tuple[dict[str, sympy.Expr], list[dict[str, sympy.Expr]]]:
         """The exact ``U`` and ``V_a`` (run on first use)."""

@@ -103,25 +103,20 @@ def _never_zero(factor: sympy.Expr) -> bool:
 def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
     """The distinct irreducible factors of the denominator of ``expr`` that depend on the ``variables``.
 
-    ``expr`` is brought over one denominator (``sympy.together``) and the denominator
-    factored (``sympy.factor_list``; ``sin(theta)`` counts as a factor of
-    ``sin(theta)**2``). Factors without real zeros and numbers are left out; an
+    The bases of the negative powers in ``expr`` (its denominators) are factored
+    (``sympy.factor_list``; ``sin(theta)`` counts as a factor of ``sin(theta)**2``); a
+    factor that a numerator would cancel is kept (no gcd is taken). Factors without real zeros and numbers are left out; an
     expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``.
     """
     names = set(variables)
     if not prints_shorter(expr, DIVISOR_TEXT_LIMIT) or not (expr.free_symbols & names):  # size first: a shared tree is huge
         return []
-    if not any(isinstance(node, sympy.Pow) and node.exp.is_negative and node.base.free_symbols & names
-               for node in sympy.preorder_traversal(expr)):
-        return []  # no variable in a denominator (one walk, no gcd)
-    _, denominator = sympy.fraction(sympy.together(expr))
-    if not (denominator.free_symbols & names):
-        return []
+    bases = list(dict.fromkeys(
+        node.base for node in sympy.preorder_traversal(expr)
+        if isinstance(node, sympy.Pow) and node.exp.is_negative and node.base.free_symbols & names
+    ))  # every denominator of the tree, in one walk (no gcd: a factor the numerator cancels is kept)
     found: list[sympy.Expr] = []
-    for part in sympy.Mul.make_args(denominator):
-        base = part.base if isinstance(part, sympy.Pow) and part.exp.is_positive else part
-        if not (base.free_symbols & names):
-            continue
+    for base in bases:
         try:
             _, listed = sympy.factor_list(sympy.expand(base))
             found += [f for f, _ in listed]
