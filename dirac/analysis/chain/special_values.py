@@ -47,7 +47,7 @@ from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.errors import AnalysisError
 
-__all__ = ["SpecialValue", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
+__all__ = ["SpecialValue", "admissible", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
 
 #: blocks larger than this are not searched symbolically (their determinants are too large): they are scanned
 #: numerically at :data:`SCAN_VALUES` instead (:func:`_scan`)
@@ -61,6 +61,24 @@ SCAN_SECONDS = 1.0
 
 #: the values each parameter of a block is set to, one at a time, by the numeric scan
 SCAN_VALUES = tuple(sympy.Rational(v) for v in ("0", "1", "-1", "2", "-2", "1/2", "-1/2"))
+
+
+def admissible(parameter: sympy.Symbol, value: sympy.Expr) -> bool:
+    """Whether ``parameter = value`` is allowed by the assumptions the parameter was declared with.
+
+    A principal moment declared ``positive=True`` never takes the value 0, so a rank drop
+    there is no case of the system; the symbolic road already drops such values (``sympy.solve``
+    respects the assumptions), and the numeric scan asks this before evaluating a value.
+    """
+    checks = (
+        (parameter.is_positive, value.is_positive),
+        (parameter.is_negative, value.is_negative),
+        (parameter.is_nonnegative, value.is_nonnegative),
+        (parameter.is_nonpositive, value.is_nonpositive),
+        (parameter.is_nonzero, value.is_nonzero),
+        (parameter.is_integer, value.is_integer),
+    )
+    return not any(declared and holds is False for declared, holds in checks)
 
 
 
@@ -515,7 +533,7 @@ def _scan(
     scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time)
     for p in params:
         done = True
-        for value in SCAN_VALUES:
+        for value in (v for v in SCAN_VALUES if admissible(p, v)):
             try:
                 with scan.interrupting():
                     at = scanner.rank(p, float(value))
@@ -528,7 +546,8 @@ def _scan(
     shown = ", ".join(str(v) for v in SCAN_VALUES)
     note = (
         f"special parameter values: {why}; scanned numerically instead: "
-        + (f"{', '.join(scanned)} at {shown} (one at a time, the others generic)" if scanned else "nothing")
+        + (f"{', '.join(scanned)} at {shown} (one at a time, the others generic; values a parameter's declared "
+           "assumptions exclude, such as 0 for a positive one, left out)" if scanned else "nothing")
         + "; other values and curves of several parameters (such as b = a**2) were not searched"
     )
     if left_out:

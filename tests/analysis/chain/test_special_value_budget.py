@@ -95,3 +95,27 @@ def test_when_the_scan_runs_out_too_the_parameters_left_are_named(monkeypatch):
     assert a.special_parameter_values == []
     notes = _budget_notes(a)
     assert notes and all("scanned numerically instead: nothing" in n and "not scanned" in n and n.endswith(": M") for n in notes)
+
+
+def test_scan_leaves_out_values_the_declared_assumptions_exclude():
+    """A parameter declared ``positive=True`` never takes 0 or a negative value, so those are
+    no cases of the system: the symbolic road never offers them (``sympy.solve(I, I)`` is
+    empty for a positive ``I``), and the numeric scan must not either."""
+    positive = sympy.Symbol("I", positive=True)
+    plain = sympy.Symbol("a")
+    whole = sympy.Symbol("n", integer=True)
+    assert [v for v in special_values.SCAN_VALUES if special_values.admissible(positive, v)] == [
+        1, 2, sympy.Rational(1, 2)]
+    assert all(special_values.admissible(plain, v) for v in special_values.SCAN_VALUES)
+    assert not special_values.admissible(whole, sympy.Rational(1, 2))
+
+
+def test_rigid_body_matrix_has_no_special_values_among_positive_moments():
+    """Lagrangian (78) with principal moments ``I_1, I_2, I_3`` declared positive: its
+    blocks are larger than the symbolic search takes, so they are scanned. At ``I_k = 0`` a
+    rank drops (the body is degenerate), but a positive moment cannot be 0, and at the
+    positive scan values ``1, 2, 1/2`` (the others generic) the mass matrix ``g`` with
+    ``g_1 = (I_2 + I_3 - I_1)/2`` etc. stays invertible: no special value is reported."""
+    analysis = dirac.analyze(dirac.load_system("rigid_body_matrix"))
+    assert analysis.special_parameter_values == []
+    assert any("assumptions exclude" in note for note in analysis.notes)
