@@ -57,7 +57,7 @@ from dirac.analysis.classes.multiplier_solution import (
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.divisors import Division
 from dirac.analysis.core.divisors import divisions as divisions_of
-from dirac.analysis.core.linear_solve import weak_solve
+from dirac.analysis.core.linear_solve import SingularAtSamplePoint, weak_solve
 from dirac.analysis.core.numeric import (
     LARGE_ROWS,
     Numerics,
@@ -343,7 +343,16 @@ class ConstraintChain:
             candidates, chosen = self._settle(self._nonzero(direct, points), constraints, limit) if direct else ([], [])
             if not chosen and deferred:
                 # nothing new without them: build the conditions that need multipliers eliminated
-                eliminated = [self._eliminate(i, needed, constraints, pivots_rows, pivot_cols, A_num, b_zero) for i, needed in deferred]
+                try:
+                    eliminated = [self._eliminate(i, needed, constraints, pivots_rows, pivot_cols, A_num, b_zero) for i, needed in deferred]
+                except SingularAtSamplePoint as error:
+                    # the pivot block {Phi_P, phi_Q} is singular at some points only: a rank that
+                    # differs between parts of the surface, which the components road separates
+                    ranks = [int(np.linalg.matrix_rank(A[np.ix_(pivots_rows, pivot_cols)])) for A in A_num]
+                    raise SeparableParts(
+                        f"stage {len(self.stages) + 1}: {error}", points=list(points), ranks=ranks,
+                        variables=list(self.phase_space.variables),
+                    ) from None
                 candidates, chosen = self._settle(self._nonzero(eliminated, points), constraints, limit)
             elif deferred:
                 self.notes.append(

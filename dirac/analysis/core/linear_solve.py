@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import maximum_bipartite_matching
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.errors import AnalysisError
 
-__all__ = ["weak_solve", "weakly_solvable", "block_order"]
+__all__ = ["weak_solve", "weakly_solvable", "block_order", "SingularAtSamplePoint"]
 
 RELATIVE_ZERO = 1e-9
 
@@ -37,6 +37,15 @@ TIDY_LIMIT = 4000
 
 #: largest diagonal block solved by symbolic LU when a time limit is set
 MAX_EXACT_BLOCK = 6
+
+
+class SingularAtSamplePoint(AnalysisError):
+    """A system that is independent at some sample points of the surface is singular at another.
+
+    The surface then has parts of different structure; the caller, which knows the points,
+    turns this into :class:`~dirac.errors.SeparableParts` so that the parts can be analysed
+    one by one (:mod:`dirac.analysis.components`).
+    """
 
 
 class SolveTooLarge(AnalysisError):
@@ -131,7 +140,7 @@ def weakly_solvable(
     try:
         x_vals = np.array([np.linalg.solve(a, b) for a, b in zip(a_vals, b_vals)])
     except np.linalg.LinAlgError:
-        raise AnalysisError(
+        raise SingularAtSamplePoint(
             f"a {k}x{k} system the analysis solves on the constraint surface is singular at one of its sample "
             "points, though independent at others: the surface has parts of different structure (a constraint "
             "whose branches cross, or a rank that changes on it); write the constraints so that each part is a "
