@@ -44,7 +44,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics, numeric_rank
-from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.phase_space import PhaseSpace, free_symbols_of
 from dirac.errors import AnalysisError
 
 __all__ = ["SpecialValue", "admissible", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
@@ -426,7 +426,7 @@ def special_parameter_values(
     cut: list[RankUse] = []
     large: list[RankUse] = []
     for use in uses:
-        if use.rank == 0 or not (use.block.free_symbols & set(parameters)):
+        if use.rank == 0 or not (free_symbols_of(use.block) & set(parameters)):
             continue
         if use.block.shape[0] > MAX_BLOCK:
             large.append(use)  # too large for a symbolic determinant: the numeric road
@@ -527,7 +527,7 @@ def _scan(
     to each of :data:`SCAN_VALUES` (the other parameters at their generic values); a drop
     is recorded as a special value. Only these values are searched.
     """
-    params = sorted(use.block.free_symbols & set(space.parameters), key=lambda s: s.name)
+    params = sorted(free_symbols_of(use.block) & set(space.parameters), key=lambda s: s.name)
     scanned: list[str] = []
     left_out: list[str] = []
     scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time)
