@@ -415,16 +415,19 @@ class ConstraintAnalysis:
             if not involves(A[rows, cols]):
                 continue
             uses.append(RankUse(f"consistency matrix {{Phi_a, phi_k}} of stage {stage}", A[rows, cols], A, len(rows),
-                                on_surface=True, surface=chain.constraints[:n]))
+                                on_surface=True, surface=chain.constraints[:n], symbols=free_symbols_of(A[rows, cols], memo)))
         P, Q = chain.pivots
         if P:
             A = consistency(len(chain.constraints))
             if involves(A[P, Q]):
-                uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True))
+                uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True,
+                                    symbols=free_symbols_of(A[P, Q], memo)))
         if second and involves(C[second, second]):
-            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True))
+            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True,
+                                symbols=free_symbols_of(C[second, second], memo)))
         found, skipped = special_parameter_values(
-            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time
+            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time,
+            compiled=self._numerics,
         )
         return found, unsearched + skipped
 
