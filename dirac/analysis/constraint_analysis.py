@@ -33,6 +33,7 @@ from dirac.analysis.core.divisors import (
 )
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
 from dirac.analysis.legendre.regularity import regular_holonomic
@@ -390,7 +391,12 @@ class ConstraintAnalysis:
         def consistency(n: int) -> sympy.Matrix:
             return sympy.Matrix([[chain._rows(c)[1][k] for k in range(K)] for c in chain.constraints[:n]])
 
-        if self.hessian_rank and W.free_symbols & params:
+        memo: dict = {}  # free symbols of shared sub-trees, walked once (free_symbols_of)
+
+        def involves(M: sympy.Matrix) -> frozenset:
+            return free_symbols_of(M, memo) & params
+
+        if self.hessian_rank and involves(W):
             if W.free_symbols & set(self.lagrangian.velocities):
                 unsearched.append(
                     "special parameter values: not searched in the Hessian, which depends on the velocities "
@@ -406,19 +412,22 @@ class ConstraintAnalysis:
             if not rows:
                 continue
             A = consistency(n)
-            if not A[rows, cols].free_symbols & params:
+            if not involves(A[rows, cols]):
                 continue
             uses.append(RankUse(f"consistency matrix {{Phi_a, phi_k}} of stage {stage}", A[rows, cols], A, len(rows),
-                                on_surface=True, surface=chain.constraints[:n]))
+                                on_surface=True, surface=chain.constraints[:n], symbols=free_symbols_of(A[rows, cols], memo)))
         P, Q = chain.pivots
         if P:
             A = consistency(len(chain.constraints))
-            if A[P, Q].free_symbols & params:
-                uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True))
-        if second and C[second, second].free_symbols & params:
-            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True))
+            if involves(A[P, Q]):
+                uses.append(RankUse("consistency matrix {Phi_a, phi_k}", A[P, Q], A, len(P), on_surface=True,
+                                    symbols=free_symbols_of(A[P, Q], memo)))
+        if second and involves(C[second, second]):
+            uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True,
+                                symbols=free_symbols_of(C[second, second], memo)))
         found, skipped = special_parameter_values(
-            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time
+            space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time,
+            compiled=self._numerics,
         )
         return found, unsearched + skipped
 

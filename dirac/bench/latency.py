@@ -5,7 +5,8 @@ pendulums and double pendulums in angles and in Cartesian coordinates, a triple 
 tops in Euler angles, a bead on a turning hoop, a relativistic particle) is run in a
 fresh Python process with an empty cache of generated code (a temporary
 ``DIRAC_CACHE_DIR`` and ``NUMBA_CACHE_DIR``) and the default kernel policy, interpreter
-start included:
+start included (the engine's bytecode compiled beforehand, as an install does:
+:func:`compile_bytecode`):
 
 * **first**: ``t_end = 1`` with the default method (``rattle-2``, ``dt = 1e-3`` for the
   tops in Euler angles);
@@ -135,7 +136,8 @@ def _child(arguments: list[str], pythonpath: str | None, timeout: float) -> tupl
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         try:
-            done = subprocess.run([sys.executable, *arguments], capture_output=True, text=True, env=env, timeout=timeout)
+            done = subprocess.run([sys.executable, *arguments], capture_output=True, text=True, env=env, timeout=timeout,
+                                  cwd=scratch)
             out, err, code = done.stdout, done.stderr, done.returncode
         except subprocess.TimeoutExpired:
             out, err, code = "", f"timed out after {timeout:.0f} s", -1
@@ -147,6 +149,31 @@ def _child(arguments: list[str], pythonpath: str | None, timeout: float) -> tupl
         except (OSError, ValueError):
             compilations = []
     return wall, cpu, out, err, code, compilations
+
+
+_BYTECODE = r'''
+import compileall, importlib.util, os
+for name in ("dirac", "dirac_systems"):
+    spec = importlib.util.find_spec(name)
+    if spec is not None and spec.origin:
+        compileall.compile_dir(os.path.dirname(spec.origin), quiet=1, force=False)
+'''
+
+
+def compile_bytecode(pythonpath: str | None = None) -> None:
+    """Compile the bytecode of the engine the children import, as ``pip install`` does.
+
+    An installed package comes with its ``.pyc`` files; a source checkout gets them on its
+    first import, unless ``PYTHONDONTWRITEBYTECODE`` is set, in which case every fresh
+    process compiles the whole engine again (about 0.5 s) and no user meets that. Done in
+    a child with the children's ``sys.path`` (run from an empty folder, with ``pythonpath``
+    in front), so that the engine compiled is the engine timed.
+    """
+    env = dict(os.environ)
+    if pythonpath:
+        env["PYTHONPATH"] = pythonpath + os.pathsep + env.get("PYTHONPATH", "")
+    with tempfile.TemporaryDirectory(prefix="dirac-latency-") as scratch:
+        subprocess.run([sys.executable, "-c", _BYTECODE], capture_output=True, text=True, env=env, cwd=scratch, timeout=600)
 
 
 def _row(system: str, run: str, arguments: list[str], pythonpath: str | None, timeout: float, target: float | None,
@@ -190,6 +217,7 @@ def run_latency(models: Sequence[str] = CORPUS, *, first_t_end: float = 1.0, stu
     import importlib
 
     latency_models = importlib.import_module("dirac_systems.latency_models").MODELS
+    compile_bytecode(pythonpath)
     rows: list[LatencyRow] = []
     baselines_done: dict[str, LatencyRow] = {}
 
@@ -260,7 +288,8 @@ def format_latency(rows: list[LatencyRow]) -> str:
         lines += ["", "compile time against kernel size (each cold, measured by the run that compiled it):",
                   f"{'source chars':>12s} {'cpu s':>6s} {'us/char':>8s}  kernel"]
         lines += [f"{chars:12d} {seconds:6.2f} {1e6 * seconds / chars:8.1f}  {what}" for chars, seconds, what in compiled]
-    lines += ["", "Fresh process and empty cache per row, default kernel policy; wall is what a user waits (distorted "
+    lines += ["", "Fresh process and empty cache per row (the engine's bytecode compiled first, as an install does), default "
+              "kernel policy; wall is what a user waits (distorted "
               "by other load), cpu is the child's user + system time. Targets: first result <= "
               f"{FIRST_TARGET:g} s, 1e5-step study <= {STUDY_TARGET:g} s; a t_end run no slower than scipy (ratio <= 1)."]
     return "\n".join(lines)

@@ -44,7 +44,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics, numeric_rank
-from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.phase_space import PhaseSpace, free_symbols_of
 from dirac.errors import AnalysisError
 
 __all__ = ["SpecialValue", "admissible", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
@@ -181,6 +181,12 @@ class RankUse:
     on_surface: bool
     #: the constraints whose surface the rank was decided on, when not all of them (an earlier stage's surface)
     surface: Sequence[sympy.Expr] | None = None
+    #: the free symbols of ``block`` when the caller knows them (a walk of a large block's shared sub-trees is not free)
+    symbols: frozenset | None = None
+
+    def block_symbols(self) -> frozenset:
+        """The free symbols of ``block`` (:func:`~dirac.analysis.core.phase_space.free_symbols_of`)."""
+        return self.symbols if self.symbols is not None else free_symbols_of(self.block)
 
     def constraints(self, constraints_at: Callable[[dict], list[sympy.Expr]], substitution: dict) -> list[sympy.Expr]:
         """The constraints of this decision's surface with ``substitution`` (``[]`` off the surface)."""
@@ -368,6 +374,7 @@ def special_parameter_values(
     time: sympy.Symbol | None = None,
     budget: float | None = None,
     scan_budget: float | None = None,
+    compiled: Numerics | None = None,
 ) -> tuple[list[SpecialValue], list[str]]:
     """The special parameter values of the rank decisions ``uses``, checked numerically.
 
@@ -395,6 +402,10 @@ def special_parameter_values(
     budget, scan_budget
         CPU seconds of the symbolic search and of the numeric scan; default
         :data:`SEARCH_SECONDS` and :data:`SCAN_SECONDS`.
+    compiled
+        The analysis' :class:`~dirac.analysis.core.numeric.Numerics` (its parameters are
+        arguments of its compiled functions): the scan evaluates the same matrices and
+        constraints at other parameter values without compiling them again.
 
     Returns
     -------
@@ -426,7 +437,7 @@ def special_parameter_values(
     cut: list[RankUse] = []
     large: list[RankUse] = []
     for use in uses:
-        if use.rank == 0 or not (use.block.free_symbols & set(parameters)):
+        if use.rank == 0 or not (use.block_symbols() & set(parameters)):
             continue
         if use.block.shape[0] > MAX_BLOCK:
             large.append(use)  # too large for a symbolic determinant: the numeric road
@@ -464,11 +475,11 @@ def special_parameter_values(
         scan = CpuBudget(SCAN_SECONDS if scan_budget is None else scan_budget)
         for use in cut:
             why = f"the symbolic search in the {use.label} ran over its budget of {clock.seconds:g} s CPU and was not finished"
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record))
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled))
         for use in large:
             n = use.block.shape[0]
             why = f"the {use.label} was not searched symbolically (its {n}x{n} block is larger than {MAX_BLOCK}x{MAX_BLOCK})"
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record))
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled))
     return [replace(values[key], where="; ".join(w)) for key, w in found.items()], notes
 
 
@@ -482,11 +493,13 @@ class _Scanner:
     """
 
     def __init__(self, space: PhaseSpace, generic: dict[sympy.Symbol, float], use: RankUse,
-                 constraints: list[sympy.Expr], seed: int, time: sympy.Symbol | None) -> None:
+                 constraints: list[sympy.Expr], seed: int, time: sympy.Symbol | None,
+                 compiled: Numerics | None = None) -> None:
         self.space, self.generic, self.use, self.constraints = space, generic, use, constraints
         self.seed, self.time = seed, time
         self.entries = list(use.matrix)
-        self.numerics = Numerics(space, generic, seed=seed, time=time)
+        self.numerics = (Numerics(space, generic, seed=seed, time=time) if compiled is None
+                         else compiled.sharing_compiled(generic, seed))
 
     def rank(self, p: sympy.Symbol, value: float) -> int | None:
         """Rank with ``p = value`` (others generic); ``UNDEFINED`` where the entries are not finite; None: no surface point."""
@@ -520,6 +533,7 @@ def _scan(
     why: str,
     scan: CpuBudget,
     record: Callable[[RankUse, sympy.Symbol, sympy.Expr, int | None, sympy.Expr | None], None],
+    compiled: Numerics | None = None,
 ) -> str:
     """The numeric road of a block not searched symbolically (over the budget, or too large); returns the note.
 
@@ -527,10 +541,10 @@ def _scan(
     to each of :data:`SCAN_VALUES` (the other parameters at their generic values); a drop
     is recorded as a special value. Only these values are searched.
     """
-    params = sorted(use.block.free_symbols & set(space.parameters), key=lambda s: s.name)
+    params = sorted(use.block_symbols() & set(space.parameters), key=lambda s: s.name)
     scanned: list[str] = []
     left_out: list[str] = []
-    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time)
+    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time, compiled)
     for p in params:
         done = True
         for value in (v for v in SCAN_VALUES if admissible(p, v)):

@@ -34,7 +34,7 @@ import sympy
 from dirac.analysis.core.algebra import prints_shorter
 from dirac.errors import AnalysisError
 
-__all__ = ["Division", "SingularLocus", "denominator_factors", "singular_loci", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR"]
+__all__ = ["Division", "SingularLocus", "denominator_factors", "singular_loci", "constant_on_surface", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR"]
 
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
 DIVISOR_TEXT_LIMIT = 4000
@@ -170,6 +170,47 @@ def locus_equation(divisor: sympy.Expr, fixed: dict[sympy.Symbol, sympy.Expr]) -
     return f"{reduced} = 0"
 
 
+def constant_on_surface(divisor: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> sympy.Expr | None:
+    """The value ``c`` when ``divisor = c + sum_i a_i phi_i`` exactly, with numbers or parameters ``a_i``, ``c``; else None.
+
+    Then ``divisor = c`` on the whole surface ``phi_i = 0``: a certificate, not a
+    sample. The rotation-matrix Lagrangian (78) divides by ``R_11^2 + R_21^2 + R_31^2``
+    and by combinations of the squared column norms, ``1`` and ``2 I_3`` on ``R^T R = 1``:
+    each is decided here by a linear system in the coefficients of the monomials,
+    instead of a search for a point where it vanishes. Only the polynomial constraints
+    in the divisor's variables are used; ``None`` says nothing (the search decides).
+    """
+    own = sorted(divisor.free_symbols & set(variables), key=lambda s: s.name)
+    if not own:
+        return None
+    used = [c for c in surface if c.free_symbols & set(variables) and c.free_symbols & set(variables) <= set(own)]
+    if not used:
+        return None
+    try:
+        polys = [sympy.Poly(e, *own) for e in (divisor, *used)]
+    except (sympy.PolynomialError, sympy.GeneratorsError):
+        return None
+    if any(not p.domain.is_Field and not p.domain.is_Ring for p in polys):
+        return None
+    a = sympy.symbols(f"a_0:{len(used)}", cls=sympy.Dummy)
+    c = sympy.Dummy("c")
+    rest = polys[0] - sum((ak * p for ak, p in zip(a, polys[1:])), sympy.Poly(0, *own)) - c
+    equations = rest.coeffs()
+    if len(equations) > CONSTANT_TEST_EQUATIONS:
+        return None
+    solution = sympy.linsolve(equations, [c, *a])
+    if not solution:
+        return None
+    value = next(iter(solution))[0]
+    if value.free_symbols & set(a):  # c not fixed by the identity
+        return None
+    return sympy.simplify(value)
+
+
+#: largest number of monomial equations :func:`constant_on_surface` solves (above it, the search decides)
+CONSTANT_TEST_EQUATIONS = 200
+
+
 def singular_loci(
     found: Sequence[Division],
     surface: Sequence[sympy.Expr],
@@ -189,6 +230,9 @@ def singular_loci(
         seen.setdefault(d.divisor, d)
     out = []
     for d in seen.values():
+        value = constant_on_surface(d.divisor, surface, variables)
+        if value is not None and value != 0:
+            continue  # a constant on the whole surface (nonzero at generic parameter values, as the search samples): no locus
         try:
             numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:

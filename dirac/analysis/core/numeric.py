@@ -227,6 +227,19 @@ class Numerics:
         #: what the analysis should tell the user about its sample points (points kept next to a rank-drop locus)
         self.notes: list[str] = []
 
+    def sharing_compiled(self, parameter_values: Mapping[sympy.Symbol, float], seed: int) -> Numerics:
+        """A new instance at other parameter values that shares this one's compiled functions.
+
+        The parameters are arguments of the compiled functions, so the expressions this
+        instance compiled are not compiled again (the special-value scan evaluates the
+        analysis' own matrices at other parameter values). Everything else starts as in a
+        new instance: the random points from ``seed``, no expressions to avoid, no held
+        variables, no notes.
+        """
+        other = Numerics(self.phase_space, parameter_values, seed=seed, time=self.time)
+        other._index, other._batches = self._index, self._batches
+        return other
+
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
         """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""

@@ -48,8 +48,8 @@ from typing import Any
 import numpy as np
 import sympy
 
-from dirac.analysis.core.algebra import tidy
-from dirac.analysis.core.linear_solve import weak_solve
+from dirac.analysis.core.algebra import prints_shorter, tidy
+from dirac.analysis.core.linear_solve import TIDY_LIMIT, weak_solve
 from dirac.analysis.core.numeric import independent_rows
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
@@ -407,7 +407,8 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
             if coefficients is not None:
                 c = coefficients[len(gammas) : 2 * len(gammas)]
                 following += sum((ca * ga for ca, ga in zip(c, gammas) if ca != 0), sympy.S.Zero)  # zeros skipped: O(chain) not O(gammas)
-            chain.append(tidy(following, space.variables))
+            # a long one is expanded without rational normal forms (their gcds cost seconds per term)
+            chain.append(tidy(following, space.variables, rational=prints_shorter(following, TIDY_LIMIT)))
         if not closed:
             structure.unclosed.append(gamma)
             continue
