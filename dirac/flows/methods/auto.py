@@ -25,10 +25,14 @@
 * Forced systems: ``forced-rattle-2/4`` (and ``conformal-2/4`` for linear damping of a
   constant-mass system) by the same Richardson estimate, costed by the evaluations per
   step of a short pilot.
-* General and analysed systems: each candidate of order ``p`` (``rattle-2/4``, resp.
-  ``midpoint``) is run over a pilot span with steps ``h`` and ``h/2``; Richardson's
-  estimate with linear growth in time gives the step for ``tolerance``; the cheaper
-  candidate wins.
+* General and analysed systems: each candidate of order ``p`` (``rattle-2/4/6/8``, resp.
+  ``midpoint``) is run over a short pilot span with steps ``h`` and ``h/2``; Richardson's
+  estimate with linear growth in time gives the step for ``tolerance / 2`` at ``t_end``,
+  and the pilots are repeated at that step until it agrees with ``h`` within a factor 2
+  (:func:`_accurate_step`: an estimate made far from the asymptotic regime is not
+  trusted). The cost is steps times stages (all candidates share one kernel), with at
+  least one step per output sample; the cheapest candidate wins, and a candidate that
+  cannot beat the best even at one step per sample is not piloted at all.
 
 The estimates are a-priori models, recorded in the result's ``meta["auto"]``.
 """
@@ -61,6 +65,12 @@ LOOP_SAMPLE_US = 15.0
 #: (``dirac bench``'s heavy-top per-step figures, 0.59 and 1.45 us per 3-stage step).
 SPLIT_STAGE_US = 0.2
 EXACT_KICK_STAGE_US = 0.48
+#: General and analysed systems: the candidates (RATTLE and its compositions up to order 8,
+#: each costed by its base steps, which share one kernel), and the pilots that judge them.
+GENERAL_CANDIDATES = ("rattle-2", "rattle-4", "rattle-6", "rattle-8")
+ANALYSED_CANDIDATES = ("midpoint",)
+PILOT_STEPS = 16
+PILOT_ROUNDS = 4
 HEAVY_TOP_CANDIDATES = ("lie-poisson-4", "lie-poisson-6", "lie-poisson-8", "exact-kick-4", "exact-kick-6", "exact-kick-8")
 
 
@@ -104,8 +114,8 @@ def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) 
 
 
 def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float,
-                  options) -> tuple[float, np.ndarray]:
-    """``dt0`` halved until a pilot of 64 steps runs without a failed step: that step and
+                  options, steps: int = 64) -> tuple[float, np.ndarray]:
+    """``dt0`` halved until a pilot of ``steps`` steps runs without a failed step: that step and
     the pilot's final state (the coarse run of the Richardson estimate).
 
     A first guess such as ``t_end / 1000`` can be far beyond the system's own time scale
@@ -114,7 +124,7 @@ def _working_step(method_name: str, problem, outputs, dt0: float, t_end: float,
     dt = dt0
     for _ in range(60):
         try:
-            span = min(t_end, 64 * dt)
+            span = min(t_end, steps * dt)
             return dt, _pilot(method_name, problem, outputs, span, dt, options)
         except StepFailure:
             dt /= 2
@@ -134,39 +144,77 @@ def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: 
         return _heavy_top(problem, t_end, tolerance, dt, outputs, options)
     if kind == "rigid_body":
         return _rigid_body(problem, t_end, samples, tolerance, outputs, options)
-    candidates: tuple[str, ...]
     if kind == "heavy_top":
         return _heavy_top(problem, t_end, tolerance, dt, outputs, options)
-    if kind == "analysed":
-        candidates = ("midpoint",)
-        dt0 = dt if dt is not None else t_end / 1000.0
-    elif kind == "forced":
+    if kind == "forced":
         return _forced(problem, t_end, tolerance, dt, outputs, options)
-    else:
-        candidates = ("rattle-2", "rattle-4")
-        dt0 = dt if dt is not None else t_end / 1000.0
+    candidates = ANALYSED_CANDIDATES if kind == "analysed" else GENERAL_CANDIDATES
+    dt_start = dt if dt is not None else t_end / 1000.0
+    spacing = t_end / (samples - 1) if samples > 1 else t_end  # the loop's step divides the sample spacing
     best: AutoChoice | None = None
     best_cost = math.inf
-    for name in candidates:
+    for name in candidates:  # in order of increasing order and stages
         method = get_method(name)
-        dt0, coarse = _working_step(name, problem, outputs, dt0, t_end, options)
-        span = min(t_end, 64 * dt0)
-        fine = _pilot(name, problem, outputs, span, dt0 / 2, options)
-        error = float(np.max(np.abs(coarse - fine))) / (1.0 - 2.0 ** (-method.order))
-        growth = t_end / span
-        if error * growth > 0:
-            factor = (tolerance / (error * growth)) ** (1.0 / method.order)
-        else:
-            factor = 8.0
-        step = dt0 * min(8.0, 0.5 * factor)
-        cost = (t_end / step) * _stages(method)
+        stages = _stages(method)
+        if best is not None and math.ceil(t_end / spacing * (1.0 - 1e-12)) * stages >= best_cost:
+            continue  # even one step per sample costs more than the best so far: no pilot needed
+        step, predicted = _accurate_step(name, problem, outputs, dt_start, t_end, tolerance, options)
+        used = spacing / math.ceil(spacing / step * (1.0 - 1e-12))
+        steps = math.ceil(t_end / used * (1.0 - 1e-12))
+        cost = steps * stages
+        dt_start = max(dt_start, step)  # a higher order takes larger steps: its pilots start there
         if cost < best_cost:
             best_cost = cost
-            predicted = error * growth * (step / dt0) ** method.order
-            best = AutoChoice(name, step, f"pilot Richardson estimate: {name} with dt = {step:.3g} is the cheapest "
-                              f"candidate for tolerance {tolerance:g}", predicted)
+            best = AutoChoice(name, used, f"pilot Richardson estimate: {name} with dt = {used:.3g} ({steps} steps of "
+                              f"{stages} stages) is the cheapest candidate for tolerance {tolerance:g}",
+                              predicted * (used / step) ** method.order)
     assert best is not None
     return best
+
+
+def _accurate_step(name: str, problem, outputs, dt_start: float, t_end: float, tolerance: float,
+                   options) -> tuple[float, float]:
+    """Step of ``name`` whose error at ``t_end`` is ``tolerance / 2`` by Richardson's estimate, and
+    that estimate.
+
+    A pilot of :data:`PILOT_STEPS` steps ``h`` and one of ``2 PILOT_STEPS`` steps ``h / 2`` over
+    the same span ``S`` differ by ``e(h) (1 - 2^-p)``, where ``e(h) = C S h^p`` is the error of
+    the coarse one (order ``p``; Hairer, Norsett & Wanner I, Sect. II.4). Linear growth in time
+    (the phase error of a symplectic method on a regular orbit) gives the error at ``t_end``:
+    ``E(h) = e(h) t_end / S``, and ``E(h*) = tolerance / 2`` gives ``h* = h (tolerance / (2
+    E(h)))^(1/p)``. The estimate holds only in the asymptotic regime, where ``e`` scales as
+    ``h^p``: far above it (a first guess beyond the system's time scale) it is pessimistic, far
+    below it round-off hides the error. So while ``h*`` differs from ``h`` by more than a factor
+    ``2`` the pilots are repeated at ``h*`` (clipped to ``[h / 16, 8 h]``), at most
+    :data:`PILOT_ROUNDS` times; the step of the last round is at most ``2 h``.
+    """
+    method = get_method(name)
+    order = method.order
+    dt0, coarse = _working_step(name, problem, outputs, dt_start, t_end, options, PILOT_STEPS)
+    step, predicted = dt0, math.inf
+    for attempt in range(PILOT_ROUNDS):
+        span = min(t_end, PILOT_STEPS * dt0)
+        fine = _pilot(name, problem, outputs, span, dt0 / 2, options)
+        error = float(np.max(np.abs(coarse - fine))) / (1.0 - 2.0 ** (-order))
+        at_end = error * t_end / span
+        if not math.isfinite(at_end):
+            factor = 0.5
+        elif at_end > 0:
+            factor = (0.5 * tolerance / at_end) ** (1.0 / order)
+        else:
+            factor = 8.0
+        last = attempt == PILOT_ROUNDS - 1
+        step = dt0 * min(2.0 if last else 8.0, max(1.0 / 16.0, factor))
+        predicted = at_end * (step / dt0) ** order
+        if 0.5 <= factor <= 2.0 or last or step >= t_end:
+            break
+        try:
+            coarse = _pilot(name, problem, outputs, min(t_end, PILOT_STEPS * step), step, options)
+        except StepFailure:  # beyond the step the method can take: judge it at the last working step
+            step = dt0 * min(factor, 1.0)
+            break
+        dt0 = step
+    return min(step, t_end), predicted
 
 
 def _rigid_body(problem, t_end: float, samples: int, tolerance: float, outputs, options) -> AutoChoice:
