@@ -48,7 +48,7 @@ from dirac.errors import InputError
 from dirac.flows.methods.base import Method, StepFailure
 from dirac.flows.methods.registry import get_method
 from dirac.flows.methods.rigid_body_stepper import exact_flow, needs_attitude
-from dirac.rigidbody.splitting import CompositionScheme
+from dirac.rigidbody.schemes import CompositionScheme
 
 __all__ = ["AutoChoice", "choose_method"]
 
