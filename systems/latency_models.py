@@ -17,6 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from dirac.model.lagrangian import Lagrangian
 
 __all__ = ["LatencyModel", "MODELS"]
@@ -41,6 +43,9 @@ class LatencyModel:
     baseline : str or None
         The name of the hand-written scipy right-hand side of the same motion
         (:mod:`dirac.bench.latency`), for pendulum-like systems; else None.
+    angles : callable or None
+        ``q`` at the output samples (samples, n) -> the baseline's angles (samples, k), so
+        that both runs are compared with one reference; None without a baseline.
     """
 
     system: Lagrangian
@@ -51,16 +56,30 @@ class LatencyModel:
     conserved: str = "energy"
     baseline: str | None = None
     notes: dict[str, str] = field(default_factory=dict)
+    angles: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 _PENDULUM = {"m": 1.0, "g": 9.81, "l": 1.0}
+
+
+def _same(q: np.ndarray) -> np.ndarray:
+    """The coordinates are the angles."""
+    return q
+
+
+def _rod_angles(q: np.ndarray) -> np.ndarray:
+    """Angles from the downward vertical of the rods of a chain of bobs ``(x1, y1, x2, y2, ...)``
+    hanging from the origin: ``atan2(dx, -dy)`` of each rod (unwrapped along the samples)."""
+    bobs = np.concatenate([np.zeros((q.shape[0], 2)), q], axis=1).reshape(q.shape[0], -1, 2)
+    rods = np.diff(bobs, axis=1)
+    return np.unwrap(np.arctan2(rods[..., 0], -rods[..., 1]), axis=0)
 _DOUBLE = {"m1": 1.0, "m2": 1.0, "g": 9.81, "l1": 1.0, "l2": 1.0}
 
 
 def pendulum_angle() -> LatencyModel:
     """Planar pendulum in its angle: ``L = m l^2/2 th_dot^2 + m g l cos th``."""
     system = Lagrangian.from_strings("pendulum_angle", ["th"], "m*l**2/2*th_dot**2 + m*g*l*cos(th)", parameters=_PENDULUM)
-    return LatencyModel(system, [1.0, 0.0], baseline="pendulum")
+    return LatencyModel(system, [1.0, 0.0], baseline="pendulum", angles=_same)
 
 
 def double_pendulum_angles() -> LatencyModel:
@@ -71,7 +90,7 @@ def double_pendulum_angles() -> LatencyModel:
         "double_pendulum_angles", ["a", "b"],
         "(m1+m2)/2*l1**2*a_dot**2 + m2/2*l2**2*b_dot**2 + m2*l1*l2*a_dot*b_dot*cos(a-b)"
         " + (m1+m2)*g*l1*cos(a) + m2*g*l2*cos(b)", parameters=_DOUBLE)
-    return LatencyModel(system, [1.0, 0.5, 0.0, 0.0], baseline="double_pendulum")
+    return LatencyModel(system, [1.0, 0.5, 0.0, 0.0], baseline="double_pendulum", angles=_same)
 
 
 def triple_pendulum_angles() -> LatencyModel:
@@ -88,7 +107,8 @@ def pendulum_cartesian() -> LatencyModel:
     """The planar pendulum in Cartesian coordinates with its rod ``x^2 + y^2 = l^2``."""
     system = Lagrangian.from_strings("pendulum_cartesian", ["x", "y"], "m/2*(x_dot**2 + y_dot**2) - m*g*y",
                                      constraints=["x**2 + y**2 - l**2"], parameters=_PENDULUM)
-    return LatencyModel(system, [0.8414709848078965, -0.5403023058681398, 0.0, 0.0], baseline="pendulum")
+    return LatencyModel(system, [0.8414709848078965, -0.5403023058681398, 0.0, 0.0], baseline="pendulum",
+                        angles=_rod_angles)
 
 
 def double_pendulum_cartesian() -> LatencyModel:
@@ -98,7 +118,8 @@ def double_pendulum_cartesian() -> LatencyModel:
         "m1/2*(x1_dot**2 + y1_dot**2) + m2/2*(x2_dot**2 + y2_dot**2) - g*(m1*y1 + m2*y2)",
         constraints=["x1**2 + y1**2 - l1**2", "(x2 - x1)**2 + (y2 - y1)**2 - l2**2"], parameters=_DOUBLE)
     s1, c1, s2, c2 = 0.8414709848078965, 0.5403023058681398, 0.479425538604203, 0.8775825618903728
-    return LatencyModel(system, [s1, -c1, s1 + s2, -c1 - c2, 0.0, 0.0, 0.0, 0.0], baseline="double_pendulum")
+    return LatencyModel(system, [s1, -c1, s1 + s2, -c1 - c2, 0.0, 0.0, 0.0, 0.0], baseline="double_pendulum",
+                        angles=_rod_angles)
 
 
 def symmetric_top_euler() -> LatencyModel:

@@ -22,7 +22,7 @@ import math
 import sys
 import time
 from collections.abc import Sequence
-from typing import Required, TypedDict
+from typing import Any, Required, TypedDict
 
 import numpy as np
 
@@ -230,7 +230,7 @@ def integrate(
         from dirac.errors import warn
 
         warn(f"impulses at t = {', '.join(f'{t:g}' for t in late)} come after t_end = {t_end:g}: they are not applied")
-    extra: dict[str, object] = {}
+    extra: dict[str, Any] = {}
     if (isinstance(method, str) and method == "auto"):
         from dirac.flows.methods.auto import choose_method
 
@@ -238,6 +238,10 @@ def integrate(
                                outputs=chosen_outputs)
         method_object, dt = get_method(choice.method), choice.dt
         extra["auto"] = {"chosen": choice.method, "reason": choice.reason, "estimated_error": choice.estimated_error}
+        if choice.newton_tolerance is not None and choice.newton_tolerance < newton_tolerance:
+            # the Newton floor must lie below the error auto promises (auto.newton_tolerance_for)
+            newton_tolerance = choice.newton_tolerance
+            extra["auto"]["newton_tolerance"] = newton_tolerance
     else:
         method_object = get_method(method)
     if not method_object.accepts(kind):

@@ -41,9 +41,7 @@ from dirac.compositions import COMPOSITIONS, MAIN_SUFFIXES
 from dirac.flows.methods.base import Method, Stepper, StepperFactory
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
 from dirac.flows.methods.torqued import TorquedStepper
-from dirac.rigidbody.exact_step import FreeFlowWork, exact_kick_advance
-from dirac.rigidbody.heavy_top import heavy_top_advance
-from dirac.rigidbody.splitting import CompositionScheme, build_sequence
+from dirac.rigidbody.schemes import CompositionScheme, build_sequence
 
 __all__ = ["HeavyTopSplittingStepper", "ExactKickStepper", "METHODS", "LIE_POISSON_FACTORIES"]
 
@@ -53,6 +51,9 @@ class HeavyTopSplittingStepper(RigidBodyStepper):
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:
         super().__init__(problem, outputs)
+        from dirac.rigidbody.heavy_top import heavy_top_advance  # numba: imported when a top runs
+
+        self._kernel = heavy_top_advance
         scheme = cast(CompositionScheme, method.data)
         self.gammas = np.asarray(scheme.coefficients, dtype=float)
         self.sequence = build_sequence(self.inv_inertia, (1.0,), scheme.splitting)
@@ -60,11 +61,11 @@ class HeavyTopSplittingStepper(RigidBodyStepper):
         self._stages = len(self.gammas) * (len(self.sequence[0]) + 1)
 
     def warm_up(self) -> None:
-        heavy_top_advance(self.M[0].copy(), self.R[0].copy(), self.w, self.gammas, *self.sequence, 1e-3, 1)
+        self._kernel(self.M[0].copy(), self.R[0].copy(), self.w, self.gammas, *self.sequence, 1e-3, 1)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):
-            heavy_top_advance(self.M[b], self.R[b], self.w, self.gammas, *self.sequence, dt, n_steps)
+            self._kernel(self.M[b], self.R[b], self.w, self.gammas, *self.sequence, dt, n_steps)
         self.steps += n_steps
         self.evaluations += n_steps * self._stages * self.M.shape[0]
 
@@ -76,15 +77,18 @@ class ExactKickStepper(RigidBodyStepper):
         super().__init__(problem, outputs)
         self.gammas = np.asarray(cast(tuple[float, ...], method.data), dtype=float)
         self.w = np.asarray(problem.weight_vector, dtype=float)
+        from dirac.rigidbody.exact_step import FreeFlowWork, exact_kick_advance  # numba: when a top runs
+
+        self._kernel = exact_kick_advance
         self.work = FreeFlowWork()
 
     def warm_up(self) -> None:
-        exact_kick_advance(self.M[0].copy(), self.R[0].copy(), self.inv_inertia, self.w, self.gammas, 1e-3, 1,
+        self._kernel(self.M[0].copy(), self.R[0].copy(), self.inv_inertia, self.w, self.gammas, 1e-3, 1,
                            *self.work.arrays())
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):
-            exact_kick_advance(self.M[b], self.R[b], self.inv_inertia, self.w, self.gammas, dt, n_steps,
+            self._kernel(self.M[b], self.R[b], self.inv_inertia, self.w, self.gammas, dt, n_steps,
                                *self.work.arrays())
         self.steps += n_steps
         self.evaluations += n_steps * 3 * len(self.gammas) * self.M.shape[0]

@@ -19,8 +19,7 @@ from typing import cast
 from dirac.flows.methods.base import Method, Stepper
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
 from dirac.flows.methods.torqued import TorquedStepper
-from dirac.rigidbody import splitting
-from dirac.rigidbody.batch import advance_batch
+from dirac.rigidbody import schemes
 
 __all__ = ["LiePoissonStepper", "METHODS", "BATCH_THRESHOLD"]
 
@@ -33,8 +32,10 @@ class LiePoissonStepper(RigidBodyStepper):
 
     def __init__(self, method: Method, problem, outputs: tuple[str, ...]) -> None:
         super().__init__(problem, outputs)
-        scheme = cast(splitting.CompositionScheme, method.data)
-        self._axes, self._rates, self._fractions, self._casimir_rate = splitting.build_sequence(
+        from dirac.rigidbody import splitting  # numba kernels: imported when a body runs
+
+        scheme = cast(schemes.CompositionScheme, method.data)
+        self._axes, self._rates, self._fractions, self._casimir_rate = schemes.build_sequence(
             self.inv_inertia, scheme.coefficients, scheme.splitting
         )
         self._kernel = splitting.advance_sequence
@@ -49,11 +50,15 @@ class LiePoissonStepper(RigidBodyStepper):
         R = self.R[0].copy()
         self._kernel(M, R, self._axes, self._rates, self._fractions, self._casimir_rate, 1e-3, 1, self.with_R)
         if self._batched:
+            from dirac.rigidbody.batch import advance_batch
+
             advance_batch(self.M[:2].copy(), self.R[:2].copy(), self.inv_inertia, 1e-3, 1, self._coefficients,
                           with_R=self.with_R)
 
     def step(self, n_steps: int, dt: float) -> None:
         if self._batched:
+            from dirac.rigidbody.batch import advance_batch
+
             advance_batch(self.M, self.R, self.inv_inertia, dt, n_steps, self._coefficients, with_R=self.with_R)
         else:
             for b in range(self.M.shape[0]):
@@ -67,12 +72,12 @@ class LiePoissonStepper(RigidBodyStepper):
 
 def _factory(method: Method, problem, outputs, options) -> Stepper:
     if problem.driven:  # torques or impulses: kicks composed with the Strang step
-        scheme = cast(splitting.CompositionScheme, method.data)
+        scheme = cast(schemes.CompositionScheme, method.data)
         return TorquedStepper(problem, outputs, tuple(scheme.coefficients), scheme.splitting, options)
     return LiePoissonStepper(method, problem, outputs)
 
 
-def _method(scheme: splitting.CompositionScheme) -> Method:
+def _method(scheme: schemes.CompositionScheme) -> Method:
     split = "3-term axes split" if scheme.splitting == "axes" else "symmetric-top split (Fasso 2003)"
     return Method(
         name=scheme.name,
@@ -89,4 +94,4 @@ def _method(scheme: splitting.CompositionScheme) -> Method:
 
 #: One method per composition scheme and splitting, free rigid body only; the registry
 #: adds the heavy top (:mod:`dirac.flows.methods.heavy_top`).
-METHODS: tuple[Method, ...] = tuple(_method(scheme) for scheme in splitting.SCHEMES.values())
+METHODS: tuple[Method, ...] = tuple(_method(scheme) for scheme in schemes.SCHEMES.values())

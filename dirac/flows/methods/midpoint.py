@@ -35,7 +35,6 @@ from dirac.flows.methods.constrained_stepper import (
     tiered,
 )
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper
-from dirac.rigidbody.midpoint import midpoint_rigid_body
 
 __all__ = ["RigidBodyMidpointStepper", "ConstrainedMidpointStepper", "AnalysedMidpointStepper", "METHODS"]
 
@@ -53,14 +52,17 @@ class RigidBodyMidpointStepper(RigidBodyStepper):
     def __init__(self, problem, outputs: tuple[str, ...], options: dict) -> None:
         super().__init__(problem, outputs)
         self.tol, self.max_iter, self.info = newton_options(options)
+        from dirac.rigidbody.midpoint import midpoint_rigid_body  # numba: imported when a body runs
+
+        self._kernel = midpoint_rigid_body
 
     def warm_up(self) -> None:
-        midpoint_rigid_body(self.M[0].copy(), self.R[0].copy(), self.inv_inertia, 1e-3, 1, self.with_R,
+        self._kernel(self.M[0].copy(), self.R[0].copy(), self.inv_inertia, 1e-3, 1, self.with_R,
                             self.tol, self.max_iter, self.info)
 
     def step(self, n_steps: int, dt: float) -> None:
         for b in range(self.M.shape[0]):
-            midpoint_rigid_body(self.M[b], self.R[b], self.inv_inertia, dt, n_steps, self.with_R,
+            self._kernel(self.M[b], self.R[b], self.inv_inertia, dt, n_steps, self.with_R,
                                 self.tol, self.max_iter, self.info)
             self.evaluations += int(self.info[2])
             _raise_if_failed(self.info, self.max_iter)

@@ -8,20 +8,24 @@ exact flow; the outputs are those of :class:`dirac.flows.problems.RigidBodyProbl
 from __future__ import annotations
 
 import warnings
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from dirac.errors import DiracWarning
 from dirac.flows.methods.base import Stepper
 from dirac.flows.problems import HeavyTopProblem, RigidBodyProblem
-from dirac.rigidbody.exact import ExactRigidBodyFlow
+
+if TYPE_CHECKING:
+    from dirac.rigidbody.exact import ExactRigidBodyFlow
 
 __all__ = ["RigidBodyStepper", "exact_flow", "gravity_weight", "needs_attitude", "rigid_body_outputs"]
 
 
 def exact_flow(inertia: np.ndarray, M0: np.ndarray, R0: np.ndarray | None) -> ExactRigidBodyFlow:
     """:class:`ExactRigidBodyFlow` of already validated data (its warnings were shown once)."""
+    from dirac.rigidbody.exact import ExactRigidBodyFlow  # numba: only when a rigid body runs
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DiracWarning)
         return ExactRigidBodyFlow(inertia, M0, R0)

@@ -24,8 +24,7 @@ import numpy as np
 from dirac.errors import InputError
 from dirac.flows.methods.base import StepFailure
 from dirac.flows.methods.rigid_body_stepper import RigidBodyStepper, rigid_body_outputs
-from dirac.rigidbody.exact_step import FreeFlowWork
-from dirac.rigidbody.splitting import build_sequence
+from dirac.rigidbody.schemes import build_sequence
 
 if TYPE_CHECKING:
     from dirac.flows.torques import Torque
@@ -86,6 +85,8 @@ class TorquedStepper(RigidBodyStepper):
         self.impulses = tuple(problem.impulses)
         self._next = 0
         if free == "exact":
+            from dirac.rigidbody.exact_step import FreeFlowWork  # numba: imported when a body runs
+
             self._scratch = FreeFlowWork()
         else:
             self._sequence = build_sequence(self.inv_inertia, (1.0,), free)
@@ -141,7 +142,7 @@ class TorquedStepper(RigidBodyStepper):
         cell = np.zeros(1)
         if self.free == "exact":
             k.exact_advance(M, R, self.inv_inertia, self.w, self.gammas, 0.0, 1e-3, 1, cell,
-                            *FreeFlowWork().arrays(), self.newton_tolerance, self.max_iterations)
+                            *type(self._scratch)().arrays(), self.newton_tolerance, self.max_iterations)
         else:
             k.split_advance(M, R, self.inv_inertia, self.w, self.gammas, *self._sequence, self.with_R, 0.0, 1e-3,
                             1, cell, self.newton_tolerance, self.max_iterations)
