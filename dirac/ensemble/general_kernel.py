@@ -167,6 +167,14 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
     return CompiledEnsemble(mechanics, module, fractions, gamma, layout, parameter_exprs, scene.source.names)
 
 
+#: The statements after a step loop's ``for step`` loop that the member loop may drop: the
+#: closing ``report`` call, or its body where :mod:`dirac.codegen.flatten` inlined it.
+_REPORT_TAILS = (
+    ["report(info, n_steps, False, evals, residual)"],
+    ["info[0] = n_steps", "info[1] = 1.0 if False else 0.0", "info[2] = evals", "info[3] = residual"],
+)
+
+
 def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[str]] | None:
     """The step loop ``kernel`` of the system's module cut into the three parts the member
     loop pastes in: its work-array allocations and the statements before its loop over steps
@@ -178,7 +186,10 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
 
     A one-step call of a loop that allocates two dozen small arrays spends most of its time
     allocating (the angles' RATTLE: 3.5 x the per-step cost of a long run), and passing
-    them in costs a reference count per array and step."""
+    them in costs a reference count per array and step. Since the system's module inlines its
+    helpers at the source level (:mod:`dirac.codegen.flatten`), the closing ``report`` may be
+    its inlined body: both forms are recognised, else the general RATTLE's member loop fell
+    back to the one-step call and cost 3 x a single run per step."""
     start = source.find(f"def {kernel}(")
     if start < 0:
         return None
@@ -193,7 +204,7 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
     head, rest = lines[:at], lines[at + 1:]
     split = next((k for k, line in enumerate(rest) if line.strip() and not line.startswith("        ")), len(rest))
     body, tail = rest[:split], rest[split:]
-    if [line.strip() for line in tail if line.strip()] != ["report(info, n_steps, False, evals, residual)"]:
+    if [line.strip() for line in tail if line.strip()] not in _REPORT_TAILS:
         return None
     allocations = [line for line in head if "= np." in line]
     prelude = [line for line in head if "= np." not in line]

@@ -300,3 +300,31 @@ def test_failed_members_are_nan_with_their_reason(tmp_path):
     assert stored["top"][centre] == 0.0 and np.array_equal(stored["final_q"][centre], [[0.0, 0.0]])
     meta = json.loads((tmp_path / "out" / "meta.json").read_text())
     assert meta["failure_codes"]["1"].startswith("Newton iteration did not converge")
+
+
+@pytest.mark.parametrize("builtin, forced, kernel", [
+    (ANGLES, False, "rattle_general"),
+    (DAMPED, True, "forced_rattle_run"),
+])
+def test_member_loop_pastes_the_step_body(tmp_path, builtin, forced, kernel):
+    """Regression: the member loop pastes the step loop's body (its work arrays allocated once
+    per member) for every step kernel, whether or not the system's module inlined its closing
+    ``report``; calling the loop for one step instead allocated two dozen arrays per step and
+    made the angles' flip map 3 x slower per step than a single run. (The constant-mass RATTLE
+    of the Cartesian double pendulum is unrolled scalar code that allocates nothing: it is
+    called.)"""
+    from dirac.ensemble.general_kernel import _paste_step
+    from dirac.flows import MechanicalSystem
+    from dirac.model.systems import load_system
+
+    if builtin.startswith("["):
+        (tmp_path / "sys.toml").write_text(builtin)
+        lagrangian = load_system(tmp_path / "sys.toml")
+    else:
+        lagrangian = load_system(builtin)
+    mechanics = MechanicalSystem.from_lagrangian(lagrangian, with_forces=forced)
+    pasted = _paste_step(mechanics.module.source, kernel)
+    assert pasted is not None
+    allocations, _prelude, body = pasted
+    assert allocations and all("= np." in line for line in allocations)
+    assert "for step in range(n_steps)" not in "\n".join(body)
