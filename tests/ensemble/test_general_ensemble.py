@@ -328,3 +328,24 @@ def test_member_loop_pastes_the_step_body(tmp_path, builtin, forced, kernel):
     allocations, _prelude, body = pasted
     assert allocations and all("= np." in line for line in allocations)
     assert "for step in range(n_steps)" not in "\n".join(body)
+
+
+def test_flip_map_bench_rows_count_the_steps_run():
+    """The flip-map rows of ``dirac bench --ensemble`` at 3 x 3 (the bench runs 256 x 256).
+
+    Hand derivation (point masses m = l = 1 at the rod ends, released at rest): the energy is
+    E = V(a, b) = -g (2 cos th1 + cos th2). Arm 1 over its pivot (th1 = pi) needs
+    E >= min over th2 of V(pi, th2) = g, arm 2 over arm 1 (th2 = pi) needs E >= min over th1 of
+    V(th1, pi) = -g; so no flip where 2 cos a + cos b > 1. Of a, b in {-3, 0, 3} that is
+    (0, 0), (0, 3) and (0, -3) (2 + cos 3 = 1.010): they run all 5000 steps of t_end = 10 at
+    dt = 2e-3; the other six stop at their flip or run to the end."""
+    from dirac.ensemble.bench import format_flip_table, measure_flip_maps
+
+    rows = measure_flip_maps(side=3)
+    assert [row["system"] for row in rows] == ["double pendulum (x1, y1, x2, y2; 2 rods)", "double pendulum (th1, th2)"]
+    for row in rows:
+        assert row["flips"] <= 6
+        assert 3 * 5000 + (6 - row["flips"]) * 5000 <= row["member_steps"] < 9 * 5000 or row["flips"] == 0
+        assert row["seconds"] > 0.0 and row["cpu_seconds"] > 0.0
+    table = format_flip_table(rows)
+    assert "3 x 3 angles" in table and "target: <= 60 s" in table
