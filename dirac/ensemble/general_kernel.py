@@ -24,6 +24,7 @@ The combined module is imported through :func:`dirac.codegen.numba_backend.impor
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -168,11 +169,15 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
 
 
 #: The statements after a step loop's ``for step`` loop that the member loop may drop: the
-#: closing ``report`` call, or its body where :mod:`dirac.codegen.flatten` inlined it.
-_REPORT_TAILS = (
-    ["report(info, n_steps, False, evals, residual)"],
-    ["info[0] = n_steps", "info[1] = 1.0 if False else 0.0", "info[2] = evals", "info[3] = residual"],
-)
+#: closing ``report`` call, or its body (assignments to ``info[k]``) where
+#: :mod:`dirac.codegen.flatten` inlined it.
+_REPORT_CALL = "report(info, n_steps, False, evals, residual)"
+_INFO_ENTRY = re.compile(r"info\[\d\] = [^=]+$")
+
+
+def _is_report_tail(lines: list[str]) -> bool:
+    """Whether ``lines`` (stripped, non-empty) only report the steps done (see above)."""
+    return lines == [_REPORT_CALL] or (bool(lines) and all(_INFO_ENTRY.match(line) for line in lines))
 
 
 def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[str]] | None:
@@ -204,7 +209,7 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
     head, rest = lines[:at], lines[at + 1:]
     split = next((k for k, line in enumerate(rest) if line.strip() and not line.startswith("        ")), len(rest))
     body, tail = rest[:split], rest[split:]
-    if [line.strip() for line in tail if line.strip()] not in _REPORT_TAILS:
+    if not _is_report_tail([line.strip() for line in tail if line.strip()]):
         return None
     allocations = [line for line in head if "= np." in line]
     prelude = [line for line in head if "= np." not in line]
