@@ -349,3 +349,36 @@ def test_flip_map_bench_rows_count_the_steps_run():
         assert row["seconds"] > 0.0 and row["cpu_seconds"] > 0.0
     table = format_flip_table(rows)
     assert "3 x 3 angles" in table and "target: <= 60 s" in table
+
+
+def test_projected_members_are_projected_once_with_the_same_bits(tmp_path, monkeypatch):
+    """With project = true a local run projects each member once (the check before anything is
+    written keeps the projected states for the chunks), and stores the same bits as chunks that
+    project again (as a dask worker or a resumed run does): the projection is one function of
+    the member (:meth:`MechanicalSystem.project`), whose result is kept, not approximated."""
+    from dirac.ensemble.general_chunk import _PROJECTED, compute_general_chunk
+    from dirac.flows.mechanics import MechanicalSystem
+
+    calls = []
+    project = MechanicalSystem.project
+
+    def counted(self, q, p, *args, **kwargs):
+        calls.append(1)
+        return project(self, q, p, *args, **kwargs)
+
+    monkeypatch.setattr(MechanicalSystem, "project", counted)
+    path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n',
+                  f"q = {CARTESIAN_Q.replace('-cos(a) - cos(b)', '-cos(a) - 1.5*cos(b)')}\n"
+                  'q_dot = { x1 = "0.3*b" }\nproject = true',
+                  "dt = 0.01\nt_end = 0.3", 'grid = { a = [0.0, 1.0, 3], b = [0.0, 1.0, 3] }\nchunk_size = 4\n'
+                  'reductions = ["final", "constraint_error"]')
+    assert run_ensemble(path, tmp_path / "out").complete
+    assert len(calls) == 9 and not _PROJECTED
+    stored = _arrays(tmp_path / "out")
+    scene = load_ensemble_scene(path)
+    for start, stop in ((0, 4), (4, 8), (8, 9)):
+        again = compute_general_chunk(scene, start, stop)
+        for name in ("final_q", "final_p", "constraint_error"):
+            assert np.array_equal(again[name], stored[name][start:stop])
+    assert len(calls) == 18
+    assert np.all(stored["constraint_error"] < 1e-9)
