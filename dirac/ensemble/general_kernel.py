@@ -45,7 +45,7 @@ FAILURES: dict[int, str] = {
 _CACHE: dict[str, CompiledEnsemble] = {}
 
 #: The step loops a member loop calls (one step at a time).
-_STEP_KERNELS = ("rattle_constant_mass", "rattle_general", "forced_rattle_run", "conformal_run")
+_STEP_KERNELS = ("rattle_constant_mass", "rattle_general", "forced_rattle_run", "conformal_run", "midpoint_run")
 
 
 @dataclass
@@ -114,6 +114,11 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         else:
             step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, work_done)"
         gamma = float(mechanics.conformal_rate or 0.0)
+    elif scene.method == "midpoint":
+        mechanics.require_field("midpoint")
+        fractions = np.ones(1)
+        step = "midpoint_run(z, m_a, c, dt, 1, tol, max_iter, info)"
+        gamma = 0.0
     else:
         fractions = np.array(cast(tuple[float, ...], method.data), dtype=np.float64)
         name = "rattle_constant_mass" if mechanics.constant_mass is not None else "rattle_general"
@@ -158,6 +163,10 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         system_source = system_source.replace(f"@numba.njit(cache=True)\ndef {kernel}(",
                                               f'@numba.njit(cache=True, inline="always")\ndef {kernel}(')
     pasted = _paste_step(system_source, step.split("(")[0])
+    if pasted is None and scene.method == "midpoint":
+        # the midpoint rule's time t + (step + 1/2) dt is a single run's only with its own step count
+        raise InputError("[run] method = 'midpoint' is not available in ensembles of this system (its step loop "
+                         "has an unusual form); use rattle-2 or rattle-4")
     source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
                               mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
                               "constraint_error" in kinds, pasted)
@@ -184,8 +193,9 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
     """The step loop ``kernel`` of the system's module cut into the three parts the member
     loop pastes in: its work-array allocations and the statements before its loop over steps
     (once per member), and the body of that loop indented for the member's loop over steps
-    (once per step, with ``step = 0`` and ``n_steps = 1``), the same statements as in a
-    single run. None when the loop does not
+    (once per step, with ``t = t_k`` the sample time and ``step = j`` the step's number in
+    its sample interval, so its times ``t + step dt`` -- and the midpoint rule's
+    ``t + (step + 1/2) dt`` -- are a single run's), the same statements as in a single run. None when the loop does not
     have that shape (allocations, set-up, ``for step in range(n_steps):``, then only
     ``report(...)``): the member loop then calls it.
 
@@ -298,9 +308,13 @@ def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
     w(1, "work_done = np.zeros(1)")
     w(1, "n_steps = 1")
     w(1, "step = 0")
+    midpoint = step.startswith("midpoint_run")
+    if midpoint:
+        w(1, f"z = np.empty({2 * n})  # the midpoint rule's state (q, p)")
     if pasted is not None:
         allocations, prelude, _body = pasted
-        for line in [*allocations, *prelude]:
+        # the set-up first: the midpoint rule sizes its arrays by NZ = z.shape[0]
+        for line in [*prelude, *allocations]:
             w(0, line)
     w(1, f"m_v = np.zeros({n})")
     w(1, f"m_vw = np.empty(({n}, {n}))")
@@ -344,12 +358,23 @@ def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
     w(4, "m_fa[m_x] = m_f[m_x]")
     w(3, "ta = m_a + m_j * dt")
     if pasted is not None:
-        w(3, "t = ta")
+        # the step loop's time of step m_j of this sample interval, t + step dt, as in a single
+        # run that advances the interval in one call (t the sample time t_k, step = m_j)
+        w(3, "t = m_a")
+        w(3, "step = m_j")
+        if midpoint:
+            w(3, f"for m_x in range({n}):")
+            w(4, "z[m_x] = q[m_x]")
+            w(4, f"z[{n} + m_x] = p[m_x]")
         for line in pasted[2]:
             if line.strip() == "return":
                 indent = line[: len(line) - len(line.lstrip())]
                 w(0, f"{indent}STEPS[m_i] = m_steps")
             w(0, line)
+        if midpoint:
+            w(3, f"for m_x in range({n}):")
+            w(4, "q[m_x] = z[m_x]")
+            w(4, f"p[m_x] = z[{n} + m_x]")
     else:
         w(3, step)
         w(3, "if info[1] != 0.0:")

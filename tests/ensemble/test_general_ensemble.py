@@ -47,7 +47,8 @@ def _arrays(out) -> dict[str, np.ndarray]:
 
 def test_members_equal_single_runs(tmp_path):
     """A member's final state is the single run's from the same initial state, to the last bit
-    (same kernel, same step times); its energy error is that run's max |E(t_k) - E(0)|."""
+    (same kernel, same step times: RATTLE and the implicit midpoint rule); its energy error is
+    that run's max |E(t_k) - E(0)|."""
     from dirac.flows import ConstrainedProblem, ForcedProblem, MechanicalSystem, integrate
     from dirac.model.systems import load_system
 
@@ -55,6 +56,10 @@ def test_members_equal_single_runs(tmp_path):
         ('[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "rattle-2", "double_pendulum",
          lambda a, b: [np.sin(a), -np.cos(a), np.sin(a) + np.sin(b), -np.cos(a) - np.cos(b)], None),
         (ANGLES, 'q = { th1 = "a", th2 = "b" }', "rattle-4", None, lambda a, b: [a, b], ANGLES),
+        # the implicit midpoint rule on the Dirac vector field (times t_k + (j + 1/2) dt)
+        ('[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "midpoint", "double_pendulum",
+         lambda a, b: [np.sin(a), -np.cos(a), np.sin(a) + np.sin(b), -np.cos(a) - np.cos(b)], None),
+        (ANGLES, 'q = { th1 = "a", th2 = "b" }', "midpoint", None, lambda a, b: [a, b], ANGLES),
     ]
     for k, (system, initial, method, builtin, q_of, file_text) in enumerate(cases):
         path = _scene(tmp_path, system, initial, f'method = "{method}"\ndt = 0.01\nt_end = 0.7\nsamples = 8',
@@ -203,6 +208,16 @@ def test_bad_input_is_refused_before_anything_is_written(tmp_path, initial, ense
     result = _cli(path, tmp_path / "out")
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith("error: ") and message in result.stderr and len(result.stderr.splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_impulses_are_refused_by_name(tmp_path):
+    """Impulses cut a single run's steps at their times; ensembles do not do that yet and say so."""
+    path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "dt = 0.01\nt_end = 0.1",
+                  'grid = { a = [0.0, 1.0, 2], b = [0.0, 1.0, 2] }\nreductions = ["final"]\n'
+                  '[[impulses]]\nt = 0.05\nangular_impulse = [1.0, 0.0, 0.0]')
+    result = _cli(path, tmp_path / "out")
+    assert result.returncode == 2 and result.stderr.startswith("error: [[impulses]] are not available in ensembles")
     assert not (tmp_path / "out").exists()
 
 
