@@ -312,3 +312,87 @@ def format_general_table(rows: list[dict[str, Any]]) -> str:
     lines.append("targets: ensemble per member-step <= 1.2 x a single run; ensemble throughput >= 0.5 x the prange loop "
                  f"({rows[0]['threads'] if rows else 0} threads)")
     return "\n".join(lines)
+
+
+# ---------------------------------------------------------------- the flip map at full size
+#: The flip-time map's reduction (Heyl's map): the first time either arm passes over its pivot.
+FLIP_REDUCTIONS: dict[str, dict[str, list[str]]] = {
+    "double pendulum (x1, y1, x2, y2; 2 rods)": {"expr": ["x1", "x2 - x1"], "when": ["y1 > 0", "y2 - y1 > 0"]},
+    "double pendulum (th1, th2)": {"expr": ["sin(th1)", "sin(th2)"], "when": ["cos(th1) < 0", "cos(th2) < 0"]},
+}
+
+#: The flip map's target (seconds of wall time on a two-core machine).
+FLIP_TARGET_SECONDS = 60.0
+
+
+def flip_scene(label: str, side: int, t_end: float = 10.0, dt: float = 2e-3) -> Any:
+    """The double pendulum's flip-map scene of :data:`GENERAL_SYSTEMS` ``label``: unit masses
+    and rods, ``g = 9.81``, released at rest from a ``side x side`` grid of angles in
+    ``[-3, 3]^2``, ``rattle-2``, the first time either arm flips over, members stopping at it."""
+    from dirac.ensemble.general_scene import parse_general_scene
+
+    system, q = GENERAL_SYSTEMS[label]
+    return parse_general_scene({
+        "system": system, "initial": {"q": q},
+        "run": {"method": "rattle-2", "dt": dt, "t_end": t_end},
+        "ensemble": {"grid": {"a": [-3.0, 3.0, side], "b": [-3.0, 3.0, side]},
+                     "reductions": [{"kind": "first_crossing", "name": "flip_time", **FLIP_REDUCTIONS[label]}]},
+    })
+
+
+def measure_flip_maps(side: int = 256) -> list[dict[str, Any]]:
+    """The flip-time map of each system of :data:`GENERAL_SYSTEMS` at ``side x side``, once each.
+
+    ``run_ensemble`` into a temporary store on this machine (all threads), after a 4 x 4 map of
+    the same system has loaded the compiled kernels (the first run's compilation is not in the
+    figure). Reported: wall and CPU seconds (CPU of this process, all threads), the member-steps
+    actually run (members stop at their flip), member-steps per wall and per CPU second,
+    the members that flip, the threads and the 1-minute load average before the run (the
+    machine may be shared: the CPU figure is the one to compare).
+    """
+    import os
+
+    import numba
+    import numpy as np
+    import zarr
+
+    from dirac.ensemble.engine import run_ensemble
+    from dirac.ensemble.plot import _read_array
+
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="dirac-flip-bench-") as tmp:
+        for k, label in enumerate(GENERAL_SYSTEMS):
+            run_ensemble(flip_scene(label, 4), Path(tmp) / f"warm-{k}")
+            load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+            cpu = time.process_time()
+            wall = time.perf_counter()
+            run_ensemble(flip_scene(label, side), Path(tmp) / f"map-{k}")
+            wall = time.perf_counter() - wall
+            cpu = time.process_time() - cpu
+            group = zarr.open_group(str(Path(tmp) / f"map-{k}" / "data.zarr"), mode="r")
+            steps = float(np.sum(_read_array(group, "steps")))
+            flips = int(np.sum(np.isfinite(_read_array(group, "flip_time"))))
+            rows.append({"system": label, "side": side, "seconds": wall, "cpu_seconds": cpu, "member_steps": steps,
+                         "flips": flips, "threads": numba.get_num_threads(), "load": load})
+    return rows
+
+
+def format_flip_table(rows: list[dict[str, Any]]) -> str:
+    """The flip-map table of :func:`measure_flip_maps`."""
+    side = rows[0]["side"] if rows else 0
+    lines = [
+        f"double pendulum flip map, {side} x {side} angles in [-3, 3]^2 at rest, t_end = 10, rattle-2, dt = 2e-3, "
+        "members stop at their flip:",
+        f"{'system':<42} {'wall s':>7} {'CPU s':>7} {'member-steps':>13} {'flipped':>8} {'member-st/s':>12} "
+        f"{'per CPU s':>10} {'load':>5}",
+    ]
+    for row in rows:
+        lines.append(
+            f"{row['system']:<42} {row['seconds']:>7.1f} {row['cpu_seconds']:>7.1f} {row['member_steps']:>13.3g} "
+            f"{row['flips']:>8d} {row['member_steps'] / row['seconds']:>12.3g} "
+            f"{row['member_steps'] / row['cpu_seconds']:>10.3g} {row['load']:>5.1f}"
+        )
+    threads = rows[0]["threads"] if rows else 0
+    lines.append(f"target: <= {FLIP_TARGET_SECONDS:.0f} s wall on a two-core machine ({threads} threads here; "
+                 "on a shared machine compare CPU s / 2)")
+    return "\n".join(lines)

@@ -204,17 +204,19 @@ def run_ensemble(
         _check_stored_scene(scene, store, meta)
     chunk_size = _plan_chunk_size(scene, store, meta, chunk_size)
     n_chunks = chunk_count(scene.count, chunk_size)
+    local = scheduler is None and cluster is None and client is None
     if meta is None:
         if isinstance(scene, GeneralEnsembleScene):
             from dirac.ensemble.general_chunk import check_initial_states
 
-            check_initial_states(scene)  # bad initial data: refused before anything is written
+            # bad initial data: refused before anything is written (locally the projected
+            # states are kept for the chunks, computed in this process)
+            check_initial_states(scene, chunk_size if local else None)
         meta = _create_store(scene, store, chunk_size, n_chunks)
     done = store.completed()
     missing = [i for i in range(n_chunks) if i not in done]
     if done:
         say(f"resuming: {len(done)} of {n_chunks} chunks already complete, computing the other {len(missing)}")
-    local = scheduler is None and cluster is None and client is None
     record = RunRecord(store, meta, scene, chunk_size, n_chunks, done,
                        executor="local" if local else "dask", scheduler=scheduler or cluster)
     report = EnsembleReport(store.root, scene.count, chunk_size, n_chunks, chunks_skipped=len(done))
@@ -233,6 +235,10 @@ def run_ensemble(
     finally:
         bar.close()
         record.finish()
+        if isinstance(scene, GeneralEnsembleScene):
+            from dirac.ensemble.general_chunk import forget_projected
+
+            forget_projected(scene)
     report.chunks_computed = record.chunks_computed
     report.member_steps = record.member_steps
     report.failed = dict(record.failed)

@@ -11,7 +11,9 @@ reductions are NaN; the others complete.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
+from typing import Any
 
 import numpy as np
 
@@ -20,10 +22,18 @@ from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError
 
-__all__ = ["check_initial_states", "compute_general_chunk", "initial_states", "step_grid"]
+__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "step_grid"]
 
 #: Members whose initial states are checked at once by :func:`check_initial_states`.
 _CHECK_BLOCK = 65536
+
+#: Projected initial states ``(Q, P)`` that :func:`check_initial_states` computed for the
+#: chunks of a new ensemble, by ``(scene fingerprint, start, stop)``; a chunk computed in this
+#: process takes (and drops) its entry instead of projecting every member again.
+_PROJECTED: dict[tuple[str, int, int], tuple[np.ndarray, np.ndarray]] = {}
+
+#: Projected states kept at most (values of ``Q`` and ``P`` together, 128 MB).
+_PROJECTED_LIMIT = 16_000_000
 
 
 def step_grid(scene: GeneralEnsembleScene) -> tuple[np.ndarray, np.ndarray, int, float]:
@@ -43,17 +53,28 @@ def _evaluate(expression: object, variables: tuple[str, ...], values: np.ndarray
 
     if not isinstance(expression, sympy.Basic):
         return np.full(values.shape[0], float(expression))  # type: ignore[arg-type]
-    symbols = [sympy.Symbol(name, real=True) for name in variables]
-    function = sympy.lambdify(symbols, expression, "numpy")
+    function = _numpy_function(expression, variables)
     result = function(*(values[:, k] for k in range(len(variables))))
     return np.broadcast_to(np.asarray(result, dtype=float), (values.shape[0],)).copy()
 
 
-def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray
+@functools.lru_cache(maxsize=256)
+def _numpy_function(expression: Any, variables: tuple[str, ...]) -> Any:
+    """``expression`` of the ensemble variables as a numpy function (made once per process:
+    ``sympy.lambdify`` takes milliseconds, and every chunk evaluates the same expressions)."""
+    import sympy
+
+    return sympy.lambdify([sympy.Symbol(name, real=True) for name in variables], expression, "numpy")
+
+
+def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray,
+                   projected: tuple[np.ndarray, np.ndarray] | None = None
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(Q, P, C)`` of members with the ensemble variables ``values`` (rows): positions,
     momenta (``p = M(q) q_dot`` unless ``p`` is given) and parameter values; projected onto
-    the constraints when the scene says ``project = true``."""
+    the constraints when the scene says ``project = true`` (``projected``: these members'
+    projected ``(Q, P)``, computed before by this function, which are then taken as they are:
+    the projection is a Python loop over members, about 0.15 ms each)."""
     import sympy
 
     from dirac.model.expressions import parse_expression
@@ -88,7 +109,9 @@ def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, valu
     else:
         P = np.empty((count, n))
         compiled.module.ens_momenta(Q, rates, C, P)
-    if scene.project:
+    if scene.project and projected is not None:
+        Q, P = projected[0].copy(), projected[1].copy()
+    elif scene.project:
         for i in range(count):
             member = dataclasses.replace(mechanics, params=C[i].copy(), constant_mass=None)
             try:
@@ -102,9 +125,14 @@ def _where(names: tuple[str, ...], row: np.ndarray) -> str:
     return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
 
 
-def check_initial_states(scene: GeneralEnsembleScene) -> None:
+def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = None) -> None:
     """Refuse, before anything is written, members whose initial state is off the constraint
-    surface (with ``project = false``), or not finite.
+    surface (with ``project = false``), or not finite, or cannot be projected (``project = true``).
+
+    With ``chunk_size`` the members are taken chunk by chunk (the engine's chunks), and with
+    ``project = true`` their projected states are kept for :func:`compute_general_chunk` in
+    this process (the same function on the same members: the same bits), so that each member
+    is projected once.
 
     The test is a single scene's (:class:`dirac.flows.problems.ConstrainedProblem`):
     ``|chi| <= 1e-9 (1 + |q|^2)`` and ``|G M^-1 p + d chi/dt| <= 1e-9 sqrt((1 + |q|^2)(1 + |p|^2))``.
@@ -116,10 +144,15 @@ def check_initial_states(scene: GeneralEnsembleScene) -> None:
     """
     compiled = compiled_ensemble(scene)
     m = compiled.mechanics.n_constraints
-    for start in range(0, scene.count, _CHECK_BLOCK):
-        stop = min(scene.count, start + _CHECK_BLOCK)
+    keep = scene.project and m > 0 and chunk_size is not None and (
+        2 * scene.count * len(scene.coordinate_names) <= _PROJECTED_LIMIT)
+    block = chunk_size if keep and chunk_size is not None else _CHECK_BLOCK
+    for start in range(0, scene.count, block):
+        stop = min(scene.count, start + block)
         values = scene.source.members(start, stop)
         Q, P, C = initial_states(scene, compiled, values)
+        if keep:
+            _PROJECTED[(scene.fingerprint(), start, stop)] = (Q, P)
         if scene.project or m == 0:
             continue
         residual = np.empty((stop - start, 2 * m))
@@ -140,13 +173,22 @@ def check_initial_states(scene: GeneralEnsembleScene) -> None:
             )
 
 
+def forget_projected(scene: GeneralEnsembleScene) -> None:
+    """Drop the projected states :func:`check_initial_states` kept for ``scene`` (a run that
+    ended without computing every chunk leaves some)."""
+    key = scene.fingerprint()
+    for entry in [entry for entry in _PROJECTED if entry[0] == key]:
+        _PROJECTED.pop(entry, None)
+
+
 def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                           values: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Integrate members ``start .. stop-1`` and return their arrays (:meth:`GeneralEnsembleScene.array_layout`)."""
     compiled = compiled_ensemble(scene)
     if values is None:
         values = scene.source.members(start, stop)
-    Q, P, C = initial_states(scene, compiled, values)
+    projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
+    Q, P, C = initial_states(scene, compiled, values, projected)
     count, n = Q.shape
     starts, ends, per_interval, dt = step_grid(scene)
     n_cross, n_ext, n_poin, k_max = compiled.module.ENS_SHAPES

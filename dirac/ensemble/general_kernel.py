@@ -24,6 +24,7 @@ The combined module is imported through :func:`dirac.codegen.numba_backend.impor
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -44,7 +45,7 @@ FAILURES: dict[int, str] = {
 _CACHE: dict[str, CompiledEnsemble] = {}
 
 #: The step loops a member loop calls (one step at a time).
-_STEP_KERNELS = ("rattle_constant_mass", "rattle_general", "forced_rattle_run", "conformal_run")
+_STEP_KERNELS = ("rattle_constant_mass", "rattle_general", "forced_rattle_run", "conformal_run", "midpoint_run")
 
 
 @dataclass
@@ -113,6 +114,11 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         else:
             step = "forced_rattle_run(q, p, ta, c, fractions, dt, 1, tol, max_iter, info, work_done)"
         gamma = float(mechanics.conformal_rate or 0.0)
+    elif scene.method == "midpoint":
+        mechanics.require_field("midpoint")
+        fractions = np.ones(1)
+        step = "midpoint_run(z, m_a, c, dt, 1, tol, max_iter, info)"
+        gamma = 0.0
     else:
         fractions = np.array(cast(tuple[float, ...], method.data), dtype=np.float64)
         name = "rattle_constant_mass" if mechanics.constant_mass is not None else "rattle_general"
@@ -157,6 +163,10 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         system_source = system_source.replace(f"@numba.njit(cache=True)\ndef {kernel}(",
                                               f'@numba.njit(cache=True, inline="always")\ndef {kernel}(')
     pasted = _paste_step(system_source, step.split("(")[0])
+    if pasted is None and scene.method == "midpoint":
+        # the midpoint rule's time t + (step + 1/2) dt is a single run's only with its own step count
+        raise InputError("[run] method = 'midpoint' is not available in ensembles of this system (its step loop "
+                         "has an unusual form); use rattle-2 or rattle-4")
     source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
                               mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
                               "constraint_error" in kinds, pasted)
@@ -167,18 +177,34 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
     return CompiledEnsemble(mechanics, module, fractions, gamma, layout, parameter_exprs, scene.source.names)
 
 
+#: The statements after a step loop's ``for step`` loop that the member loop may drop: the
+#: closing ``report`` call, or its body (assignments to ``info[k]``) where
+#: :mod:`dirac.codegen.flatten` inlined it.
+_REPORT_CALL = "report(info, n_steps, False, evals, residual)"
+_INFO_ENTRY = re.compile(r"info\[\d\] = [^=]+$")
+
+
+def _is_report_tail(lines: list[str]) -> bool:
+    """Whether ``lines`` (stripped, non-empty) only report the steps done (see above)."""
+    return lines == [_REPORT_CALL] or (bool(lines) and all(_INFO_ENTRY.match(line) for line in lines))
+
+
 def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[str]] | None:
     """The step loop ``kernel`` of the system's module cut into the three parts the member
     loop pastes in: its work-array allocations and the statements before its loop over steps
     (once per member), and the body of that loop indented for the member's loop over steps
-    (once per step, with ``step = 0`` and ``n_steps = 1``), the same statements as in a
-    single run. None when the loop does not
+    (once per step, with ``t = t_k`` the sample time and ``step = j`` the step's number in
+    its sample interval, so its times ``t + step dt`` -- and the midpoint rule's
+    ``t + (step + 1/2) dt`` -- are a single run's), the same statements as in a single run. None when the loop does not
     have that shape (allocations, set-up, ``for step in range(n_steps):``, then only
     ``report(...)``): the member loop then calls it.
 
     A one-step call of a loop that allocates two dozen small arrays spends most of its time
     allocating (the angles' RATTLE: 3.5 x the per-step cost of a long run), and passing
-    them in costs a reference count per array and step."""
+    them in costs a reference count per array and step. Since the system's module inlines its
+    helpers at the source level (:mod:`dirac.codegen.flatten`), the closing ``report`` may be
+    its inlined body: both forms are recognised, else the general RATTLE's member loop fell
+    back to the one-step call and cost 3 x a single run per step."""
     start = source.find(f"def {kernel}(")
     if start < 0:
         return None
@@ -193,7 +219,7 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
     head, rest = lines[:at], lines[at + 1:]
     split = next((k for k, line in enumerate(rest) if line.strip() and not line.startswith("        ")), len(rest))
     body, tail = rest[:split], rest[split:]
-    if [line.strip() for line in tail if line.strip()] != ["report(info, n_steps, False, evals, residual)"]:
+    if not _is_report_tail([line.strip() for line in tail if line.strip()]):
         return None
     allocations = [line for line in head if "= np." in line]
     prelude = [line for line in head if "= np." not in line]
@@ -282,9 +308,13 @@ def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
     w(1, "work_done = np.zeros(1)")
     w(1, "n_steps = 1")
     w(1, "step = 0")
+    midpoint = step.startswith("midpoint_run")
+    if midpoint:
+        w(1, f"z = np.empty({2 * n})  # the midpoint rule's state (q, p)")
     if pasted is not None:
         allocations, prelude, _body = pasted
-        for line in [*allocations, *prelude]:
+        # the set-up first: the midpoint rule sizes its arrays by NZ = z.shape[0]
+        for line in [*prelude, *allocations]:
             w(0, line)
     w(1, f"m_v = np.zeros({n})")
     w(1, f"m_vw = np.empty(({n}, {n}))")
@@ -328,12 +358,23 @@ def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
     w(4, "m_fa[m_x] = m_f[m_x]")
     w(3, "ta = m_a + m_j * dt")
     if pasted is not None:
-        w(3, "t = ta")
+        # the step loop's time of step m_j of this sample interval, t + step dt, as in a single
+        # run that advances the interval in one call (t the sample time t_k, step = m_j)
+        w(3, "t = m_a")
+        w(3, "step = m_j")
+        if midpoint:
+            w(3, f"for m_x in range({n}):")
+            w(4, "z[m_x] = q[m_x]")
+            w(4, f"z[{n} + m_x] = p[m_x]")
         for line in pasted[2]:
             if line.strip() == "return":
                 indent = line[: len(line) - len(line.lstrip())]
                 w(0, f"{indent}STEPS[m_i] = m_steps")
             w(0, line)
+        if midpoint:
+            w(3, f"for m_x in range({n}):")
+            w(4, "q[m_x] = z[m_x]")
+            w(4, f"p[m_x] = z[{n} + m_x]")
     else:
         w(3, step)
         w(3, "if info[1] != 0.0:")

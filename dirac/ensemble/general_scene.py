@@ -11,7 +11,7 @@ q_dot = {}                                # or p = {...}; omitted entries are 0
 project = false                           # true: project each member onto the constraints
 
 [run]
-method = "rattle-2"                       # rattle-2/4/6/8; forced systems: forced-rattle-2/4, conformal-2/4
+method = "rattle-2"                       # rattle-2/4/6/8, midpoint; forced: forced-rattle-2/4, conformal-2/4
 dt = 2e-3
 t_end = 10.0
 samples = 101                             # energy and constraint errors are checked at these times
@@ -338,6 +338,9 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
     for section in ("system", "initial", "run", "ensemble"):
         if not isinstance(data.get(section), dict):
             raise InputError(f"an ensemble scene needs a [{section}] table; see docs/ensembles.md")
+    if "impulses" in data:
+        raise InputError("[[impulses]] are not available in ensembles yet (a member's steps would be cut at each "
+                         "impulse time); run the members with impulses one by one with dirac run")
     reject_unknown_keys(data, {"system", "initial", "run", "ensemble"}, "the scene", kind="section")
     system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
     reject_unknown_keys(system, _SYSTEM_KEYS, "[system]")
@@ -470,7 +473,7 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
     from dirac.flows.methods.registry import get_method
 
     usable = ["forced-rattle-2", "forced-rattle-4", "conformal-2", "conformal-4"] if forced else \
-        ["rattle-2", "rattle-4", "rattle-6", "rattle-8"]
+        ["rattle-2", "rattle-4", "rattle-6", "rattle-8", "midpoint"]
     name = run.get("method", "auto")
     if name == "auto":
         name = usable[0]

@@ -47,7 +47,8 @@ def _arrays(out) -> dict[str, np.ndarray]:
 
 def test_members_equal_single_runs(tmp_path):
     """A member's final state is the single run's from the same initial state, to the last bit
-    (same kernel, same step times); its energy error is that run's max |E(t_k) - E(0)|."""
+    (same kernel, same step times: RATTLE and the implicit midpoint rule); its energy error is
+    that run's max |E(t_k) - E(0)|."""
     from dirac.flows import ConstrainedProblem, ForcedProblem, MechanicalSystem, integrate
     from dirac.model.systems import load_system
 
@@ -55,6 +56,10 @@ def test_members_equal_single_runs(tmp_path):
         ('[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "rattle-2", "double_pendulum",
          lambda a, b: [np.sin(a), -np.cos(a), np.sin(a) + np.sin(b), -np.cos(a) - np.cos(b)], None),
         (ANGLES, 'q = { th1 = "a", th2 = "b" }', "rattle-4", None, lambda a, b: [a, b], ANGLES),
+        # the implicit midpoint rule on the Dirac vector field (times t_k + (j + 1/2) dt)
+        ('[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "midpoint", "double_pendulum",
+         lambda a, b: [np.sin(a), -np.cos(a), np.sin(a) + np.sin(b), -np.cos(a) - np.cos(b)], None),
+        (ANGLES, 'q = { th1 = "a", th2 = "b" }', "midpoint", None, lambda a, b: [a, b], ANGLES),
     ]
     for k, (system, initial, method, builtin, q_of, file_text) in enumerate(cases):
         path = _scene(tmp_path, system, initial, f'method = "{method}"\ndt = 0.01\nt_end = 0.7\nsamples = 8',
@@ -206,6 +211,16 @@ def test_bad_input_is_refused_before_anything_is_written(tmp_path, initial, ense
     assert not (tmp_path / "out").exists()
 
 
+def test_impulses_are_refused_by_name(tmp_path):
+    """Impulses cut a single run's steps at their times; ensembles do not do that yet and say so."""
+    path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "dt = 0.01\nt_end = 0.1",
+                  'grid = { a = [0.0, 1.0, 2], b = [0.0, 1.0, 2] }\nreductions = ["final"]\n'
+                  '[[impulses]]\nt = 0.05\nangular_impulse = [1.0, 0.0, 0.0]')
+    result = _cli(path, tmp_path / "out")
+    assert result.returncode == 2 and result.stderr.startswith("error: [[impulses]] are not available in ensembles")
+    assert not (tmp_path / "out").exists()
+
+
 def test_projection_puts_members_on_the_surface(tmp_path):
     """The same off-surface initial q with project = true runs, and every member starts on the
     surface: its constraint error (max over the samples) is at the Newton tolerance."""
@@ -300,3 +315,85 @@ def test_failed_members_are_nan_with_their_reason(tmp_path):
     assert stored["top"][centre] == 0.0 and np.array_equal(stored["final_q"][centre], [[0.0, 0.0]])
     meta = json.loads((tmp_path / "out" / "meta.json").read_text())
     assert meta["failure_codes"]["1"].startswith("Newton iteration did not converge")
+
+
+@pytest.mark.parametrize("builtin, forced, kernel", [
+    (ANGLES, False, "rattle_general"),
+    (DAMPED, True, "forced_rattle_run"),
+])
+def test_member_loop_pastes_the_step_body(tmp_path, builtin, forced, kernel):
+    """Regression: the member loop pastes the step loop's body (its work arrays allocated once
+    per member) for every step kernel, whether or not the system's module inlined its closing
+    ``report``; calling the loop for one step instead allocated two dozen arrays per step and
+    made the angles' flip map 3 x slower per step than a single run. (The constant-mass RATTLE
+    of the Cartesian double pendulum is unrolled scalar code that allocates nothing: it is
+    called.)"""
+    from dirac.ensemble.general_kernel import _paste_step
+    from dirac.flows import MechanicalSystem
+    from dirac.model.systems import load_system
+
+    if builtin.startswith("["):
+        (tmp_path / "sys.toml").write_text(builtin)
+        lagrangian = load_system(tmp_path / "sys.toml")
+    else:
+        lagrangian = load_system(builtin)
+    mechanics = MechanicalSystem.from_lagrangian(lagrangian, with_forces=forced)
+    pasted = _paste_step(mechanics.module.source, kernel)
+    assert pasted is not None
+    allocations, _prelude, body = pasted
+    assert allocations and all("= np." in line for line in allocations)
+    assert "for step in range(n_steps)" not in "\n".join(body)
+
+
+def test_flip_map_bench_rows_count_the_steps_run():
+    """The flip-map rows of ``dirac bench --ensemble`` at 3 x 3 (the bench runs 256 x 256).
+
+    Hand derivation (point masses m = l = 1 at the rod ends, released at rest): the energy is
+    E = V(a, b) = -g (2 cos th1 + cos th2). Arm 1 over its pivot (th1 = pi) needs
+    E >= min over th2 of V(pi, th2) = g, arm 2 over arm 1 (th2 = pi) needs E >= min over th1 of
+    V(th1, pi) = -g; so no flip where 2 cos a + cos b > 1. Of a, b in {-3, 0, 3} that is
+    (0, 0), (0, 3) and (0, -3) (2 + cos 3 = 1.010): they run all 5000 steps of t_end = 10 at
+    dt = 2e-3; the other six stop at their flip or run to the end."""
+    from dirac.ensemble.bench import format_flip_table, measure_flip_maps
+
+    rows = measure_flip_maps(side=3)
+    assert [row["system"] for row in rows] == ["double pendulum (x1, y1, x2, y2; 2 rods)", "double pendulum (th1, th2)"]
+    for row in rows:
+        assert row["flips"] <= 6
+        assert 3 * 5000 + (6 - row["flips"]) * 5000 <= row["member_steps"] < 9 * 5000 or row["flips"] == 0
+        assert row["seconds"] > 0.0 and row["cpu_seconds"] > 0.0
+    table = format_flip_table(rows)
+    assert "3 x 3 angles" in table and "target: <= 60 s" in table
+
+
+def test_projected_members_are_projected_once_with_the_same_bits(tmp_path, monkeypatch):
+    """With project = true a local run projects each member once (the check before anything is
+    written keeps the projected states for the chunks), and stores the same bits as chunks that
+    project again (as a dask worker or a resumed run does): the projection is one function of
+    the member (:meth:`MechanicalSystem.project`), whose result is kept, not approximated."""
+    from dirac.ensemble.general_chunk import _PROJECTED, compute_general_chunk
+    from dirac.flows.mechanics import MechanicalSystem
+
+    calls = []
+    project = MechanicalSystem.project
+
+    def counted(self, q, p, *args, **kwargs):
+        calls.append(1)
+        return project(self, q, p, *args, **kwargs)
+
+    monkeypatch.setattr(MechanicalSystem, "project", counted)
+    path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n',
+                  f"q = {CARTESIAN_Q.replace('-cos(a) - cos(b)', '-cos(a) - 1.5*cos(b)')}\n"
+                  'q_dot = { x1 = "0.3*b" }\nproject = true',
+                  "dt = 0.01\nt_end = 0.3", 'grid = { a = [0.0, 1.0, 3], b = [0.0, 1.0, 3] }\nchunk_size = 4\n'
+                  'reductions = ["final", "constraint_error"]')
+    assert run_ensemble(path, tmp_path / "out").complete
+    assert len(calls) == 9 and not _PROJECTED
+    stored = _arrays(tmp_path / "out")
+    scene = load_ensemble_scene(path)
+    for start, stop in ((0, 4), (4, 8), (8, 9)):
+        again = compute_general_chunk(scene, start, stop)
+        for name in ("final_q", "final_p", "constraint_error"):
+            assert np.array_equal(again[name], stored[name][start:stop])
+    assert len(calls) == 18
+    assert np.all(stored["constraint_error"] < 1e-9)
