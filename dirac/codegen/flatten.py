@@ -352,7 +352,7 @@ def _written_arrays(tree: ast.Module) -> set[str]:
 
 def tidy_function(function: ast.FunctionDef, written: set[str]) -> None:
     """Remove the code of ``function`` that never runs or whose value nobody reads (a load
-    ``x = a[k]`` of an inlined helper's unused input) and load each entry ``c[k]`` of a
+    ``x = a[k]`` of an inlined helper's unused input, an allocation nobody uses) and load each entry ``c[k]`` of a
     read-only argument once (see the module docstring); ``written`` are the names the
     module writes through a subscript (such an argument's entries are loaded where they are).
 
@@ -362,12 +362,18 @@ def tidy_function(function: ast.FunctionDef, written: set[str]) -> None:
     function.body = _prune(function.body) or [ast.Pass()]
     used = {node.id for node in ast.walk(function) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load)}
 
-    def unused_load(statement: ast.stmt) -> bool:  # ``x = a[k]`` with x never read: no effect
-        return (isinstance(statement, ast.Assign) and len(statement.targets) == 1
-                and isinstance(statement.targets[0], ast.Name) and statement.targets[0].id not in used
-                and isinstance(statement.value, ast.Subscript) and isinstance(statement.value.value, ast.Name)
-                and isinstance(statement.value.slice, ast.Constant) and type(statement.value.slice.value) is int
-                and statement.value.slice.value >= 0)
+    def unused_load(statement: ast.stmt) -> bool:  # ``x = a[k]`` or ``x = np.empty(...)``, x never read
+        if not (isinstance(statement, ast.Assign) and len(statement.targets) == 1
+                and isinstance(statement.targets[0], ast.Name) and statement.targets[0].id not in used):
+            return False
+        value = statement.value
+        if isinstance(value, ast.Call):  # an allocation nobody uses (the work arrays of absent constraints)
+            return (isinstance(value.func, ast.Attribute) and isinstance(value.func.value, ast.Name)
+                    and value.func.value.id == "np" and value.func.attr in ("empty", "zeros")
+                    and all(isinstance(n, (ast.Constant, ast.Tuple, ast.Attribute, ast.Name, ast.keyword))
+                            for a in [*value.args, *value.keywords] for n in [a]))
+        return (isinstance(value, ast.Subscript) and isinstance(value.value, ast.Name)
+                and isinstance(value.slice, ast.Constant) and type(value.slice.value) is int and value.slice.value >= 0)
 
     def drop(statements: list[ast.stmt]) -> list[ast.stmt]:
         out = []
