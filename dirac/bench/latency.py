@@ -337,8 +337,9 @@ def format_latency(rows: list[LatencyRow]) -> str:
                        for c in row.compilations if isinstance(c, dict) and "chars" in c and "seconds" in c},
                       key=lambda entry: entry[0])
     if compiled:
-        lines += ["", "compile time against kernel size (each cold, measured by the run that compiled it):",
-                  f"{'source chars':>12s} {'cpu s':>6s} {'us/char':>8s}  kernel"]
+        lines += ["", "compile time against kernel size (each cold, measured by the run that compiled it; size: the "
+                  "characters of the function numba compiled and of the functions it calls):",
+                  f"{'kernel chars':>12s} {'cpu s':>6s} {'us/char':>8s}  kernel"]
         lines += [f"{chars:12d} {seconds:6.2f} {1e6 * seconds / chars:8.1f}  {what}" for chars, seconds, what in compiled]
     lines += ["", "Fresh process and empty cache per row (the engine's bytecode compiled first, as an install does), default "
               "kernel policy; wall is what a user waits (distorted "

@@ -33,16 +33,44 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["BackgroundCompile", "estimate_compile_seconds", "record_compile_seconds", "HISTORY_FILE", "describe",
-           "numba_type", "mark_ready",
+           "numba_type", "mark_ready", "kernel_chars",
            "DEFAULT_SECONDS_PER_CHAR", "DEFAULT_COMPILE_FLOOR"]
 
 HISTORY_FILE = "compile_history.json"
-#: without a history: seconds of CPU per character of generated source (the RATTLE kernel
-#: of a top in Euler angles, 22 kB of source after inlining, compiled in 3.5 s on 2 cores)
-#: and the floor (numba's own start-up for the first kernel of a process)
-DEFAULT_SECONDS_PER_CHAR = 1.6e-4
+#: without a history: seconds of CPU per character of the kernel numba compiles
+#: (:func:`kernel_chars`; the RATTLE loop of a top in Euler angles and the LU it calls,
+#: 8.4 kB after flattening, compiled in 2.3 s of CPU in a fresh process on 2 busy cores,
+#: numba's own start-up included) and the floor (that start-up, for the smallest kernel)
+DEFAULT_SECONDS_PER_CHAR = 2.7e-4
 DEFAULT_COMPILE_FLOOR = 0.5
 _KEEP = 64
+
+
+def kernel_chars(source: str, name: str) -> int:
+    """The size of what numba compiles for ``name`` of the module ``source``: the characters
+    of its definition and of the definitions of the module's functions it calls, directly or
+    through them (each compiled once). The size of the whole module says little: a module
+    holds a dozen loops of which a run compiles one or two."""
+    import ast
+
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return len(source)
+    functions = {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
+    if name not in functions:
+        return len(source)
+    seen, todo, total = {name}, [name], 0
+    while todo:
+        node = functions[todo.pop()]
+        segment = ast.get_source_segment(source, node)
+        total += len(segment) if segment is not None else 0
+        for sub in ast.walk(node):
+            if isinstance(sub, ast.Call) and isinstance(sub.func, ast.Name) and sub.func.id in functions \
+                    and sub.func.id not in seen:
+                seen.add(sub.func.id)
+                todo.append(sub.func.id)
+    return total
 
 
 def _history_path() -> Path:

@@ -74,6 +74,8 @@ def forced_rattle_run(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info, w
     Qa = np.empty(__N__)
     work = np.empty((__N__, __N__))
     pivn = np.empty(__N__, dtype=np.int64)
+    work0 = np.empty((__N__, __N__))
+    piv0 = np.empty(__N__, dtype=np.int64)
     chi = np.zeros(__M__)
     G0 = np.zeros((__M__, __N__))
     G1 = np.zeros((__M__, __N__))
@@ -94,7 +96,7 @@ def forced_rattle_run(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info, w
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
             tau1 = tau + h
-            velocity(q, p, tau, c, v, work, pivn)
+            velocity(q, p, tau, c, v, work0, piv0)  # M(q, tau) factored once per sub-step
             for i in range(__N__):
                 x[i] = p[i]
                 x[__N__ + i] = q[i] + h * v[i]
@@ -102,25 +104,35 @@ def forced_rattle_run(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info, w
             for a in range(__M__):
                 x[2 * __N__ + a] = 0.0
             jacobian(q, tau, c, G0)
-            rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, pivn)
-            evals += 1.0
-            for j in range(__NX__):
+            # one place evaluates the residual (numba compiles each inlined copy anew): at
+            # e = 0 at x, at e = 1 .. NX at x + d e_j (column j = e - 1 of the finite-difference
+            # Jacobian, factored after the last), then at the Newton iterates
+            converged = False
+            d = 0.0
+            for e in range(1 + __NX__ + max_iter):
                 for i in range(__NX__):
                     xx[i] = x[i]
-                d = 1e-7 * (1.0 + abs(x[j]))
-                xx[j] += d
-                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn)
+                if 0 < e <= __NX__:
+                    d = 1e-7 * (1.0 + abs(x[e - 1]))
+                    xx[e - 1] += d
+                elif e > __NX__:
+                    lu_solve(J, pivx, r)
+                    for i in range(__NX__):
+                        x[i] -= r[i]
+                        xx[i] = x[i]
+                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn, work0, piv0)
+                if 0 < e <= __NX__:
+                    for i in range(__NX__):
+                        J[i, e - 1] = (rr[i] - r[i]) / d
+                    if e == __NX__:
+                        evals += __NX__
+                        lu_factor(J, pivx)
+                    continue
                 for i in range(__NX__):
-                    J[i, j] = (rr[i] - r[i]) / d
-            evals += __NX__
-            lu_factor(J, pivx)
-            converged = False
-            for _it in range(max_iter):
-                lu_solve(J, pivx, r)
-                for i in range(__NX__):
-                    x[i] -= r[i]
-                rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, pivn)
+                    r[i] = rr[i]
                 evals += 1.0
+                if e == 0:
+                    continue
                 residual = max_abs(r)
                 if residual <= tol * scale(x, 2 * __N__):
                     converged = True

@@ -260,7 +260,7 @@ def _stage_residual(q: list[sympy.Symbol], parameters: Sequence[sympy.Symbol], i
                             ("tau1", tau1 if time is not None else None)],
                            residual, (2 * n + m,), parameters)
     return source.replace("def rattle_residual(x, q, p, G0, h, tau, tau1, c, out):",
-                          "def rattle_residual(x, q, p, G0, h, tau, tau1, c, out, ph, q1, v0, f0, v1, chi, work, piv):")
+                          "def rattle_residual(x, q, p, G0, h, tau, tau1, c, out, ph, q1, v0, f0, v1, chi, work, piv, work0, piv0):")
 
 
 def analysed_kernel_source(
@@ -326,7 +326,7 @@ def _analysed_field(z: list[sympy.Symbol], parameters: Sequence[sympy.Symbol], h
         *body.lines,
         "",
         "",
-        "@numba.njit(cache=True)",
+        INLINED,  # one allocation: compiled as a function of its own, it cost a pipeline of numba
         "def field_work():",
         '    """The scratch space of the looped solve of field_into (empty when the solve is unrolled)."""',
         f"    return np.empty({body.scratch_size})",

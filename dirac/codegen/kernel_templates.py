@@ -81,7 +81,6 @@ def midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info):
     f = np.empty(NZ)
     fz = np.empty(NZ)
     zz = np.empty(NZ)
-    zm = np.empty(NZ)
     z1 = np.empty(NZ)
     r = np.empty(NZ)
     J = np.empty((NZ, NZ))
@@ -92,26 +91,37 @@ def midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info):
     size = 0.0
     for step in range(n_steps):
         tm = t + (step + 0.5) * dt
-        field_into(z, tm, c, f, work)
-        evals += 1.0
-        for j in range(NZ):
-            for i in range(NZ):
-                zz[i] = z[i]
-            d = 1e-7 * (1.0 + abs(z[j]))
-            zz[j] += d
-            field_into(zz, tm, c, fz, work)
-            for i in range(NZ):
-                J[i, j] = -0.5 * dt * (fz[i] - f[i]) / d
-            J[j, j] += 1.0
-        evals += NZ
-        lu_factor(J, piv)
-        for i in range(NZ):
-            z1[i] = z[i] + dt * f[i]
+        # one place evaluates the field (numba compiles each inlined copy anew): at e = 0
+        # at z, at e = 1 .. NZ at z + d e_j (column j = e - 1 of the finite-difference
+        # Jacobian, factored after the last), then at the midpoints of the Newton iterates
         converged = False
-        for _it in range(max_iter):
-            for i in range(NZ):
-                zm[i] = 0.5 * (z[i] + z1[i])
-            field_into(zm, tm, c, fz, work)
+        d = 0.0
+        for e in range(1 + NZ + max_iter):
+            if e <= NZ:
+                for i in range(NZ):
+                    zz[i] = z[i]
+                if e > 0:
+                    d = 1e-7 * (1.0 + abs(z[e - 1]))
+                    zz[e - 1] += d
+            else:
+                for i in range(NZ):
+                    zz[i] = 0.5 * (z[i] + z1[i])
+            field_into(zz, tm, c, fz, work)
+            if e == 0:
+                for i in range(NZ):
+                    f[i] = fz[i]
+                evals += 1.0
+                continue
+            if e <= NZ:
+                for i in range(NZ):
+                    J[i, e - 1] = -0.5 * dt * (fz[i] - f[i]) / d
+                J[e - 1, e - 1] += 1.0
+                if e == NZ:
+                    evals += NZ
+                    lu_factor(J, piv)
+                    for i in range(NZ):
+                        z1[i] = z[i] + dt * f[i]
+                continue
             evals += 1.0
             for i in range(NZ):
                 r[i] = z1[i] - z[i] - dt * fz[i]
@@ -157,12 +167,15 @@ def velocity(q, p, t, c, v, work, piv):
 _STAGE_RESIDUAL = '''
 
 @numba.njit(cache=True, inline="always")
-def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv):
-    """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau)."""
+def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, piv, work0, piv0):
+    """Residual of RATTLE's implicit stage at x = (p_half, q1, lam); G0 = G(q, tau), work0
+    and piv0 the LU factors of M(q, tau) (the sub-step's start, factored once by the loop)."""
     for i in range(__N__):
         ph[i] = x[i]
         q1[i] = x[__N__ + i]
-    velocity(q, ph, tau, c, v0, work, piv)
+    for i in range(__N__):
+        v0[i] = ph[i]
+    lu_solve(work0, piv0, v0)
     force(q, v0, tau, c, f0)
     for i in range(__N__):
         acc = 0.0
@@ -236,6 +249,8 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     u = np.empty(__N__)
     work = np.empty((__N__, __N__))
     pivn = np.empty(__N__, dtype=np.int64)
+    work0 = np.empty((__N__, __N__))
+    piv0 = np.empty(__N__, dtype=np.int64)
     # every entry is written before it is read; np.empty only: each allocation form
     # (np.zeros among them) is a numba implementation compiled once per process
     chi = np.empty(__M__)
@@ -256,32 +271,42 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
             tau1 = tau + h
-            velocity(q, p, tau, c, v, work, pivn)
+            velocity(q, p, tau, c, v, work0, piv0)  # M(q, tau) factored once per sub-step
             for i in range(__N__):
                 x[i] = p[i]
                 x[__N__ + i] = q[i] + h * v[i]
             for a in range(__M__):
                 x[2 * __N__ + a] = 0.0
             jacobian(q, tau, c, G0)
-            rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, pivn)
-            evals += 1.0
-            for j in range(__NX__):
+            # one place evaluates the residual (numba compiles each inlined copy anew): at
+            # e = 0 at x, at e = 1 .. NX at x + d e_j (column j = e - 1 of the finite-difference
+            # Jacobian, factored after the last), then at the Newton iterates
+            converged = False
+            d = 0.0
+            for e in range(1 + __NX__ + max_iter):
                 for i in range(__NX__):
                     xx[i] = x[i]
-                d = 1e-7 * (1.0 + abs(x[j]))
-                xx[j] += d
-                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn)
+                if 0 < e <= __NX__:
+                    d = 1e-7 * (1.0 + abs(x[e - 1]))
+                    xx[e - 1] += d
+                elif e > __NX__:
+                    lu_solve(J, pivx, r)
+                    for i in range(__NX__):
+                        x[i] -= r[i]
+                        xx[i] = x[i]
+                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn, work0, piv0)
+                if 0 < e <= __NX__:
+                    for i in range(__NX__):
+                        J[i, e - 1] = (rr[i] - r[i]) / d
+                    if e == __NX__:
+                        evals += __NX__
+                        lu_factor(J, pivx)
+                    continue
                 for i in range(__NX__):
-                    J[i, j] = (rr[i] - r[i]) / d
-            evals += __NX__
-            lu_factor(J, pivx)
-            converged = False
-            for _it in range(max_iter):
-                lu_solve(J, pivx, r)
-                for i in range(__NX__):
-                    x[i] -= r[i]
-                rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, work, pivn)
+                    r[i] = rr[i]
                 evals += 1.0
+                if e == 0:
+                    continue
                 residual = max_abs(r)
                 if residual <= tol * scale(x, 2 * __N__):
                     converged = True
@@ -480,6 +505,9 @@ def analysed_templates(n: int, k: int) -> str:
     constraints): ``field``, ``midpoint_run`` (projected), ``project``, ``energy``,
     ``residuals``. The module defines ``field_into(z, t, c, out, work)`` and
     ``field_work()`` itself (:func:`dirac.codegen.field_body.dirac_field_body`)."""
-    common = (_COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol, project_buffers)\n")
-              .replace("    PROJECT_WORK\n", "    project_buffers = project_work()\n"))
+    if k == 0:  # nothing to project onto: neither the projection nor its work arrays are compiled
+        common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
+    else:
+        common = (_COMMON.replace("        PROJECT\n", "        project(z, t + (step + 1) * dt, c, tol, project_buffers)\n")
+                  .replace("    PROJECT_WORK\n", "    project_buffers = project_work()\n"))
     return _fill(_ANALYSED + common, n, 0, k)

@@ -36,7 +36,13 @@ from typing import Any
 
 import numpy as np
 
-from dirac.codegen.background import BackgroundCompile, estimate_compile_seconds, mark_ready, record_compile_seconds
+from dirac.codegen.background import (
+    BackgroundCompile,
+    estimate_compile_seconds,
+    kernel_chars,
+    mark_ready,
+    record_compile_seconds,
+)
 from dirac.codegen.flatten import flatten_source
 from dirac.codegen.numba_backend import (
     cache_directory,
@@ -47,12 +53,17 @@ from dirac.codegen.numba_backend import (
     write_source,
 )
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
 #: a small kernel; ``dirac bench`` measures the actual figures)
 COMPILE_SECONDS = 1.0
+#: a step loop whose interpreted remainder exceeds this many times the estimated compile time
+#: waits for the compilation in the process (the estimate may be off by this factor and the
+#: wait still not exceed the interpreted run); below it, a background compilation lets the
+#: run go on interpreted
+WAIT_FACTOR = 2.0
 #: interpreted seconds between two looks at a background compilation (a step loop runs in
 #: parts of about this length while one is in flight)
 CHECK_SECONDS = 0.05
@@ -180,6 +191,7 @@ class TieredFunction:
         self.background_failed = False
         self._split: tuple[int, int, int, int] | None | bool = False  # not looked at yet
         self._marker: Path | None = None
+        self._chars: int | None = None
 
     @property
     def tier(self) -> str:
@@ -212,7 +224,7 @@ class TieredFunction:
 
                     start = time.process_time()
                     dispatcher.compile(tuple(numba.typeof(a) for a in args))
-                    record_compile_seconds(len(self.module.source), time.process_time() - start, self.name)
+                    record_compile_seconds(self.kernel_chars(), time.process_time() - start, self.name)
                     mark_ready(self.ready_marker())
             self._compiled = dispatcher
         return self._compiled
@@ -220,7 +232,13 @@ class TieredFunction:
     def compile_estimate(self) -> float:
         """Estimated seconds to compile this function (:func:`estimate_compile_seconds` of
         the module's source size and the measured history in the cache)."""
-        return estimate_compile_seconds(len(self.module.source))
+        return estimate_compile_seconds(self.kernel_chars())
+
+    def kernel_chars(self) -> int:
+        """The size of what numba compiles for this function (:func:`kernel_chars`)."""
+        if self._chars is None:
+            self._chars = kernel_chars(self.module.source, self.name)
+        return self._chars
 
     def seconds_per_step(self) -> float | None:
         """Measured interpreted seconds (CPU) per step (None before an interpreted call)."""
@@ -334,17 +352,25 @@ class TieredFunction:
         if remaining <= COMPILE_SECONDS:
             return
         estimate = self.compile_estimate()
-        if background_enabled() and not self.background_failed and (spare_core() or remaining < 2.0 * estimate):
+        if remaining > WAIT_FACTOR * estimate:
+            # the interpreted remainder costs far more than the compilation: waiting for it here
+            # is the shortest road (a child would add its own start, about half a second of
+            # importing numba, to the wait and keep a second core busy interpreting steps that
+            # the compiled loop does in microseconds)
+            self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
+                         "compile", args)
+            return
+        if background_enabled() and not self.background_failed and (spare_core() or remaining <= estimate):
             announce_compilation(f"{self.name} of {self.module.title}",
                                  f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
             path = source_path(self.module.source)
             if not path.exists():  # the file numba compiles from, written without importing it
                 write_source(self.module.source)
-            self.background = BackgroundCompile(path, self.name, args, len(self.module.source))
+            self.background = BackgroundCompile(path, self.name, args, self.kernel_chars())
         elif remaining > estimate:
-            # no core to spare and a run far longer than the compilation: compiling here costs
-            # the least CPU (a child would share the core with the interpreted run)
+            # no core to spare and a run longer than the compilation: compiling here costs the
+            # least (a child would share the core with the interpreted run)
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
                          "compile", args)
 
@@ -353,17 +379,20 @@ class TieredFunction:
         (these included; None: unknown).
 
         Interpreted while the interpreted time of what is planned (measured seconds per
-        step times ``planned``) stays below :data:`COMPILE_SECONDS`. Beyond it, a loop
-        that can be split (arguments ``t, dt, n_steps, info``) is compiled in a separate
-        process (:class:`~dirac.codegen.background.BackgroundCompile`) while it goes on
+        step times ``planned``) stays below :data:`COMPILE_SECONDS`. Beyond it the price
+        of each road is compared with the estimated compile time ``E``
+        (:func:`~dirac.codegen.background.estimate_compile_seconds`, from the size of the
+        kernel and the measured history): when the interpreted remainder exceeds
+        :data:`WAIT_FACTOR` ``* E`` (a run of unknown length included), the function is
+        compiled in this process at once, the shortest wait; otherwise a loop that can be
+        split (arguments ``t, dt, n_steps, info``) is compiled in a separate process
+        (:class:`~dirac.codegen.background.BackgroundCompile`) while it goes on
         interpreted, and switches to the compiled form at the first step boundary after
-        the compilation is done: no run waits for the compiler. That happens when a core
-        is idle (:func:`spare_core`) or the run is shorter than twice the estimated
-        compile time (:func:`~dirac.codegen.background.estimate_compile_seconds`); on a
-        busy machine a longer run compiles in this process, since the interpreted time
-        still to come exceeds the wait. Other loops, or with
-        ``DIRAC_BACKGROUND_COMPILE=0``, compile in this process when the interpreted
-        time still to come exceeds the estimated compile time.
+        the compilation is done: such a run never waits for the compiler. That happens when
+        a core is idle (:func:`spare_core`) or the remainder is shorter than ``E``; on a
+        busy machine a longer run compiles in this process. Other loops, or with
+        ``DIRAC_BACKGROUND_COMPILE=0``, compile in this process when the interpreted time
+        still to come exceeds ``E``.
         """
         if self.tier == "interpreted" and self._split_positions() is not None:
             return self._split_run(steps, planned, args)

@@ -136,10 +136,12 @@ def _loop_module(tmp_path, monkeypatch) -> tiers.TieredFunction:
 
 
 def test_a_long_loop_compiles_in_the_background_and_switches_at_a_step_boundary(tmp_path, monkeypatch, capsys) -> None:
-    """Planned far beyond a second of interpreted work with an idle core: a child process
-    compiles while the loop goes on interpreted in parts; after it is done the next part runs
-    compiled. The iterates are the hand loop's to the last bit (the same operations)."""
+    """Planned beyond a second of interpreted work, yet less than the compilation is estimated
+    to cost, with an idle core: a child process compiles while the loop goes on interpreted in
+    parts; after it is done the next part runs compiled. The iterates are the hand loop's to
+    the last bit (the same operations)."""
     monkeypatch.setattr(tiers, "spare_core", lambda: True)
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
     function = _loop_module(tmp_path, monkeypatch)
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(300, 10**9, x, 0.0, 0.1, 300, info)
@@ -167,6 +169,34 @@ def test_a_long_loop_on_a_busy_machine_compiles_in_the_process(tmp_path, monkeyp
     assert x[0] == _hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
 
 
+def test_a_loop_far_longer_than_its_compilation_waits_for_it_even_with_an_idle_core(tmp_path, monkeypatch) -> None:
+    """An interpreted remainder above WAIT_FACTOR times the estimated compile time: compiled
+    at once in the process (a child would add its start-up to the wait), after one
+    interpreted step that measured the rate; the iterates are the hand loop's."""
+    monkeypatch.setattr(tiers, "spare_core", lambda: True)
+    function = _loop_module(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(50, 10**12, x, 0.0, 0.1, 50, info)
+    assert function.background is None and function.tier == "compiled"
+    assert function.interpreted_steps == 1
+    assert x[0] == _hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
+
+
+def test_kernel_size_counts_the_function_and_what_it_calls_not_the_module() -> None:
+    """The size of what numba compiles for one function: its definition and those of the
+    module's functions it calls, directly or not (counted by hand below), not the others."""
+    from dirac.codegen.background import kernel_chars
+
+    a = "def a(x):\n    return b(x) + 1"
+    b = "def b(x):\n    return c(x) * 2"
+    c = "def c(x):\n    return x"
+    unused = "def unused(x):\n    return a(x) - b(x) - c(x)"
+    source = "\n\n".join([a, b, c, unused]) + "\n"
+    assert kernel_chars(source, "a") == len(a) + len(b) + len(c)
+    assert kernel_chars(source, "c") == len(c)
+    assert kernel_chars(source, "unused") == len(source) - 7  # all four definitions: the source less its separators
+
+
 def test_a_short_loop_stays_interpreted_and_starts_no_compilation(tmp_path, monkeypatch) -> None:
     monkeypatch.setattr(tiers, "spare_core", lambda: True)
     function = _loop_module(tmp_path, monkeypatch)
@@ -174,3 +204,28 @@ def test_a_short_loop_stays_interpreted_and_starts_no_compilation(tmp_path, monk
     function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
     assert function.background is None and function.tier == "interpreted"
     assert x[0] == _hand_loop(0.5, 40) and info[0] == 40
+
+
+def test_the_rattle_loop_of_a_configuration_dependent_mass_gives_the_same_numbers_on_both_tiers(monkeypatch) -> None:
+    """The heavy symmetric top in Euler angles (Goldstein eq. 5.59): its mass depends on
+    theta, so RATTLE runs the general loop (one residual site, M(q, tau) factored once per
+    sub-step). Interpreted and compiled agree to the last bit; phi and psi are cyclic, so
+    p_phi and p_psi stay at their initial values (Goldstein Sect. 5.7) up to rounding."""
+    top = Lagrangian.from_strings(
+        "symmetric_top_tiers", ["ph", "th", "ps"],
+        "I1/2*(th_dot**2 + ph_dot**2*sin(th)**2) + I3/2*(ps_dot + ph_dot*cos(th))**2 - M*g*l*cos(th)",
+        parameters={"I1": 1.0, "I3": 0.5, "M": 1.0, "g": 9.81, "l": 1.0})
+    q0, p0 = [0.0, 0.5, 0.0], [0.3, 0.0, 2.0]
+    problem = ConstrainedProblem(top, q0, p0)
+    function = problem.mechanics.module.function("rattle_general")
+    before = function.interpreted_calls
+    interpreted = integrate(problem, "rattle-2", t_end=0.02, dt=1e-3, samples=5)
+    assert function.interpreted_calls > before or function.tier == "compiled"
+    monkeypatch.setenv("DIRAC_KERNELS", "compiled")
+    compiled = integrate(ConstrainedProblem(top, q0, p0), "rattle-2", t_end=0.02, dt=1e-3, samples=5)
+    assert function.tier == "compiled"
+    np.testing.assert_array_equal(interpreted.outputs["q"], compiled.outputs["q"])
+    np.testing.assert_array_equal(interpreted.outputs["p"], compiled.outputs["p"])
+    p = np.asarray(compiled.outputs["p"])
+    assert np.max(np.abs(p[:, 0] - 0.3)) < 1e-13 and np.max(np.abs(p[:, 2] - 2.0)) < 1e-13
+    assert np.max(np.abs(np.asarray(compiled.outputs["q"])[:, 1] - 0.5)) > 1e-6  # theta moves: a real run
