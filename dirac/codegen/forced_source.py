@@ -43,6 +43,7 @@ from collections.abc import Sequence
 import sympy
 
 from dirac.codegen.kernel_source import emit_function
+from dirac.codegen.kernel_templates import RATTLE_NEWTON
 
 __all__ = ["forced_kernel_source"]
 
@@ -103,43 +104,7 @@ def forced_rattle_run(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info, w
                 qa[i] = q[i]
             for a in range(__M__):
                 x[2 * __N__ + a] = 0.0
-            jacobian(q, tau, c, G0)
-            # one place evaluates the residual (numba compiles each inlined copy anew): at
-            # e = 0 at x, at e = 1 .. NX at x + d e_j (column j = e - 1 of the finite-difference
-            # Jacobian, factored after the last), then at the Newton iterates
-            converged = False
-            d = 0.0
-            for e in range(1 + __NX__ + max_iter):
-                for i in range(__NX__):
-                    xx[i] = x[i]
-                if 0 < e <= __NX__:
-                    d = 1e-7 * (1.0 + abs(x[e - 1]))
-                    xx[e - 1] += d
-                elif e > __NX__:
-                    lu_solve(J, pivx, r)
-                    for i in range(__NX__):
-                        x[i] -= r[i]
-                        xx[i] = x[i]
-                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn, work0, piv0)
-                if 0 < e <= __NX__:
-                    for i in range(__NX__):
-                        J[i, e - 1] = (rr[i] - r[i]) / d
-                    if e == __NX__:
-                        evals += __NX__
-                        lu_factor(J, pivx)
-                    continue
-                for i in range(__NX__):
-                    r[i] = rr[i]
-                evals += 1.0
-                if e == 0:
-                    continue
-                residual = max_abs(r)
-                if residual <= tol * scale(x, 2 * __N__):
-                    converged = True
-                    break
-                if residual != residual:
-                    break
-            if not converged:
+''' + RATTLE_NEWTON + '''            if not converged:
                 for i in range(__N__):
                     q[i] = q_save[i]
                     p[i] = p_save[i]

@@ -14,7 +14,7 @@ the sub-step ``s`` of step ``j`` starts at ``t + j dt + dt (c_1 + ... + c_{s-1})
 
 from __future__ import annotations
 
-__all__ = ["mechanical_templates", "analysed_templates"]
+__all__ = ["mechanical_templates", "analysed_templates", "RATTLE_NEWTON"]
 
 _COMMON = '''
 
@@ -191,6 +191,48 @@ def rattle_residual(x, q, p, G0, h, tau, tau1, c, r, ph, q1, v0, f0, v1, chi, wo
             r[2 * __N__ + a] = chi[a]
 '''
 
+#: the Newton solve of one RATTLE sub-step on ``rattle_residual``, shared by the general
+#: and the forced RATTLE loops (pasted at the same place in both: the same statements,
+#: so the same numbers)
+RATTLE_NEWTON = '''            jacobian(q, tau, c, G0)
+            # one place evaluates the residual (numba compiles each inlined copy anew): at
+            # e = 0 at x, at e = 1 .. NX at x + d e_j (column j = e - 1 of the finite-difference
+            # Jacobian, factored after the last), then at the Newton iterates
+            converged = False
+            d = 0.0
+            for e in range(1 + __NX__ + max_iter):
+                for i in range(__NX__):
+                    xx[i] = x[i]
+                if 0 < e <= __NX__:
+                    d = 1e-7 * (1.0 + abs(x[e - 1]))
+                    xx[e - 1] += d
+                elif e > __NX__:
+                    lu_solve(J, pivx, r)
+                    for i in range(__NX__):
+                        x[i] -= r[i]
+                        xx[i] = x[i]
+                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn, work0, piv0)
+                if 0 < e <= __NX__:
+                    for i in range(__NX__):
+                        J[i, e - 1] = (rr[i] - r[i]) / d
+                    if e == __NX__:
+                        evals += __NX__
+                        lu_factor(J, pivx)
+                    continue
+                for i in range(__NX__):
+                    r[i] = rr[i]
+                evals += 1.0
+                if e == 0:
+                    continue
+                residual = max_abs(r)
+                if residual <= tol * scale(x, 2 * __N__):
+                    converged = True
+                    break
+                if residual != residual:
+                    break
+'''
+
+
 _MECHANICAL = '''
 
 
@@ -277,43 +319,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                 x[__N__ + i] = q[i] + h * v[i]
             for a in range(__M__):
                 x[2 * __N__ + a] = 0.0
-            jacobian(q, tau, c, G0)
-            # one place evaluates the residual (numba compiles each inlined copy anew): at
-            # e = 0 at x, at e = 1 .. NX at x + d e_j (column j = e - 1 of the finite-difference
-            # Jacobian, factored after the last), then at the Newton iterates
-            converged = False
-            d = 0.0
-            for e in range(1 + __NX__ + max_iter):
-                for i in range(__NX__):
-                    xx[i] = x[i]
-                if 0 < e <= __NX__:
-                    d = 1e-7 * (1.0 + abs(x[e - 1]))
-                    xx[e - 1] += d
-                elif e > __NX__:
-                    lu_solve(J, pivx, r)
-                    for i in range(__NX__):
-                        x[i] -= r[i]
-                        xx[i] = x[i]
-                rattle_residual(xx, q, p, G0, h, tau, tau1, c, rr, ph, q1, v0, f0, v1, chi, work, pivn, work0, piv0)
-                if 0 < e <= __NX__:
-                    for i in range(__NX__):
-                        J[i, e - 1] = (rr[i] - r[i]) / d
-                    if e == __NX__:
-                        evals += __NX__
-                        lu_factor(J, pivx)
-                    continue
-                for i in range(__NX__):
-                    r[i] = rr[i]
-                evals += 1.0
-                if e == 0:
-                    continue
-                residual = max_abs(r)
-                if residual <= tol * scale(x, 2 * __N__):
-                    converged = True
-                    break
-                if residual != residual:
-                    break
-            if not converged:
+''' + RATTLE_NEWTON + '''            if not converged:
                 for i in range(__N__):
                     q[i] = q_save[i]
                     p[i] = p_save[i]
