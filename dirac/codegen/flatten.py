@@ -47,7 +47,7 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
 
-__all__ = ["flatten_source", "straight", "tidy_function", "INLINE_MARK", "SEPARATE", "SMALL"]
+__all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "INLINE_MARK", "SEPARATE", "SMALL"]
 
 #: the decorator generated modules put on a helper to be inlined
 INLINE_MARK = '@numba.njit(cache=True, inline="always")'
@@ -474,3 +474,74 @@ def flatten_source(source: str, policy: Callable[[_Helper], bool] = straight) ->
             tidy_function(node, written)
     ast.fix_missing_locations(tree)
     return ast.unparse(tree) + "\n"
+
+
+def _square_allocations(function: ast.FunctionDef) -> dict[str, int]:
+    """Names that ``function`` binds once, to ``np.empty((k, k))`` or ``np.zeros((k, k))`` with a literal ``k``."""
+    stores: dict[str, int] = {}
+    for node in ast.walk(function):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, (ast.Store, ast.Del)):
+            stores[node.id] = stores.get(node.id, 0) + 1
+    for argument in function.args.args:
+        stores[argument.arg] = stores.get(argument.arg, 0) + 1
+    sizes: dict[str, int] = {}
+    for node in ast.walk(function):
+        if not (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)
+                and stores.get(node.targets[0].id) == 1 and isinstance(node.value, ast.Call)):
+            continue
+        call = node.value
+        if not (isinstance(call.func, ast.Attribute) and isinstance(call.func.value, ast.Name)
+                and call.func.value.id == "np" and call.func.attr in ("empty", "zeros") and len(call.args) == 1
+                and not call.keywords and isinstance(call.args[0], ast.Tuple) and len(call.args[0].elts) == 2):
+            continue
+        rows, columns = call.args[0].elts
+        if isinstance(rows, ast.Constant) and isinstance(columns, ast.Constant) and type(rows.value) is int \
+                and rows.value == columns.value:
+            sizes[node.targets[0].id] = rows.value
+    return sizes
+
+
+def specialise_solves(source: str, max_size: int | None = None) -> str:
+    """``source`` for the interpreted tier: each call ``lu_factor(A, piv)`` / ``lu_solve(A, piv, b)``
+    on a matrix ``A`` that its function allocates once as ``np.empty((k, k))`` (a literal
+    ``k`` from 1 to ``max_size``, default
+    :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`) calls the straight-line
+    ``lu_factor_<k>`` / ``lu_solve_<k>`` of :func:`~dirac.codegen.small_solves.unrolled_lu_source`
+    instead, appended to the module.
+
+    The unrolled forms make the same floating-point operations in the same order as the
+    loops (bit for bit the same results), so the interpreted tier still gives the numbers of
+    the compiled one, which keeps the loops (numba compiles them faster). A source without
+    such calls is returned unchanged. Run it on a flattened source
+    (:func:`flatten_source`), where the helpers that pass the matrix on are inlined.
+    """
+    from dirac.codegen.small_solves import UNROLLED_MAX_SIZE, unrolled_lu_source
+
+    limit = UNROLLED_MAX_SIZE if max_size is None else max_size
+    if "lu_factor(" not in source and "lu_solve(" not in source:
+        return source
+    tree = ast.parse(source)
+    defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
+    if not {"lu_factor", "lu_solve"} <= defined:
+        return source
+    used: set[int] = set()
+    for function in tree.body:
+        if not isinstance(function, ast.FunctionDef) or function.name in ("lu_factor", "lu_solve"):
+            continue
+        sizes = _square_allocations(function)
+        if not sizes:
+            continue
+        for node in ast.walk(function):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                    and node.func.id in ("lu_factor", "lu_solve") and node.args \
+                    and isinstance(node.args[0], ast.Name) and 1 <= sizes.get(node.args[0].id, 0) <= limit:
+                size = sizes[node.args[0].id]
+                name = f"{node.func.id}_{size}"
+                if name in defined:  # the module has a function of that name already: leave the call
+                    continue
+                node.func = ast.Name(id=name, ctx=ast.Load())
+                used.add(size)
+    if not used:
+        return source
+    ast.fix_missing_locations(tree)
+    return ast.unparse(tree) + "\n" + "".join(unrolled_lu_source(size) for size in sorted(used))

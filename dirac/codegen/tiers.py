@@ -18,8 +18,9 @@ like a tiered JIT, when to switch:
 which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
 
 Both forms execute the same source with the same floating-point operations in the same
-order: a run gives the same method and the same accuracy on either tier, only the speed
-differs. The first compilation in a process writes one line to stderr
+order (the interpreted form has its LU solves of fixed size written out as straight-line
+code, :func:`dirac.codegen.flatten.specialise_solves`, which makes the operations of the
+loops in their order): a run gives the same numbers on either tier, only the speed differs. The first compilation in a process writes one line to stderr
 (:func:`announce_compilation`): what is compiled, why, and where the cache lives.
 """
 
@@ -43,7 +44,7 @@ from dirac.codegen.background import (
     mark_ready,
     record_compile_seconds,
 )
-from dirac.codegen.flatten import flatten_source
+from dirac.codegen.flatten import flatten_source, specialise_solves
 from dirac.codegen.numba_backend import (
     cache_directory,
     import_source,
@@ -159,9 +160,11 @@ class TieredModule:
 
     @property
     def interpreted(self) -> ModuleType:
-        """The same source run by the interpreter (nothing compiled)."""
+        """The same source run by the interpreter (nothing compiled), its LU solves of fixed
+        size unrolled (:func:`~dirac.codegen.flatten.specialise_solves`: the same operations
+        in the same order, so the same numbers, in a fraction of the interpreter's time)."""
         if self._interpreted is None:
-            self._interpreted = interpret_source(self.source)
+            self._interpreted = interpret_source(specialise_solves(self.source))
         return self._interpreted
 
     def function(self, name: str) -> TieredFunction:
