@@ -47,7 +47,8 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
 
-__all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "INLINE_MARK", "SEPARATE", "SMALL"]
+__all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "specialised_function", "INLINE_MARK",
+           "SEPARATE", "SMALL"]
 
 #: the decorator generated modules put on a helper to be inlined
 INLINE_MARK = '@numba.njit(cache=True, inline="always")'
@@ -560,3 +561,36 @@ def specialise_solves(source: str, max_size: int | None = None) -> str:
         return source
     ast.fix_missing_locations(tree)
     return ast.unparse(tree) + "\n" + "".join(unrolled_lu_source(size) for size in sorted(used))
+
+
+def _function_text(source: str, name: str) -> str | None:
+    """The text of the top-level ``def name(...)`` of ``source`` (up to the next line that
+    starts in the first column), or None."""
+    start = source.find(f"\ndef {name}(")
+    if start < 0:
+        return None
+    lines = source[start + 1:].split("\n")
+    end = 1
+    while end < len(lines) and (not lines[end] or lines[end][0] in " \t"):
+        end += 1
+    return "\n".join(lines[:end]) + "\n"
+
+
+def specialised_function(source: str, name: str, max_size: int | None = None) -> str | None:
+    """The source of function ``name`` of ``source`` with its solves of literal size
+    unrolled, followed by the unrolled solves it calls (:func:`specialise_solves` of that
+    one function), or None when it has none. Only this function is parsed: the interpreted
+    tier specialises the functions it runs, when it first runs them, and a module whose
+    loops never solve with a fixed matrix (a constant mass) pays nothing."""
+    text = _function_text(source, name)
+    if text is None or ("lu_factor(" not in text and "lu_solve(" not in text) or "np.empty((" not in text \
+            and "np.zeros((" not in text:
+        return None
+    helpers = "".join(t for t in (_function_text(source, "lu_factor"), _function_text(source, "lu_solve")) if t)
+    specialised = specialise_solves(helpers + text, max_size)
+    if specialised == helpers + text:
+        return None
+    tree = ast.parse(specialised)
+    tree.body = [node for node in tree.body if not (isinstance(node, ast.FunctionDef)
+                                                     and node.name in ("lu_factor", "lu_solve"))]
+    return ast.unparse(tree) + "\n"

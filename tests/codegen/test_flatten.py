@@ -135,3 +135,24 @@ def test_solves_of_a_literal_size_are_unrolled_and_the_others_left_to_the_loops(
     assert x1.tobytes() == x2.tobytes()
     np.testing.assert_allclose(x1, np.linalg.solve(matrix, b), rtol=1e-14)
     assert specialise_solves(_SOURCE) == _SOURCE  # nothing to specialise: unchanged
+
+
+def test_one_function_is_specialised_alone_when_the_interpreter_first_runs_it() -> None:
+    """specialised_function parses only the function asked for: ``fixed`` comes back with
+    its unrolled solves, put into the interpreted module it solves (4 I + H) x = b as the
+    loops do, bit for bit; ``sized_at_run_time`` (no literal size) and a function that is
+    not there give None."""
+    from dirac.codegen.flatten import specialised_function
+
+    text = specialised_function(_SOLVES, "fixed")
+    assert text is not None and "lu_factor_3(A, piv)" in text and "def lu_solve_3(" in text
+    assert "def lu_factor(" not in text
+    assert specialised_function(_SOLVES, "sized_at_run_time") is None
+    assert specialised_function(_SOLVES, "absent") is None
+    module = interpret_source(_SOLVES)
+    b = np.array([1.0, 2.0, 3.0])
+    looped, unrolled = b.copy(), b.copy()
+    module.fixed(looped)
+    exec(compile(text, "<specialised fixed>", "exec"), module.__dict__)
+    module.fixed(unrolled)
+    assert looped.tobytes() == unrolled.tobytes()
