@@ -47,7 +47,8 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
 
-__all__ = ["flatten_source", "straight", "tidy_function", "INLINE_MARK", "SEPARATE", "SMALL"]
+__all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "specialised_function", "INLINE_MARK",
+           "SEPARATE", "SMALL"]
 
 #: the decorator generated modules put on a helper to be inlined
 INLINE_MARK = '@numba.njit(cache=True, inline="always")'
@@ -459,11 +460,25 @@ def tidy_function(function: ast.FunctionDef, written: set[str]) -> None:
     function.body = [*docstring, *head, *renamed]
 
 
+def _without_cfunc_wrapper(function: ast.FunctionDef) -> None:
+    """``@numba.njit(..., no_cfunc_wrapper=True)``: numba compiles, next to each function and
+    its CPython wrapper, a C-callable wrapper for first-class function values (a dispatcher
+    passed as an argument to jitted code), which no generated kernel uses; leaving it out
+    took about 10 % off the compilation of a RATTLE kernel (paired runs, docs/performance.md).
+    It changes no machine code of the function itself, hence no number."""
+    for decorator in function.decorator_list:
+        if isinstance(decorator, ast.Call) and isinstance(decorator.func, ast.Attribute) \
+                and isinstance(decorator.func.value, ast.Name) and decorator.func.value.id == "numba" \
+                and decorator.func.attr == "njit" and not any(k.arg == "no_cfunc_wrapper" for k in decorator.keywords):
+            decorator.keywords.append(ast.keyword(arg="no_cfunc_wrapper", value=ast.Constant(value=True)))
+
+
 def flatten_source(source: str, policy: Callable[[_Helper], bool] = straight) -> str:
     """``source`` with every call of a helper marked ``inline="always"`` replaced by the
     helper's body where ``policy`` says so (see the module docstring); every helper stays,
     as a plain ``@numba.njit`` function without the mark, for the calls left and for direct
-    calls. A source without marks is returned unchanged."""
+    calls; every ``njit`` function is compiled without numba's C-callable wrapper
+    (:func:`_without_cfunc_wrapper`). A source without marks is returned unchanged."""
     if 'inline="always"' not in source and "inline='always'" not in source:
         return source
     tree = ast.parse(source)
@@ -472,5 +487,110 @@ def flatten_source(source: str, policy: Callable[[_Helper], bool] = straight) ->
     for node in tree.body:
         if isinstance(node, ast.FunctionDef):
             tidy_function(node, written)
+            _without_cfunc_wrapper(node)
     ast.fix_missing_locations(tree)
+    return ast.unparse(tree) + "\n"
+
+
+def _square_allocations(function: ast.FunctionDef) -> dict[str, int]:
+    """Names that ``function`` binds once, to ``np.empty((k, k))`` or ``np.zeros((k, k))`` with a literal ``k``."""
+    stores: dict[str, int] = {}
+    for node in ast.walk(function):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, (ast.Store, ast.Del)):
+            stores[node.id] = stores.get(node.id, 0) + 1
+    for argument in function.args.args:
+        stores[argument.arg] = stores.get(argument.arg, 0) + 1
+    sizes: dict[str, int] = {}
+    for node in ast.walk(function):
+        if not (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)
+                and stores.get(node.targets[0].id) == 1 and isinstance(node.value, ast.Call)):
+            continue
+        call = node.value
+        if not (isinstance(call.func, ast.Attribute) and isinstance(call.func.value, ast.Name)
+                and call.func.value.id == "np" and call.func.attr in ("empty", "zeros") and len(call.args) == 1
+                and not call.keywords and isinstance(call.args[0], ast.Tuple) and len(call.args[0].elts) == 2):
+            continue
+        rows, columns = call.args[0].elts
+        if isinstance(rows, ast.Constant) and isinstance(columns, ast.Constant) and type(rows.value) is int \
+                and rows.value == columns.value:
+            sizes[node.targets[0].id] = rows.value
+    return sizes
+
+
+def specialise_solves(source: str, max_size: int | None = None) -> str:
+    """``source`` for the interpreted tier: each call ``lu_factor(A, piv)`` / ``lu_solve(A, piv, b)``
+    on a matrix ``A`` that its function allocates once as ``np.empty((k, k))`` (a literal
+    ``k`` from 1 to ``max_size``, default
+    :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`) calls the straight-line
+    ``lu_factor_<k>`` / ``lu_solve_<k>`` of :func:`~dirac.codegen.small_solves.unrolled_lu_source`
+    instead, appended to the module.
+
+    The unrolled forms make the same floating-point operations in the same order as the
+    loops (bit for bit the same results), so the interpreted tier still gives the numbers of
+    the compiled one, which keeps the loops (numba compiles them faster). A source without
+    such calls is returned unchanged. Run it on a flattened source
+    (:func:`flatten_source`), where the helpers that pass the matrix on are inlined.
+    """
+    from dirac.codegen.small_solves import UNROLLED_MAX_SIZE, unrolled_lu_source
+
+    limit = UNROLLED_MAX_SIZE if max_size is None else max_size
+    if "lu_factor(" not in source and "lu_solve(" not in source:
+        return source
+    tree = ast.parse(source)
+    defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
+    if not {"lu_factor", "lu_solve"} <= defined:
+        return source
+    used: set[int] = set()
+    for function in tree.body:
+        if not isinstance(function, ast.FunctionDef) or function.name in ("lu_factor", "lu_solve"):
+            continue
+        sizes = _square_allocations(function)
+        if not sizes:
+            continue
+        for node in ast.walk(function):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                    and node.func.id in ("lu_factor", "lu_solve") and node.args \
+                    and isinstance(node.args[0], ast.Name) and 1 <= sizes.get(node.args[0].id, 0) <= limit:
+                size = sizes[node.args[0].id]
+                name = f"{node.func.id}_{size}"
+                if name in defined:  # the module has a function of that name already: leave the call
+                    continue
+                node.func = ast.Name(id=name, ctx=ast.Load())
+                used.add(size)
+    if not used:
+        return source
+    ast.fix_missing_locations(tree)
+    return ast.unparse(tree) + "\n" + "".join(unrolled_lu_source(size) for size in sorted(used))
+
+
+def _function_text(source: str, name: str) -> str | None:
+    """The text of the top-level ``def name(...)`` of ``source`` (up to the next line that
+    starts in the first column), or None."""
+    start = source.find(f"\ndef {name}(")
+    if start < 0:
+        return None
+    lines = source[start + 1:].split("\n")
+    end = 1
+    while end < len(lines) and (not lines[end] or lines[end][0] in " \t"):
+        end += 1
+    return "\n".join(lines[:end]) + "\n"
+
+
+def specialised_function(source: str, name: str, max_size: int | None = None) -> str | None:
+    """The source of function ``name`` of ``source`` with its solves of literal size
+    unrolled, followed by the unrolled solves it calls (:func:`specialise_solves` of that
+    one function), or None when it has none. Only this function is parsed: the interpreted
+    tier specialises the functions it runs, when it first runs them, and a module whose
+    loops never solve with a fixed matrix (a constant mass) pays nothing."""
+    text = _function_text(source, name)
+    if text is None or ("lu_factor(" not in text and "lu_solve(" not in text) or "np.empty((" not in text \
+            and "np.zeros((" not in text:
+        return None
+    helpers = "".join(t for t in (_function_text(source, "lu_factor"), _function_text(source, "lu_solve")) if t)
+    specialised = specialise_solves(helpers + text, max_size)
+    if specialised == helpers + text:
+        return None
+    tree = ast.parse(specialised)
+    tree.body = [node for node in tree.body if not (isinstance(node, ast.FunctionDef)
+                                                     and node.name in ("lu_factor", "lu_solve"))]
     return ast.unparse(tree) + "\n"

@@ -18,8 +18,9 @@ like a tiered JIT, when to switch:
 which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
 
 Both forms execute the same source with the same floating-point operations in the same
-order: a run gives the same method and the same accuracy on either tier, only the speed
-differs. The first compilation in a process writes one line to stderr
+order (the interpreted form has its LU solves of fixed size written out as straight-line
+code, :func:`dirac.codegen.flatten.specialised_function`, which makes the operations of
+the loops in their order): a run gives the same numbers on either tier, only the speed differs. The first compilation in a process writes one line to stderr
 (:func:`announce_compilation`): what is compiled, why, and where the cache lives.
 """
 
@@ -43,7 +44,7 @@ from dirac.codegen.background import (
     mark_ready,
     record_compile_seconds,
 )
-from dirac.codegen.flatten import flatten_source
+from dirac.codegen.flatten import flatten_source, specialised_function
 from dirac.codegen.numba_backend import (
     cache_directory,
     import_source,
@@ -148,6 +149,7 @@ class TieredModule:
         self.title = title
         self._compiled: ModuleType | None = None
         self._interpreted: ModuleType | None = None
+        self._specialised: set[str] = set()
         self._functions: dict[str, TieredFunction] = {}
 
     @property
@@ -163,6 +165,20 @@ class TieredModule:
         if self._interpreted is None:
             self._interpreted = interpret_source(self.source)
         return self._interpreted
+
+    def interpreted_function(self, name: str) -> Callable[..., Any]:
+        """Function ``name`` of :attr:`interpreted`, its LU solves of fixed size unrolled
+        (:func:`~dirac.codegen.flatten.specialised_function`: the same operations in the same
+        order, so the same numbers, in a fraction of the interpreter's time); specialised
+        when first asked for, and put in the interpreted module in place of the looped one."""
+        module = self.interpreted
+        if name not in self._specialised:
+            text = specialised_function(self.source, name)
+            if text is not None:
+                exec(compile(text, f"<dirac generated {module.__name__} {name}>", "exec"), module.__dict__)
+            self._specialised.add(name)
+        function: Callable[..., Any] = getattr(module, name)
+        return function
 
     def function(self, name: str) -> TieredFunction:
         """The :class:`TieredFunction` of ``name`` (one per name, so time adds up)."""
@@ -245,7 +261,7 @@ class TieredFunction:
         return self.interpreted_seconds / self.interpreted_steps if self.interpreted_steps else None
 
     def _interpreted_call(self, steps: int, args: tuple[Any, ...]) -> Any:
-        function = getattr(self.module.interpreted, self.name)
+        function = self.module.interpreted_function(self.name)
         start = time.process_time()  # CPU, as the compile estimates: a busy machine slows both alike
         saved = [(a, a.copy()) for a in args if isinstance(a, np.ndarray)]  # the state the call changes in place
         try:

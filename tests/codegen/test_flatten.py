@@ -8,8 +8,9 @@ import ast
 
 import numpy as np
 
-from dirac.codegen.flatten import flatten_source
+from dirac.codegen.flatten import flatten_source, specialise_solves
 from dirac.codegen.numba_backend import interpret_source
+from dirac.codegen.small_solves import lu_source
 
 _SOURCE = '''"""tidy -- generated for a test"""
 import math
@@ -79,3 +80,79 @@ def test_the_flattened_source_computes_the_hand_iteration() -> None:
         q = np.array([1.0, 0.0])
         module.run(q, c, 2, out)
         assert out.tolist() == [31.0, 15.0]
+
+
+_SOLVES = '''"""solves -- generated for a test"""
+import math
+import numpy as np
+import numba
+''' + lu_source() + '''
+
+@numba.njit(cache=True)
+def fixed(b):
+    """A literal 3 x 3 matrix: its solves are specialised."""
+    A = np.empty((3, 3))
+    piv = np.empty(3, dtype=np.int64)
+    for i in range(3):
+        for j in range(3):
+            A[i, j] = 1.0 / (i + j + 1) + (4.0 if i == j else 0.0)
+    lu_factor(A, piv)
+    lu_solve(A, piv, b)
+
+
+@numba.njit(cache=True)
+def sized_at_run_time(z, b):
+    """A matrix whose size is known only at run time: left to the loops."""
+    n = z.shape[0]
+    A = np.empty((n, n))
+    piv = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = 1.0 / (i + j + 1) + (4.0 if i == j else 0.0)
+    lu_factor(A, piv)
+    lu_solve(A, piv, b)
+'''
+
+
+def test_solves_of_a_literal_size_are_unrolled_and_the_others_left_to_the_loops() -> None:
+    """specialise_solves renames the calls on the 3 x 3 matrix only and appends their
+    unrolled forms; both functions still solve (4 I + H) x = b, H the 3 x 3 Hilbert matrix,
+    which numpy.linalg.solve gives too."""
+    specialised = specialise_solves(_SOLVES)
+    tree = ast.parse(specialised)
+    calls = {name: sorted({n.func.id for n in ast.walk(f) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)
+                           and n.func.id.startswith("lu_")})
+             for f in tree.body if isinstance(f, ast.FunctionDef) for name in [f.name]}
+    assert calls["fixed"] == ["lu_factor_3", "lu_solve_3"]
+    assert calls["sized_at_run_time"] == ["lu_factor", "lu_solve"]
+    assert {"lu_factor_3", "lu_solve_3"} <= set(calls)  # appended to the module
+    module = interpret_source(specialised)
+    matrix = np.array([[1.0 / (i + j + 1) + (4.0 if i == j else 0.0) for j in range(3)] for i in range(3)])
+    b = np.array([1.0, 2.0, 3.0])
+    x1, x2 = b.copy(), b.copy()
+    module.fixed(x1)
+    module.sized_at_run_time(np.zeros(3), x2)
+    assert x1.tobytes() == x2.tobytes()
+    np.testing.assert_allclose(x1, np.linalg.solve(matrix, b), rtol=1e-14)
+    assert specialise_solves(_SOURCE) == _SOURCE  # nothing to specialise: unchanged
+
+
+def test_one_function_is_specialised_alone_when_the_interpreter_first_runs_it() -> None:
+    """specialised_function parses only the function asked for: ``fixed`` comes back with
+    its unrolled solves, put into the interpreted module it solves (4 I + H) x = b as the
+    loops do, bit for bit; ``sized_at_run_time`` (no literal size) and a function that is
+    not there give None."""
+    from dirac.codegen.flatten import specialised_function
+
+    text = specialised_function(_SOLVES, "fixed")
+    assert text is not None and "lu_factor_3(A, piv)" in text and "def lu_solve_3(" in text
+    assert "def lu_factor(" not in text
+    assert specialised_function(_SOLVES, "sized_at_run_time") is None
+    assert specialised_function(_SOLVES, "absent") is None
+    module = interpret_source(_SOLVES)
+    b = np.array([1.0, 2.0, 3.0])
+    looped, unrolled = b.copy(), b.copy()
+    module.fixed(looped)
+    exec(compile(text, "<specialised fixed>", "exec"), module.__dict__)
+    module.fixed(unrolled)
+    assert looped.tobytes() == unrolled.tobytes()

@@ -82,3 +82,59 @@ def test_a_chart_without_a_singularity_has_no_guard():
     """The pendulum in Cartesian coordinates has a constant ``W = m 1``: no guard, the run is as before."""
     problem = ConstrainedProblem(dirac.load_system("pendulum"), q0=[0.6, -0.8], qdot0=[0.0, 0.0])
     assert chart_guard(problem.mechanics) is None
+
+
+def test_the_polynomial_road_finds_the_gimbal_lock(monkeypatch):
+    """Without ``trigsimp``: sines and cosines as symbols, Pythagoras for ``psi``
+    (``sin(psi)^2 + cos(psi)^2 = 1``), and the factor left of ``A B C sin(theta)^2`` is
+    ``sin(theta)``, as by hand (module docstring); the distance near the gimbal lock
+    ``theta = 0`` is ``|tan(theta)|``, and trigsimp is never called."""
+    import sympy
+
+    calls = []
+    original = sympy.trigsimp
+    monkeypatch.setattr(sympy, "trigsimp", lambda *a, **k: calls.append(a) or original(*a, **k))
+    guard = chart_guard(_euler_top().mechanics)
+    assert not calls
+    assert guard is not None and guard.locus == "sin(theta) = 0"
+    for theta in (1e-3, -0.02):
+        assert guard.distance(np.array([0.3, theta, 1.1])) == pytest.approx(abs(np.tan(theta)), rel=1e-12)
+
+
+def test_three_angles_keep_every_locus():
+    """``L = (a'^2 + sin(a)^2 b'^2 + (2 + cos b + cos c) c'^2)/2``: ``W`` is diagonal with
+    ``det W = sin(a)^2 (2 + cos b + cos c)`` (three angles). Both loci
+    are kept: ``sin(a) = 0`` (distance ``|tan a|``) and ``cos b + cos c + 2 = 0``, reached only
+    at ``b = c = pi``, where at ``b = c = pi - e`` the first-order distance
+    ``|f| / |grad f| = (2 - 2 cos e) / (sqrt(2) sin e) = sqrt(2) tan(e/2)`` (by hand)."""
+    L = dirac.Lagrangian.from_strings(
+        "three_angles", ["a", "b", "c"], "(a_dot**2 + sin(a)**2*b_dot**2 + (2 + cos(b) + cos(c))*c_dot**2)/2", [],
+        parameters={})
+    guard = chart_guard(ConstrainedProblem(L, q0=[1.0, 0.5, 0.2], qdot0=[0.0, 0.0, 0.1]).mechanics)
+    assert guard is not None and guard.locus == "sin(a) = 0 and cos(b) + cos(c) + 2 = 0"
+    assert guard.distance(np.array([2e-3, 0.5, 0.2])) == pytest.approx(np.tan(2e-3), rel=1e-12)
+    e = 1e-3
+    assert guard.distance(np.array([1.0, np.pi - e, np.pi - e])) == pytest.approx(np.sqrt(2) * np.tan(e / 2), rel=1e-9)
+
+
+def test_the_triple_pendulum_keeps_its_determinant_as_the_locus():
+    """Unit masses and rods: ``W = [[3, 2 cos(a-b), cos(a-c)], [2 cos(a-b), 2, cos(b-c)],
+    [cos(a-c), cos(b-c), 1]]``, by cofactors ``det W = 6 - 4 cos^2(a-b) - 2 cos^2(a-c)
+    - 3 cos^2(b-c) + 4 cos(a-b) cos(a-c) cos(b-c)``: the one factor kept is that polynomial
+    (up to its sign), at random angles."""
+    kinetic = ("3/2*a_dot**2 + b_dot**2 + 1/2*c_dot**2 + 2*a_dot*b_dot*cos(a-b) + a_dot*c_dot*cos(a-c)"
+               " + b_dot*c_dot*cos(b-c)")
+    L = dirac.Lagrangian.from_strings("triple", ["a", "b", "c"], f"{kinetic} + 3*cos(a) + 2*cos(b) + cos(c)", [],
+                                      parameters={})
+    guard = chart_guard(ConstrainedProblem(L, q0=[1.0, 0.5, 0.2], qdot0=[0.0, 0.0, 0.0]).mechanics)
+    assert guard is not None and " and " not in guard.locus
+    import sympy
+
+    a, b, c = sympy.symbols("a b c", real=True)
+    factor = sympy.sympify(guard.locus.removesuffix(" = 0"), locals={"a": a, "b": b, "c": c})
+    rng = np.random.default_rng(3)
+    for angles in rng.uniform(-np.pi, np.pi, size=(5, 3)):
+        x, y, z = np.cos(angles[0] - angles[1]), np.cos(angles[0] - angles[2]), np.cos(angles[1] - angles[2])
+        det = 6 - 4 * x**2 - 2 * y**2 - 3 * z**2 + 4 * x * y * z
+        value = float(factor.subs({a: angles[0], b: angles[1], c: angles[2]}))
+        assert abs(value) == pytest.approx(abs(det), rel=1e-12)
