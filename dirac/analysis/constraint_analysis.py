@@ -427,7 +427,7 @@ class ConstraintAnalysis:
                                 symbols=free_symbols_of(C[second, second], memo)))
         found, skipped = special_parameter_values(
             space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time,
-            compiled=self._numerics,
+            compiled=self._numerics, starts=chain.points,
         )
         return found, unsearched + skipped
 

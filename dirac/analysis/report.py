@@ -160,8 +160,9 @@ def shared_form(exprs: dict) -> tuple[dict, dict]:
 
 
 def _latex(expr: sympy.Expr) -> str:
-    if tree_size(expr) > TREE_LIMIT:
-        return rf"\text{{(an expression of {tree_size(expr)} tree nodes; see --json)}}"
+    size = tree_size(expr)
+    if size > TREE_LIMIT:
+        return rf"\text{{(an expression of {size} tree nodes; see --json)}}"
     names = latex_names(expr)
     if len(sympy.sstr(expr, order="none")) <= ORDERED_LIMIT:
         return sympy.latex(expr, symbol_names=names)
@@ -169,8 +170,9 @@ def _latex(expr: sympy.Expr) -> str:
 
 
 def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
-    if tree_size(expr) > TREE_LIMIT:
-        return f"(an expression of {tree_size(expr)} tree nodes; see --json)"
+    size = tree_size(expr)  # one walk of the DAG (a multiplier of (228) has tens of millions of tree nodes)
+    if size > TREE_LIMIT:
+        return f"(an expression of {size} tree nodes; see --json)"
     text = expression_text(expr)
     if len(text) <= limit:
         return text
