@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
+from dirac.analysis.core.algebra import printed
 from dirac.analysis.gauge.generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
@@ -117,9 +118,13 @@ def structure_summary(analysis: AnalysisResult) -> str:
     )
 
 
-def tree_size(expr: sympy.Basic) -> int:
-    """Number of nodes of ``expr`` as a tree (what printing visits), counted on the DAG."""
-    memo: dict = {}
+def tree_size(expr: sympy.Basic, memo: dict | None = None) -> int:
+    """Number of nodes of ``expr`` as a tree (what printing visits), counted on the DAG.
+
+    ``memo`` (node -> its tree size) may be shared by calls on expressions that share
+    sub-trees (the multipliers of one analysis): each shared node is then walked once.
+    """
+    memo = {} if memo is None else memo
 
     def size(e):
         hit = memo.get(e)
@@ -138,7 +143,7 @@ def expression_text(expr: sympy.Expr) -> str:
     the order of the terms of sums differs.
     """
     text = sympy.sstr(expr, order="none")
-    return str(expr) if len(text) <= ORDERED_LIMIT else text
+    return printed(expr) if len(text) <= ORDERED_LIMIT else text
 
 
 def shared_form(exprs: dict) -> tuple[dict, dict]:
@@ -169,8 +174,8 @@ def _latex(expr: sympy.Expr) -> str:
     return sympy.latex(expr, order="none", symbol_names=names)
 
 
-def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
-    size = tree_size(expr)  # one walk of the DAG (a multiplier of (228) has tens of millions of tree nodes)
+def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT, sizes: dict | None = None) -> str:
+    size = tree_size(expr, sizes)  # one walk of the DAG (a multiplier of (228) has tens of millions of tree nodes)
     if size > TREE_LIMIT:
         return f"(an expression of {size} tree nodes; see --json)"
     text = expression_text(expr)
@@ -348,9 +353,10 @@ def to_text(analysis: AnalysisResult) -> str:
     lines.append("multipliers of the primary constraints:")
     if not a.primary_multipliers:
         lines.append("  (none)")
+    sizes: dict = {}  # tree sizes of the multipliers' shared sub-trees, walked once
     for u in a.primary_multipliers:
         if u.name in a.multipliers:
-            lines.append(f"  {u} = {_short(a.multipliers[u.name])}")
+            lines.append(f"  {u} = {_short(a.multipliers[u.name], sizes=sizes)}")
         elif general:
             lines.append(f"  {u}: not fixed alone (see the general solution)")
         else:

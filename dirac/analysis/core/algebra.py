@@ -17,7 +17,7 @@ from sympy.core.add import _addsort
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["NotInRing", "tidy", "prints_shorter", "present_in_order", "ring_value"]
+__all__ = ["NotInRing", "tidy", "prints_shorter", "printed", "present_in_order", "ring_value"]
 
 
 class NotInRing(Exception):
@@ -55,7 +55,27 @@ def prints_shorter(expr: sympy.Expr, limit: int) -> bool:
     longest = _printed_at_most(expr, limit)
     if longest is not None and longest < limit:
         return True
-    return len(str(expr)) < limit
+    return len(printed(expr)) < limit
+
+
+#: texts of the expressions printed last (:func:`printed`), at most PRINTED_KEPT of them
+_PRINTED: dict[sympy.Basic, str] = {}
+PRINTED_KEPT = 256
+
+
+def printed(expr: sympy.Basic) -> str:
+    """``str(expr)``, remembered for the last ``PRINTED_KEPT`` expressions printed.
+
+    A multiplier of (78) is printed to measure it (:func:`prints_shorter`, before its
+    denominators are searched) and again in the report: the second time is a lookup.
+    """
+    text = _PRINTED.get(expr)
+    if text is None:
+        text = str(expr)
+        if len(_PRINTED) >= PRINTED_KEPT:
+            _PRINTED.clear()
+        _PRINTED[expr] = text
+    return text
 
 
 #: characters the str printer adds per argument (" + ", "*", "**", "/", "-") and per node
