@@ -30,7 +30,7 @@ locus, or shows none nearby in its attempts.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from math import factorial
 
@@ -43,7 +43,7 @@ from dirac.errors import AnalysisError
 
 __all__ = [
     "Division", "SingularLocus", "denominator_factors", "singular_loci", "constant_on_surface", "square_on_surface",
-    "determinant_grid", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR",
+    "determinant_grid", "nonvanishing_on", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR",
 ]
 
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
@@ -110,13 +110,17 @@ def _never_zero(factor: sympy.Expr) -> bool:
     return bool(factor.is_positive or factor.is_negative or (factor.func == sympy.exp))
 
 
-def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
+def denominator_factors(
+    expr: sympy.Expr, variables: Sequence[sympy.Symbol], settled: Callable[[sympy.Expr], bool] | None = None
+) -> list[sympy.Expr]:
     """The distinct irreducible factors of the denominator of ``expr`` that depend on the ``variables``.
 
     The bases of the negative powers in ``expr`` (its denominators) are factored
     (``sympy.factor_list``; ``sin(theta)`` counts as a factor of ``sin(theta)**2``); a
     factor that a numerator would cancel is kept (no gcd is taken). Factors without real zeros and numbers are left out; an
-    expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``.
+    expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``. A denominator for which
+    ``settled`` is true (proven nonzero on the surface, :func:`nonvanishing_on`) is not factored:
+    a factor of a function that never vanishes there never vanishes there either.
     """
     names = set(variables)
     if not prints_shorter(expr, DIVISOR_TEXT_LIMIT) or not (expr.free_symbols & names):  # size first: a shared tree is huge
@@ -125,6 +129,8 @@ def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> 
         node.base for node in sympy.preorder_traversal(expr)
         if isinstance(node, sympy.Pow) and node.exp.is_negative and node.base.free_symbols & names
     ))  # every denominator of the tree, in one walk (no gcd: a factor the numerator cancels is kept)
+    if settled is not None:
+        bases = [b for b in bases if not settled(b)]
     found: list[sympy.Expr] = []
     for base in bases:
         try:
@@ -143,11 +149,15 @@ def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> 
     return out
 
 
-def divisions(exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol]) -> list[Division]:
-    """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`)."""
+def divisions(
+    exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol],
+    settled: Callable[[sympy.Expr], bool] | None = None,
+) -> list[Division]:
+    """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`; ``settled``
+    names denominators proven nonzero on the surface, which are not factored)."""
     found: dict[sympy.Expr, Division] = {}
     for e in exprs:
-        for f in denominator_factors(sympy.sympify(e), variables):
+        for f in denominator_factors(sympy.sympify(e), variables, settled):
             found.setdefault(f, Division(f, stage, what))
     return list(found.values())
 
@@ -339,6 +349,27 @@ def _constant_matrix(
                 return None
             K[i, j] = K[j, i] = value
     return K
+
+
+def nonvanishing_on(surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> Callable[[sympy.Expr], bool]:
+    """``f -> bool``: whether ``f`` is proven nonzero on the whole surface ``surface = 0``.
+
+    A proof is :func:`constant_on_surface` or :func:`square_on_surface` with a value that
+    is not 0 (at generic parameter values, as :func:`singular_loci` reads them); ``False``
+    says only that there is no proof. Answers are remembered per expression.
+    """
+    memo: dict = {}
+    answers: dict[sympy.Expr, bool] = {}
+
+    def settled(f: sympy.Expr) -> bool:
+        if f not in answers:
+            value = constant_on_surface(f, surface, variables, memo)
+            if value is None:
+                value = square_on_surface(f, surface, variables, memo)
+            answers[f] = value is not None and value != 0
+        return answers[f]
+
+    return settled
 
 
 #: largest number of monomial equations :func:`constant_on_surface` solves (above it, the search decides)

@@ -88,3 +88,19 @@ def test_no_locus_of_det_r_on_so3_and_no_search():
     """On ``R^T R = 1`` the certificate holds: no locus (``det R = +-1``), decided without sampling."""
     assert _loci(DET, ORTHOGONAL) == ()
     assert singular_loci([Division(DET, 1, "test division")], ORTHOGONAL, _NoSearch(), VARIABLES) == ()
+
+
+def test_denominators_proven_nonzero_are_not_factored():
+    """``x / (R_11^2 + R_21^2 + R_31^2)`` on unit columns: the denominator is 1 there (no factor to test);
+    ``x / (R_11 det R)`` keeps ``R_11`` (it vanishes on SO(3), at a rotation about the first axis) but
+    ``det R`` is settled; off the surface of the proof both are factors."""
+    from dirac.analysis.core.divisors import denominator_factors, nonvanishing_on
+
+    x = sympy.Symbol("x")
+    settled = nonvanishing_on(ORTHOGONAL, VARIABLES)
+    norm = R[0, 0] ** 2 + R[1, 0] ** 2 + R[2, 0] ** 2
+    assert denominator_factors(x / norm, [*VARIABLES, x], settled) == []
+    assert denominator_factors(x / norm, [*VARIABLES, x]) == [norm]
+    assert settled(DET) and not settled(R[0, 0])
+    assert denominator_factors(x / DET + x / R[0, 0], [*VARIABLES, x], settled) == [R[0, 0]]
+    assert set(denominator_factors(x / DET + x / R[0, 0], [*VARIABLES, x])) == {R[0, 0], DET}
