@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
-from dirac.analysis.core.algebra import printed
+from dirac.analysis.core.algebra import printed, printed_at_most
 from dirac.analysis.gauge.generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
@@ -142,6 +142,9 @@ def expression_text(expr: sympy.Expr) -> str:
     The text is the same expression either way (``sympy.sympify`` reads it back); only
     the order of the terms of sums differs.
     """
+    longest = printed_at_most(expr, ORDERED_LIMIT + 1)
+    if longest is not None and longest <= ORDERED_LIMIT:  # short in any order: no need to measure it
+        return printed(expr)
     text = sympy.sstr(expr, order="none")
     return printed(expr) if len(text) <= ORDERED_LIMIT else text
 
