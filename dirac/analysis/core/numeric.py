@@ -225,6 +225,7 @@ class Numerics:
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
+        self._jacobians: dict[tuple, _DenseJacobian] = {}
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
@@ -485,8 +486,14 @@ class Numerics:
         m = len(constraints)
         jacobian: _DenseJacobian | SparseJacobian | None = None
         if m:  # a large system: sparse Jacobian, steps and rank tests; the same rules otherwise
-            jacobian = (SparseJacobian(self, constraints, REGULAR_TOLERANCE, SINGULAR_GRADIENT) if n >= LARGE_SYSTEM
-                        else _DenseJacobian(self, constraints))
+            if n >= LARGE_SYSTEM:
+                jacobian = SparseJacobian(self, constraints, REGULAR_TOLERANCE, SINGULAR_GRADIENT)
+            else:  # the same surface is projected onto again and again: its Jacobian is built once
+                jacobian = self._jacobians.get(tuple(constraints))
+                if jacobian is None:
+                    jacobian = _DenseJacobian(self, constraints)
+                    if len(self._jacobians) < PLAN_CACHE:
+                        self._jacobians[tuple(constraints)] = jacobian
         fixed = dict(fixed or {})
         free = np.array([i for i in range(n) if i not in fixed], dtype=int)
         points: list[np.ndarray] = []
