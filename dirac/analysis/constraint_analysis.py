@@ -29,6 +29,7 @@ from dirac.analysis.core.divisors import (
     Division,
     SingularLocus,
     divisions,
+    nonvanishing_on,
     singular_loci,
 )
 from dirac.analysis.core.linear_solve import SolveTooLarge
@@ -311,14 +312,16 @@ class ConstraintAnalysis:
         """The divisions recorded and found in the results, tested against the surface (:attr:`singular_loci`)."""
         variables = self._space.variables
         legendre = self._legendre
+        surface = [*self.constraints, *self.reducible_constraints]
+        settled = nonvanishing_on(surface, variables)  # denominators proven nonzero on the surface are not factored
         found: list[Division] = divisions(
-            [*legendre.velocity_solution.values(), self.canonical_hamiltonian], 1, LEGENDRE_SINGULAR, variables
+            [*legendre.velocity_solution.values(), self.canonical_hamiltonian], 1, LEGENDRE_SINGULAR, variables, settled
         )
         found += self._chain.divisions
         solution = self.multiplier_solution
         if self._chain.multiplier_solution is not None and self.constraints:
             exprs = [*solution.particular.values(), *(e for vec in solution.null_vectors for e in vec.values())]
-            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables)
+            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables, settled)
         if 0 < len(self.second_class) <= SMALL_DETERMINANT:
             C = bracket_matrix(self._space, self.second_class)
             found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
@@ -328,7 +331,7 @@ class ConstraintAnalysis:
             return ()
         numerics = Numerics(self._space, self._generic, seed=self._seed + 1, time=self.time)
         numerics.avoid = list(self._numerics.avoid)
-        return singular_loci(found, [*self.constraints, *self.reducible_constraints], numerics, variables)
+        return singular_loci(found, surface, numerics, variables)
 
     @property
     def multipliers(self) -> Mapping[str, sympy.Expr]:
@@ -427,7 +430,7 @@ class ConstraintAnalysis:
                                 symbols=free_symbols_of(C[second, second], memo)))
         found, skipped = special_parameter_values(
             space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time,
-            compiled=self._numerics,
+            compiled=self._numerics, starts=chain.points,
         )
         return found, unsearched + skipped
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
+from dirac.analysis.core.algebra import printed, printed_at_most
 from dirac.analysis.gauge.generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
@@ -117,9 +118,13 @@ def structure_summary(analysis: AnalysisResult) -> str:
     )
 
 
-def tree_size(expr: sympy.Basic) -> int:
-    """Number of nodes of ``expr`` as a tree (what printing visits), counted on the DAG."""
-    memo: dict = {}
+def tree_size(expr: sympy.Basic, memo: dict | None = None) -> int:
+    """Number of nodes of ``expr`` as a tree (what printing visits), counted on the DAG.
+
+    ``memo`` (node -> its tree size) may be shared by calls on expressions that share
+    sub-trees (the multipliers of one analysis): each shared node is then walked once.
+    """
+    memo = {} if memo is None else memo
 
     def size(e):
         hit = memo.get(e)
@@ -137,8 +142,11 @@ def expression_text(expr: sympy.Expr) -> str:
     The text is the same expression either way (``sympy.sympify`` reads it back); only
     the order of the terms of sums differs.
     """
+    longest = printed_at_most(expr, ORDERED_LIMIT + 1)
+    if longest is not None and longest <= ORDERED_LIMIT:  # short in any order: no need to measure it
+        return printed(expr)
     text = sympy.sstr(expr, order="none")
-    return str(expr) if len(text) <= ORDERED_LIMIT else text
+    return printed(expr) if len(text) <= ORDERED_LIMIT else text
 
 
 def shared_form(exprs: dict) -> tuple[dict, dict]:
@@ -160,17 +168,19 @@ def shared_form(exprs: dict) -> tuple[dict, dict]:
 
 
 def _latex(expr: sympy.Expr) -> str:
-    if tree_size(expr) > TREE_LIMIT:
-        return rf"\text{{(an expression of {tree_size(expr)} tree nodes; see --json)}}"
+    size = tree_size(expr)
+    if size > TREE_LIMIT:
+        return rf"\text{{(an expression of {size} tree nodes; see --json)}}"
     names = latex_names(expr)
     if len(sympy.sstr(expr, order="none")) <= ORDERED_LIMIT:
         return sympy.latex(expr, symbol_names=names)
     return sympy.latex(expr, order="none", symbol_names=names)
 
 
-def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT) -> str:
-    if tree_size(expr) > TREE_LIMIT:
-        return f"(an expression of {tree_size(expr)} tree nodes; see --json)"
+def _short(expr: sympy.Expr, limit: int = TEXT_LIMIT, sizes: dict | None = None) -> str:
+    size = tree_size(expr, sizes)  # one walk of the DAG (a multiplier of (228) has tens of millions of tree nodes)
+    if size > TREE_LIMIT:
+        return f"(an expression of {size} tree nodes; see --json)"
     text = expression_text(expr)
     if len(text) <= limit:
         return text
@@ -346,9 +356,10 @@ def to_text(analysis: AnalysisResult) -> str:
     lines.append("multipliers of the primary constraints:")
     if not a.primary_multipliers:
         lines.append("  (none)")
+    sizes: dict = {}  # tree sizes of the multipliers' shared sub-trees, walked once
     for u in a.primary_multipliers:
         if u.name in a.multipliers:
-            lines.append(f"  {u} = {_short(a.multipliers[u.name])}")
+            lines.append(f"  {u} = {_short(a.multipliers[u.name], sizes=sizes)}")
         elif general:
             lines.append(f"  {u}: not fixed alone (see the general solution)")
         else:

@@ -59,6 +59,9 @@ SEARCH_SECONDS = 2.0
 #: CPU seconds of the numeric scan of the blocks whose symbolic search ran over SEARCH_SECONDS
 SCAN_SECONDS = 1.0
 
+#: points of the surface at which the numeric scan reads each rank (the rank most of them give counts)
+SCAN_POINTS = 4
+
 #: the values each parameter of a block is set to, one at a time, by the numeric scan
 SCAN_VALUES = tuple(sympy.Rational(v) for v in ("0", "1", "-1", "2", "-2", "1/2", "-1/2"))
 
@@ -375,6 +378,7 @@ def special_parameter_values(
     budget: float | None = None,
     scan_budget: float | None = None,
     compiled: Numerics | None = None,
+    starts: Sequence[np.ndarray] = (),
 ) -> tuple[list[SpecialValue], list[str]]:
     """The special parameter values of the rank decisions ``uses``, checked numerically.
 
@@ -406,6 +410,11 @@ def special_parameter_values(
         The analysis' :class:`~dirac.analysis.core.numeric.Numerics` (its parameters are
         arguments of its compiled functions): the scan evaluates the same matrices and
         constraints at other parameter values without compiling them again.
+    starts
+        Points of the analysis' constraint surface at the generic values: the scan's
+        projections onto the surface at a scanned value start from them (a few
+        Gauss-Newton steps instead of a projection from a random point), random starts
+        fill in where one does not converge.
 
     Returns
     -------
@@ -475,11 +484,11 @@ def special_parameter_values(
         scan = CpuBudget(SCAN_SECONDS if scan_budget is None else scan_budget)
         for use in cut:
             why = f"the symbolic search in the {use.label} ran over its budget of {clock.seconds:g} s CPU and was not finished"
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled))
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled, starts))
         for use in large:
             n = use.block.shape[0]
             why = f"the {use.label} was not searched symbolically (its {n}x{n} block is larger than {MAX_BLOCK}x{MAX_BLOCK})"
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled))
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled, starts))
     return [replace(values[key], where="; ".join(w)) for key, w in found.items()], notes
 
 
@@ -494,9 +503,10 @@ class _Scanner:
 
     def __init__(self, space: PhaseSpace, generic: dict[sympy.Symbol, float], use: RankUse,
                  constraints: list[sympy.Expr], seed: int, time: sympy.Symbol | None,
-                 compiled: Numerics | None = None) -> None:
+                 compiled: Numerics | None = None, starts: Sequence[np.ndarray] = ()) -> None:
         self.space, self.generic, self.use, self.constraints = space, generic, use, constraints
         self.seed, self.time = seed, time
+        self.starts = list(starts)[:SCAN_POINTS]
         self.entries = list(use.matrix)
         self.numerics = (Numerics(space, generic, seed=seed, time=time) if compiled is None
                          else compiled.sharing_compiled(generic, seed))
@@ -506,12 +516,18 @@ class _Scanner:
         numerics = self.numerics
         numerics.parameter_vector = np.array([value if q == p else float(self.generic[q]) for q in numerics.parameters])
         if self.use.on_surface:
+            points = []
+            for start in self.starts:  # from the generic surface: the surface at this value is near (or empty)
+                try:
+                    points += numerics.surface_points(self.constraints, 1, attempts=1, start=start)
+                except AnalysisError:
+                    continue
             try:
-                points = numerics.surface_points(self.constraints, 4, attempts=20)
+                points += numerics.surface_points(self.constraints, SCAN_POINTS - len(points), attempts=20) if len(points) < SCAN_POINTS else []
             except AnalysisError:
                 return None
         else:
-            points = [numerics.random_point() for _ in range(4)]
+            points = [numerics.random_point() for _ in range(SCAN_POINTS)]
         values = numerics.evaluate(self.entries, points)
         scales = numerics.term_scale(self.entries, points)
         ranks = []
@@ -534,6 +550,7 @@ def _scan(
     scan: CpuBudget,
     record: Callable[[RankUse, sympy.Symbol, sympy.Expr, int | None, sympy.Expr | None], None],
     compiled: Numerics | None = None,
+    starts: Sequence[np.ndarray] = (),
 ) -> str:
     """The numeric road of a block not searched symbolically (over the budget, or too large); returns the note.
 
@@ -544,7 +561,7 @@ def _scan(
     params = sorted(use.block_symbols() & set(space.parameters), key=lambda s: s.name)
     scanned: list[str] = []
     left_out: list[str] = []
-    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time, compiled)
+    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time, compiled, starts)
     for p in params:
         done = True
         for value in (v for v in SCAN_VALUES if admissible(p, v)):

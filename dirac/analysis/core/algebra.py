@@ -17,7 +17,7 @@ from sympy.core.add import _addsort
 from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 
-__all__ = ["NotInRing", "tidy", "prints_shorter", "present_in_order", "ring_value"]
+__all__ = ["NotInRing", "tidy", "prints_shorter", "printed", "printed_at_most", "present_in_order", "ring_value"]
 
 
 class NotInRing(Exception):
@@ -52,23 +52,48 @@ def prints_shorter(expr: sympy.Expr, limit: int) -> bool:
 
     if walk(expr) >= limit:
         return False
-    longest = _printed_at_most(expr, limit)
+    longest = printed_at_most(expr, limit)
     if longest is not None and longest < limit:
         return True
-    return len(str(expr)) < limit
+    return len(printed(expr)) < limit
 
 
-#: characters the str printer adds per argument (" + ", "*", "**", "/", "-") and per node
-#: (parentheses, "sqrt(", "1/"): generous bounds for sums, products and powers of atoms
-_PER_ARGUMENT, _PER_NODE = 8, 8
+#: texts of the expressions printed last (:func:`printed`), at most PRINTED_KEPT of them
+_PRINTED: dict[sympy.Basic, str] = {}
+PRINTED_KEPT = 256
 
 
-def _printed_at_most(expr: sympy.Expr, limit: int) -> int | None:
-    """An upper bound of ``len(str(expr))`` for sums, products and powers of atoms, else ``None``.
+def printed(expr: sympy.Basic) -> str:
+    """``str(expr)``, remembered for the last ``PRINTED_KEPT`` expressions printed.
 
-    Atoms count their own printed length; every sum, product or power adds at most
-    ``_PER_ARGUMENT`` characters per argument and ``_PER_NODE`` for itself. ``None`` for
-    any other node (a function, a relation) or once the bound reaches ``limit``.
+    A multiplier of (78) is printed to measure it (:func:`prints_shorter`, before its
+    denominators are searched) and again in the report: the second time is a lookup.
+    """
+    text = _PRINTED.get(expr)
+    if text is None:
+        text = str(expr)
+        if len(_PRINTED) >= PRINTED_KEPT:
+            _PRINTED.clear()
+        _PRINTED[expr] = text
+    return text
+
+
+#: characters sympy's str printer adds, at most, around the arguments of a node: (per node, per argument).
+#: A sum: " + " or " - " between terms (a term's own "-" becomes the separator's) and "(...)"
+#: around a term; a product: "*" or "/" between factors (a fraction ``p/q`` is counted with its "/"),
+#: "(...)" around a factor, and at most a sign, a "1" over an empty numerator and "(...)" around
+#: a denominator of several factors; a power: "**", "(...)" around base and exponent, or
+#: "sqrt(...)", "1/sqrt(...)", "1/" (a negative exponent inside a product prints shorter).
+#: Checked against the printer on random trees in tests/analysis/core/test_printed_bound.py.
+_EXTRA = {"Add": (0, 5), "Mul": (5, 3), "Pow": (8, 0)}
+
+
+def printed_at_most(expr: sympy.Expr, limit: int) -> int | None:
+    """An upper bound of ``len(str(expr))`` (in any order of the terms) for sums, products and powers of atoms, else ``None``.
+
+    Atoms count their own printed length; every sum, product or power adds at most the
+    characters :data:`_EXTRA` allows for itself and its arguments. ``None`` for any other
+    node (a function, a relation) or once the bound reaches ``limit``.
     """
     sizes: dict[sympy.Basic, int] = {}
 
@@ -81,12 +106,13 @@ def _printed_at_most(expr: sympy.Expr, limit: int) -> int | None:
                 return None
             hit = len(str(node))
         elif node.is_Add or node.is_Mul or node.is_Pow:
-            hit = _PER_NODE
+            per_node, per_argument = _EXTRA["Add" if node.is_Add else "Mul" if node.is_Mul else "Pow"]
+            hit = per_node
             for a in node.args:
                 size = walk(a)
                 if size is None:
                     return None
-                hit += size + _PER_ARGUMENT
+                hit += size + per_argument
                 if hit >= limit:
                     return None
         else:

@@ -18,23 +18,33 @@ Dynamics", Sect. 4.3 on points where ranks change):
   expressions of the analysis (the multipliers, the velocities) divide by zero. It is
   reported (:class:`SingularLocus`), never passed over.
 
-:func:`singular_loci` tests each recorded divisor against ``S`` by sampling: a
-Gauss–Newton projection onto ``S`` and ``f = 0`` together
+:func:`singular_loci` first asks for a proof that a divisor never vanishes on ``S``:
+an exact identity ``f = c + sum a_i phi_i`` with a constant ``c != 0``
+(:func:`constant_on_surface`), or ``f = c det M`` with a Gram matrix ``M^T M`` constant on
+``S`` and of nonzero determinant, so that ``f^2`` is a nonzero constant there
+(:func:`square_on_surface`: ``det R = +-1`` on ``R^T R = 1``). Without a proof it tests the
+divisor by sampling: a Gauss–Newton projection onto ``S`` and ``f = 0`` together
 (:meth:`~dirac.analysis.core.numeric.Numerics.surface_points`) finds a point of the
 locus, or shows none nearby in its attempts.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from math import factorial
 
 import sympy
+from sympy.polys.matrices import DomainMatrix
 
 from dirac.analysis.core.algebra import prints_shorter
+from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.errors import AnalysisError
 
-__all__ = ["Division", "SingularLocus", "denominator_factors", "singular_loci", "constant_on_surface", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR"]
+__all__ = [
+    "Division", "SingularLocus", "denominator_factors", "singular_loci", "constant_on_surface", "square_on_surface",
+    "determinant_grid", "nonvanishing_on", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR",
+]
 
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
 DIVISOR_TEXT_LIMIT = 4000
@@ -100,13 +110,17 @@ def _never_zero(factor: sympy.Expr) -> bool:
     return bool(factor.is_positive or factor.is_negative or (factor.func == sympy.exp))
 
 
-def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
+def denominator_factors(
+    expr: sympy.Expr, variables: Sequence[sympy.Symbol], settled: Callable[[sympy.Expr], bool] | None = None
+) -> list[sympy.Expr]:
     """The distinct irreducible factors of the denominator of ``expr`` that depend on the ``variables``.
 
     The bases of the negative powers in ``expr`` (its denominators) are factored
     (``sympy.factor_list``; ``sin(theta)`` counts as a factor of ``sin(theta)**2``); a
     factor that a numerator would cancel is kept (no gcd is taken). Factors without real zeros and numbers are left out; an
-    expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``.
+    expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``. A denominator for which
+    ``settled`` is true (proven nonzero on the surface, :func:`nonvanishing_on`) is not factored:
+    a factor of a function that never vanishes there never vanishes there either.
     """
     names = set(variables)
     if not prints_shorter(expr, DIVISOR_TEXT_LIMIT) or not (expr.free_symbols & names):  # size first: a shared tree is huge
@@ -115,6 +129,8 @@ def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> 
         node.base for node in sympy.preorder_traversal(expr)
         if isinstance(node, sympy.Pow) and node.exp.is_negative and node.base.free_symbols & names
     ))  # every denominator of the tree, in one walk (no gcd: a factor the numerator cancels is kept)
+    if settled is not None:
+        bases = [b for b in bases if not settled(b)]
     found: list[sympy.Expr] = []
     for base in bases:
         try:
@@ -133,11 +149,15 @@ def denominator_factors(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> 
     return out
 
 
-def divisions(exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol]) -> list[Division]:
-    """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`)."""
+def divisions(
+    exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol],
+    settled: Callable[[sympy.Expr], bool] | None = None,
+) -> list[Division]:
+    """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`; ``settled``
+    names denominators proven nonzero on the surface, which are not factored)."""
     found: dict[sympy.Expr, Division] = {}
     for e in exprs:
-        for f in denominator_factors(sympy.sympify(e), variables):
+        for f in denominator_factors(sympy.sympify(e), variables, settled):
             found.setdefault(f, Division(f, stage, what))
     return list(found.values())
 
@@ -170,7 +190,9 @@ def locus_equation(divisor: sympy.Expr, fixed: dict[sympy.Symbol, sympy.Expr]) -
     return f"{reduced} = 0"
 
 
-def constant_on_surface(divisor: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> sympy.Expr | None:
+def constant_on_surface(
+    divisor: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict | None = None
+) -> sympy.Expr | None:
     """The value ``c`` when ``divisor = c + sum_i a_i phi_i`` exactly, with numbers or parameters ``a_i``, ``c``; else None.
 
     Then ``divisor = c`` on the whole surface ``phi_i = 0``: a certificate, not a
@@ -179,32 +201,175 @@ def constant_on_surface(divisor: sympy.Expr, surface: Sequence[sympy.Expr], vari
     each is decided here by a linear system in the coefficients of the monomials,
     instead of a search for a point where it vanishes. Only the polynomial constraints
     in the divisor's variables are used; ``None`` says nothing (the search decides).
+    ``memo`` (:func:`~dirac.analysis.core.phase_space.free_symbols_of`) keeps the free
+    symbols of the constraints between calls: a long constraint is walked once.
     """
     own = sorted(divisor.free_symbols & set(variables), key=lambda s: s.name)
     if not own:
         return None
-    used = [c for c in surface if c.free_symbols & set(variables) and c.free_symbols & set(variables) <= set(own)]
+    names = set(variables)
+    memo = {} if memo is None else memo
+    used = [c for c in surface if (inside := free_symbols_of([c], memo) & names) and inside <= set(own)]
     if not used:
         return None
     try:
-        polys = [sympy.Poly(e, *own) for e in (divisor, *used)]
+        polys, _ = sympy.parallel_poly_from_expr([divisor, *used], *own)
     except (sympy.PolynomialError, sympy.GeneratorsError):
         return None
-    if any(not p.domain.is_Field and not p.domain.is_Ring for p in polys):
+    domain = polys[0].domain
+    if not domain.is_Field and not domain.is_Ring or domain.is_EX or domain.is_EXRAW:
         return None
-    a = sympy.symbols(f"a_0:{len(used)}", cls=sympy.Dummy)
-    c = sympy.Dummy("c")
-    rest = polys[0] - sum((ak * p for ak, p in zip(a, polys[1:])), sympy.Poly(0, *own)) - c
-    equations = rest.coeffs()
-    if len(equations) > CONSTANT_TEST_EQUATIONS:
+    # divisor = c + sum_i a_i phi_i, coefficient by coefficient: one row per monomial, unknowns (c, a_1, ...)
+    monomials = sorted({m for p in polys for m in p.monoms()})
+    if len(monomials) > CONSTANT_TEST_EQUATIONS:
         return None
-    solution = sympy.linsolve(equations, [c, *a])
-    if not solution:
-        return None
-    value = next(iter(solution))[0]
-    if value.free_symbols & set(a):  # c not fixed by the identity
-        return None
+    field = domain.get_field()
+    constant = (0,) * len(own)
+    coefficients = [p.as_dict(native=True) for p in polys]
+    rows = [
+        [field.one if m == constant else field.zero, *(field.convert(c.get(m, domain.zero), domain) for c in coefficients[1:]),
+         field.convert(coefficients[0].get(m, domain.zero), domain)]
+        for m in monomials
+    ]
+    reduced, pivots = DomainMatrix(rows, (len(rows), len(used) + 2), field).rref()
+    if len(used) + 1 in pivots or 0 not in pivots:
+        return None  # no such identity (inconsistent), or c not fixed by it
+    row = reduced.to_Matrix().row(pivots.index(0))
+    if any(row[j] != 0 for j in range(1, len(used) + 1) if j not in pivots):
+        return None  # c depends on a free coefficient: not fixed by the identity
+    value = row[len(used) + 1]
+    return _exact_value(value)
+
+
+def _exact_value(value: sympy.Expr) -> sympy.Expr:
+    """``value`` in a form whose comparison with 0 is exact: a number, or a cancelled rational function
+    of the parameters (``cancel`` is 0 exactly when the function is); anything else is simplified."""
+    if value.is_Rational:
+        return value
+    if value.is_rational_function():
+        return sympy.cancel(value)
     return sympy.simplify(value)
+
+
+#: largest size ``k`` of a ``k x k`` matrix that :func:`square_on_surface` recognises a divisor as the determinant of
+GRID_SIZE = 4
+
+
+def determinant_grid(divisor: sympy.Expr, variables: Sequence[sympy.Symbol]) -> tuple[sympy.Matrix, sympy.Expr] | None:
+    """``(M, c)`` with ``divisor = c det M`` exactly, ``M`` a ``k x k`` matrix of distinct variables; else None.
+
+    The ``k^2`` variables of a determinant of distinct variables fall into rows and
+    columns: two of them share a row or a column exactly when no term of ``det M``
+    holds both (each of its ``k!`` terms takes one entry of every row and of every
+    column). The grid read off the terms is then checked by expanding ``c det M``
+    against the divisor, so a divisor that only looks like a determinant is refused.
+    """
+    own = sorted(divisor.free_symbols & set(variables), key=lambda s: s.name)
+    k = int(round(len(own) ** 0.5))
+    if k < 2 or k > GRID_SIZE or k * k != len(own):
+        return None
+    try:
+        poly = sympy.Poly(divisor, *own)
+    except (sympy.PolynomialError, sympy.GeneratorsError):
+        return None
+    terms = poly.terms()
+    if len(terms) != factorial(k) or any(sum(m) != k or max(m) != 1 for m, _ in terms):
+        return None
+    together = [{own[i] for i, e in enumerate(m) if e} for m, _ in terms]
+
+    def apart(x: sympy.Symbol, y: sympy.Symbol) -> bool:  # same row or same column
+        return not any(x in t and y in t for t in together)
+
+    first = own[0]
+    mates = [v for v in own[1:] if apart(first, v)]
+    if len(mates) != 2 * (k - 1):
+        return None
+    row = [first, mates[0], *(v for v in mates[1:] if apart(mates[0], v))]
+    column = [first, *(v for v in mates if v not in row)]
+    if len(row) != k or len(column) != k:
+        return None
+    grid = [[sympy.S.Zero] * k for _ in range(k)]
+    for j in range(k):
+        grid[0][j] = row[j]
+    for i in range(1, k):
+        grid[i][0] = column[i]
+        for j in range(1, k):
+            cell = [v for v in own if v not in row and v not in column and apart(v, row[j]) and apart(v, column[i])]
+            if len(cell) != 1:
+                return None
+            grid[i][j] = cell[0]
+    M = sympy.Matrix(grid)
+    det = sympy.Poly(M.det(method="berkowitz"), *own)
+    monomial, coefficient = terms[0]
+    c = coefficient / det.coeff_monomial(monomial) if det.coeff_monomial(monomial) != 0 else None
+    if c is None or not sympy.Poly(c * det.as_expr() - divisor, *own).is_zero:
+        return None
+    return M, c
+
+
+def square_on_surface(
+    divisor: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict | None = None
+) -> sympy.Expr | None:
+    """The value ``s`` of ``divisor^2`` on the whole surface, proven by the Gram identity; else None.
+
+    When ``divisor = c det M`` (:func:`determinant_grid`) and every entry of the Gram
+    matrix ``G = M^T M`` (or ``M M^T``) is a constant ``K_ij`` on the surface
+    (:func:`constant_on_surface`, an exact identity ``G_ij = K_ij + sum a phi``), then
+    ``divisor^2 = c^2 det(M^T M) = c^2 det K`` at every point of the surface. For the
+    rotation-matrix Lagrangians ((78), (228)) the legendre map divides by ``det R``, and
+    ``R^T R = 1`` gives ``det(R)^2 = 1``: ``det R = +-1`` never vanishes there (a proof, where
+    ``det R`` itself is no constant combination of the constraints). ``None`` says nothing
+    (the search decides).
+    """
+    found = determinant_grid(divisor, variables)
+    if found is None:
+        return None
+    M, c = found
+    memo = {} if memo is None else memo
+    own = set(M)
+    names = set(variables)
+    surface = [e for e in surface if free_symbols_of([e], memo) & names <= own]  # the Gram entries use no other constraint
+    for gram in (M.T * M, M * M.T):
+        K = _constant_matrix(gram, surface, variables, memo)
+        if K is not None:
+            return _exact_value(c**2 * K.det(method="berkowitz"))
+    return None
+
+
+def _constant_matrix(
+    G: sympy.Matrix, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict
+) -> sympy.Matrix | None:
+    """The symmetric matrix ``K`` of the values of ``G`` on the surface (:func:`constant_on_surface`), or None."""
+    k = G.shape[0]
+    K = sympy.zeros(k, k)
+    for i in range(k):
+        for j in range(i, k):
+            value = constant_on_surface(sympy.expand(G[i, j]), surface, variables, memo)
+            if value is None:
+                return None
+            K[i, j] = K[j, i] = value
+    return K
+
+
+def nonvanishing_on(surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> Callable[[sympy.Expr], bool]:
+    """``f -> bool``: whether ``f`` is proven nonzero on the whole surface ``surface = 0``.
+
+    A proof is :func:`constant_on_surface` or :func:`square_on_surface` with a value that
+    is not 0 (at generic parameter values, as :func:`singular_loci` reads them); ``False``
+    says only that there is no proof. Answers are remembered per expression.
+    """
+    memo: dict = {}
+    answers: dict[sympy.Expr, bool] = {}
+
+    def settled(f: sympy.Expr) -> bool:
+        if f not in answers:
+            value = constant_on_surface(f, surface, variables, memo)
+            if value is None:
+                value = square_on_surface(f, surface, variables, memo)
+            answers[f] = value is not None and value != 0
+        return answers[f]
+
+    return settled
 
 
 #: largest number of monomial equations :func:`constant_on_surface` solves (above it, the search decides)
@@ -229,10 +394,14 @@ def singular_loci(
     for d in sorted(found, key=lambda d: d.stage):
         seen.setdefault(d.divisor, d)
     out = []
+    memo: dict = {}  # free symbols of the constraints, walked once for all the divisors
     for d in seen.values():
-        value = constant_on_surface(d.divisor, surface, variables)
+        value = constant_on_surface(d.divisor, surface, variables, memo)
         if value is not None and value != 0:
             continue  # a constant on the whole surface (nonzero at generic parameter values, as the search samples): no locus
+        square = square_on_surface(d.divisor, surface, variables, memo) if value is None else None
+        if square is not None and square != 0:
+            continue  # divisor^2 is a nonzero constant on the whole surface (det R = +-1 on R^T R = 1): no locus
         try:
             numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:

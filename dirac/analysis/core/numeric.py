@@ -183,6 +183,9 @@ def independent_rows(
     return chosen
 
 
+#: evaluation plans (and term splits) a :class:`Numerics` keeps (:meth:`Numerics.function`); past it, plans are made anew
+PLAN_CACHE = 4096
+
 #: relative size below which an expression assumed nonzero counts as vanishing at a point
 AVOID_TOLERANCE = 1e-6
 
@@ -219,6 +222,10 @@ class Numerics:
         self.rng = np.random.default_rng(seed)
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
+        #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
+        self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
+        self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
+        self._jacobians: dict[tuple, _DenseJacobian] = {}
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
@@ -242,9 +249,24 @@ class Numerics:
 
     # ------------------------------------------------------------------ compiled functions
     def function(self, exprs: Sequence[sympy.Expr], key: object | None = None) -> Callable[[np.ndarray], np.ndarray]:
-        """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches)."""
-        zero = sympy.S.Zero  # most entries of a large gradient or bracket matrix: no conversion
+        """Compile ``exprs`` into ``f(z) -> array`` (expressions compiled once, in batches).
+
+        The evaluation plan of a list of expressions met before (the same expressions in
+        the same order, as the projections onto one surface ask again and again) is
+        reused: only the values are computed again.
+        """
         exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        plan_key = tuple(exprs)
+        fn = self._plans.get(plan_key)
+        if fn is None:
+            fn = self._plan(exprs)
+            if len(self._plans) < PLAN_CACHE:
+                self._plans[plan_key] = fn
+        return fn
+
+    def _plan(self, exprs: list[sympy.Expr]) -> Callable[[np.ndarray], np.ndarray]:
+        """``f(z) -> array`` of ``exprs``: the compiled batches' values gathered by index arrays."""
+        zero = sympy.S.Zero  # most entries of a large gradient or bracket matrix: no conversion
         self._compile([e for e in exprs if e is not zero])
         # (batch, index in it) of a compiled expression, (None, value) of a number; every
         # expression that is not a number is in the index after ``_compile`` (``is_number``
@@ -253,11 +275,18 @@ class Numerics:
         plan: list[tuple[int | None, Any]] = [
             (None, 0.0) if e is zero else (index.get(e) or (None, float(e))) for e in exprs
         ]
-        batches = sorted({b for b, _ in plan if b is not None})
+        constant = np.array([0.0 if b is not None else i for b, i in plan], dtype=float)
+        gathers = [
+            (b, np.array([k for k, (c, _) in enumerate(plan) if c == b], dtype=np.intp),
+             np.array([i for c, i in plan if c == b], dtype=np.intp))
+            for b in sorted({b for b, _ in plan if b is not None})
+        ]
 
         def fn(z: np.ndarray) -> np.ndarray:
-            got = {b: self._call(b, z) for b in batches}
-            return np.array([got[b][i] if b is not None else i for b, i in plan], dtype=float)
+            out = constant.copy()
+            for b, where, picks in gathers:
+                out[where] = self._call(b, z)[picks]
+            return out
 
         return fn
 
@@ -276,10 +305,17 @@ class Numerics:
         for i, e in enumerate(missing):
             self._index[e] = (batch, i)
 
-    def _call(self, batch: int, z: np.ndarray) -> list[float]:
+    def _call(self, batch: int, z: np.ndarray) -> np.ndarray:
+        """The values of one compiled batch at ``z`` (real parts of complex values)."""
         with np.errstate(all="ignore"):
             out = self._batches[batch](*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
-        return [complex(v).real if isinstance(v, complex) else float(v) for v in out]
+        try:
+            values = np.asarray(out)
+            if values.dtype.kind == "c":  # a complex value (a root of a negative number): its real part
+                values = values.real
+            return values.astype(float)
+        except (TypeError, ValueError):
+            return np.array([complex(v).real if isinstance(v, complex) else float(v) for v in out], dtype=float)
 
     def evaluate(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray] | np.ndarray) -> np.ndarray:
         """Values of ``exprs`` at each point: array of shape ``(len(points), len(exprs))``."""
@@ -297,17 +333,23 @@ class Numerics:
 
     def term_scale(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
         """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests)."""
-        terms: list[sympy.Expr] = []
-        owner: list[int] = []
-        for k, e in enumerate(exprs):
-            e = sympy.sympify(e)
-            parts = e.args if isinstance(e, sympy.Add) else (e,)
-            terms.extend(parts)
-            owner.extend([k] * len(parts))
+        exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        split = self._terms.get(tuple(exprs))
+        if split is None:
+            terms: list[sympy.Expr] = []
+            owner: list[int] = []
+            for k, e in enumerate(exprs):
+                parts = e.args if isinstance(e, sympy.Add) else (e,)
+                terms.extend(parts)
+                owner.extend([k] * len(parts))
+            split = (terms, np.asarray(owner, dtype=np.intp))
+            if len(self._terms) < PLAN_CACHE:
+                self._terms[tuple(exprs)] = split
+        terms, owners = split
         values = np.abs(self.evaluate(terms, points)) if terms else np.zeros((len(points), 0))
         scale = np.ones((len(points), len(exprs)))
         # unbuffered, in the order of the terms: the same sums as adding them one by one
-        np.add.at(scale.T, np.asarray(owner, dtype=np.intp), values.T)
+        np.add.at(scale.T, owners, values.T)
         return scale
 
     def weakly_zero(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
@@ -444,8 +486,14 @@ class Numerics:
         m = len(constraints)
         jacobian: _DenseJacobian | SparseJacobian | None = None
         if m:  # a large system: sparse Jacobian, steps and rank tests; the same rules otherwise
-            jacobian = (SparseJacobian(self, constraints, REGULAR_TOLERANCE, SINGULAR_GRADIENT) if n >= LARGE_SYSTEM
-                        else _DenseJacobian(self, constraints))
+            if n >= LARGE_SYSTEM:
+                jacobian = SparseJacobian(self, constraints, REGULAR_TOLERANCE, SINGULAR_GRADIENT)
+            else:  # the same surface is projected onto again and again: its Jacobian is built once
+                jacobian = self._jacobians.get(tuple(constraints))
+                if jacobian is None:
+                    jacobian = _DenseJacobian(self, constraints)
+                    if len(self._jacobians) < PLAN_CACHE:
+                        self._jacobians[tuple(constraints)] = jacobian
         fixed = dict(fixed or {})
         free = np.array([i for i in range(n) if i not in fixed], dtype=int)
         points: list[np.ndarray] = []
