@@ -28,6 +28,7 @@ from dirac.analysis.core.divisors import (
     MULTIPLIERS_SINGULAR,
     Division,
     SingularLocus,
+    Unsearched,
     divisions,
     nonvanishing_on,
     singular_loci,
@@ -285,6 +286,7 @@ class ConstraintAnalysis:
         self.components: list = []
         self._generic_analysis: ConstraintAnalysis | None = None
         self._singular_loci: tuple[SingularLocus, ...] | None = None
+        self._unsearched: tuple[Unsearched, ...] = ()
         self._seed = seed
         if self.parameters:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
@@ -308,25 +310,37 @@ class ConstraintAnalysis:
             self._singular_loci = self._find_singular_loci()
         return self._singular_loci
 
+    @property
+    def singular_loci_unsearched(self) -> tuple[Unsearched, ...]:
+        """The expressions of the analysis too long to search for divisions by zero
+        (:class:`~dirac.analysis.core.divisors.Unsearched`, one record per place and stage; empty
+        when every expression was searched): a division by zero in them is neither among
+        :attr:`singular_loci` nor ruled out, and the report says so."""
+        _ = self.singular_loci
+        return self._unsearched
+
     def _find_singular_loci(self) -> tuple[SingularLocus, ...]:
         """The divisions recorded and found in the results, tested against the surface (:attr:`singular_loci`)."""
         variables = self._space.variables
         legendre = self._legendre
         surface = [*self.constraints, *self.reducible_constraints]
         settled = nonvanishing_on(surface, variables)  # denominators proven nonzero on the surface are not factored
+        unsearched: list[Unsearched] = list(self._chain.unsearched)
         found: list[Division] = divisions(
-            [*legendre.velocity_solution.values(), self.canonical_hamiltonian], 1, LEGENDRE_SINGULAR, variables, settled
+            [*legendre.velocity_solution.values(), self.canonical_hamiltonian], 1, LEGENDRE_SINGULAR, variables, settled,
+            unsearched=unsearched,
         )
         found += self._chain.divisions
         solution = self.multiplier_solution
         if self._chain.multiplier_solution is not None and self.constraints:
             exprs = [*solution.particular.values(), *(e for vec in solution.null_vectors for e in vec.values())]
-            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables, settled)
+            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables, settled, unsearched=unsearched)
         if 0 < len(self.second_class) <= SMALL_DETERMINANT:
             C = bracket_matrix(self._space, self.second_class)
             found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
                                "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
-                               "constraints drops rank)", variables)
+                               "constraints drops rank)", variables, unsearched=unsearched)
+        self._unsearched = tuple(unsearched)
         if not found:
             return ()
         numerics = Numerics(self._space, self._generic, seed=self._seed + 1, time=self.time)

@@ -206,7 +206,10 @@ def to_json(analysis: AnalysisResult) -> dict:
     ``gauge_conditions``; ``forces`` (coordinate name -> the generalized force ``Q_r`` in
     phase-space variables; ``{}`` when none); ``singular_loci`` (one ``{"expression", "where", "stage",
     "what"}`` per locus of the surface where an expression of the analysis divides by zero,
-    :class:`~dirac.analysis.core.divisors.SingularLocus`; ``[]`` when none).
+    :class:`~dirac.analysis.core.divisors.SingularLocus`; ``[]`` when none);
+    ``singular_loci_unsearched`` (one sentence per place of the analysis whose expressions were
+    too long to search for divisions by zero, :class:`~dirac.analysis.core.divisors.Unsearched`;
+    ``[]`` when everything was searched).
     """
     multipliers, solution, definitions = _multiplier_texts(analysis)
     gauge = analysis.gauge_structure
@@ -246,6 +249,7 @@ def to_json(analysis: AnalysisResult) -> dict:
         "gauge_conditions": list(analysis.gauge_conditions),
         "forces": {name: expression_text(Q) for name, Q in getattr(analysis, "forces", {}).items()},
         "singular_loci": [locus.to_json() for locus in getattr(analysis, "singular_loci", ())],
+        "singular_loci_unsearched": [str(u) for u in getattr(analysis, "singular_loci_unsearched", ())],
     }
     if definitions:
         out["multiplier_subexpressions"] = definitions
@@ -400,7 +404,8 @@ def to_text(analysis: AnalysisResult) -> str:
 
 def _singular_lines(a: AnalysisResult) -> list[str]:
     """``singular locus: x = 0 (divisor 3*x - 4*z, stage 2): the multiplier solution divides by zero`` per locus."""
-    return [f"singular locus: {locus}" for locus in getattr(a, "singular_loci", ())]
+    return [f"singular locus: {locus}" for locus in getattr(a, "singular_loci", ())] + [
+        f"singular loci: {u}" for u in getattr(a, "singular_loci_unsearched", ())]
 
 
 def _gauge_latex_rows(a: AnalysisResult) -> list[str]:

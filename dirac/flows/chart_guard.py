@@ -161,7 +161,7 @@ def _locus(det: Any, q: list[Any], factors: Callable[[Any, list[Any]], list[Any]
 def _build(mechanics: Any) -> ChartGuard | None:
     import sympy  # not at import: a run without a guard never needs it
 
-    from dirac.analysis.core.divisors import denominator_factors
+    from dirac.analysis.core.divisors import denominator_factors, too_long_to_search
     from dirac.codegen.scalar_backend import scalar_function
 
     symbolic = mechanics.symbolic
@@ -172,6 +172,10 @@ def _build(mechanics: Any) -> ChartGuard | None:
     W = sympy.Matrix(W)
     det = W.det(method="berkowitz")
     locus = _locus(det, q, denominator_factors)
+    text = " and ".join(f"{f} = 0" for f in locus)
+    if not locus and (too_long_to_search(1 / det, q) or too_long_to_search(sympy.expand(det), q)):
+        # too long to factor: det W itself guards its own zero set (the same loci, not named factor by factor)
+        locus, text = [det], "det W = 0 (det W is too long to factor into named loci)"
     if not locus:
         return None  # det W constant or never zero: nothing to guard
     params = list(symbolic.get("parameters") or ())
@@ -184,7 +188,7 @@ def _build(mechanics: Any) -> ChartGuard | None:
         compiled = scalar_function(arguments, exprs)
     except Exception:  # an unusual function in W: no guard (the run is as before)  # noqa: BLE001
         return None
-    return ChartGuard(compiled, " and ".join(f"{f} = 0" for f in locus), time is not None, mechanics.params)
+    return ChartGuard(compiled, text, time is not None, mechanics.params)
 
 
 def chart_guard(mechanics: Any) -> ChartGuard | None:

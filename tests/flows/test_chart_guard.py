@@ -138,3 +138,18 @@ def test_the_triple_pendulum_keeps_its_determinant_as_the_locus():
         det = 6 - 4 * x**2 - 2 * y**2 - 3 * z**2 + 4 * x * y * z
         value = float(factor.subs({a: angles[0], b: angles[1], c: angles[2]}))
         assert abs(value) == pytest.approx(abs(det), rel=1e-12)
+
+
+def test_a_det_w_too_long_to_factor_still_guards_its_zero_set(monkeypatch):
+    """With the factoring limit set below the length of ``det W = A B C sin(theta)^2`` (module
+    docstring), no factor is named, and the guard used to be dropped without a word. It now
+    guards ``det W`` itself: the same zero set, distance ``|det W| / |grad det W|`` to first
+    order; by hand ``sin(theta)^2 / |2 sin(theta) cos(theta)| = |tan(theta)| / 2``."""
+    from dirac.analysis.core import divisors
+
+    monkeypatch.setattr(divisors, "DIVISOR_TEXT_LIMIT", 2)
+    guard = chart_guard(_euler_top().mechanics)
+    assert guard is not None and guard.locus.startswith("det W = 0")
+    for theta in (0.4, 1e-3, -0.2):
+        q = np.array([[0.3, theta, 1.1]])
+        assert guard.distance(q) == pytest.approx(abs(np.tan(theta)) / 2, rel=1e-12)

@@ -55,7 +55,7 @@ from dirac.analysis.classes.multiplier_solution import (
     unsolved_multipliers,
 )
 from dirac.analysis.core.algebra import prints_shorter, tidy
-from dirac.analysis.core.divisors import Division
+from dirac.analysis.core.divisors import Division, Unsearched
 from dirac.analysis.core.divisors import divisions as divisions_of
 from dirac.analysis.core.linear_solve import SingularAtSamplePoint, weak_solve
 from dirac.analysis.core.numeric import (
@@ -180,6 +180,8 @@ class ConstraintChain:
     hessian_rank: int = 0
     #: divisions by functions that are no branch: the elimination of multipliers at a stage (:meth:`_cleared`)
     divisions: list[Division] = field(default_factory=list)
+    #: coefficients of those eliminations too long to search for divisions by zero (said in the report)
+    unsearched: list[Unsearched] = field(default_factory=list)
     #: the rank decisions of the stages before the last: ``(s, n, rows, cols)`` for each stage ``s`` that added
     #: constraints, the pivot rows and multiplier columns of ``{Phi_a, phi_k}`` over its first ``n`` constraints
     #: (stages ``1..s``); searched for special parameter values (:mod:`dirac.analysis.chain.special_values`)
@@ -992,7 +994,8 @@ class ConstraintChain:
             coefficients = self._coefficients(row, used, constraints, P, Q, A_num) if used and self._varying.get(row) else []
         stage = len(self.stages) + 1
         branches = []
-        for division in divisions_of(coefficients, stage, "the elimination of multipliers divides by zero", self.phase_space.variables):
+        for division in divisions_of(coefficients, stage, "the elimination of multipliers divides by zero", self.phase_space.variables,
+                                     unsearched=self.unsearched):
             f = division.divisor
             key = (f, len(constraints))  # one verdict per divisor and surface
             if key not in self._judged:

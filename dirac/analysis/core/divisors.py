@@ -42,8 +42,9 @@ from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.errors import AnalysisError
 
 __all__ = [
-    "Division", "SingularLocus", "denominator_factors", "singular_loci", "constant_on_surface", "square_on_surface",
-    "determinant_grid", "nonvanishing_on", "LEGENDRE_SINGULAR", "MULTIPLIERS_SINGULAR",
+    "Division", "SingularLocus", "Unsearched", "too_long_to_search", "denominator_factors", "singular_loci",
+    "constant_on_surface", "square_on_surface", "determinant_grid", "nonvanishing_on", "LEGENDRE_SINGULAR",
+    "MULTIPLIERS_SINGULAR",
 ]
 
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
@@ -151,15 +152,51 @@ def denominator_factors(
 
 def divisions(
     exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol],
-    settled: Callable[[sympy.Expr], bool] | None = None,
+    settled: Callable[[sympy.Expr], bool] | None = None, *, unsearched: list[Unsearched] | None = None,
 ) -> list[Division]:
     """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`; ``settled``
-    names denominators proven nonzero on the surface, which are not factored)."""
+    names denominators proven nonzero on the surface, which are not factored).
+
+    An expression in the ``variables`` too long to search (:func:`too_long_to_search`) gives
+    no division; ``unsearched`` (when given) then receives one :class:`Unsearched` record of
+    how many there were, so that the caller can say what was not searched.
+    """
     found: dict[sympy.Expr, Division] = {}
+    skipped = 0
     for e in exprs:
-        for f in denominator_factors(sympy.sympify(e), variables, settled):
+        e = sympy.sympify(e)
+        if too_long_to_search(e, variables):
+            skipped += 1
+            continue
+        for f in denominator_factors(e, variables, settled):
             found.setdefault(f, Division(f, stage, what))
+    if skipped and unsearched is not None:
+        unsearched.append(Unsearched(skipped, stage, what))
     return list(found.values())
+
+
+def too_long_to_search(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> bool:
+    """Whether ``expr`` depends on the ``variables`` and prints longer than ``DIVISOR_TEXT_LIMIT``
+    characters: :func:`denominator_factors` gives ``[]`` for it without looking at its denominators."""
+    return not prints_shorter(expr, DIVISOR_TEXT_LIMIT) and bool(free_symbols_of([expr]) & set(variables))
+
+
+@dataclass(frozen=True)
+class Unsearched:
+    """Expressions of the analysis not searched for divisions by zero (too long to factor).
+
+    A division by zero in them is neither found nor ruled out: the report says so
+    (``singular loci: not searched ...``) instead of passing over it.
+    """
+
+    count: int
+    stage: int
+    what: str
+
+    def __str__(self) -> str:
+        return (f"not searched in {self.count} expression{'s' if self.count != 1 else ''} of stage {self.stage} "
+                f"(longer than {DIVISOR_TEXT_LIMIT} characters, too long to factor): whether {self.what} on part of "
+                "the surface is neither found nor ruled out")
 
 
 def fixed_values(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> dict[sympy.Symbol, sympy.Expr]:

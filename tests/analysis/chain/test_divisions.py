@@ -131,3 +131,31 @@ def test_a_regular_system_has_no_singular_locus():
         a = dirac.analyze(dirac.load_system("pendulum"))
     assert a.singular_loci == ()
     assert a.to_json()["singular_loci"] == []
+
+
+def test_expressions_too_long_to_factor_are_said_not_searched(monkeypatch):
+    """An expression longer than ``DIVISOR_TEXT_LIMIT`` characters is not factored (a gcd of a
+    large one costs more than the analysis). It used to give no division and no word: the
+    null vector of ``L = x y y' + x y z'`` (test above: it divides by ``x`` or ``y``, by hand)
+    would then have shown no singular locus at all. With the limit set below the length of
+    its components, the locus is not found, and the analysis says so in its result, its text
+    and its JSON."""
+    from dirac.analysis.core import divisors
+
+    monkeypatch.setattr(divisors, "DIVISOR_TEXT_LIMIT", 2)
+    L = dirac.Lagrangian.from_strings("null_vector", ["x", "y", "z"], "x*y*y_dot + x*y*z_dot", [])
+    a = dirac.analyze(L)
+    assert not [locus for locus in a.singular_loci if locus.what == MULTIPLIERS_SINGULAR]
+    [unsearched] = [u for u in a.singular_loci_unsearched if u.what == MULTIPLIERS_SINGULAR]
+    assert unsearched.stage == 1 and unsearched.count >= 1
+    assert "singular loci: not searched in" in a.to_text() and "neither found nor ruled out" in a.to_text()
+    assert any(MULTIPLIERS_SINGULAR in text for text in a.to_json()["singular_loci_unsearched"])
+
+
+def test_a_regular_system_searched_everything():
+    """The planar pendulum's expressions are short: every one was searched (nothing to say)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = dirac.analyze(dirac.load_system("pendulum"))
+    assert a.singular_loci_unsearched == ()
+    assert a.to_json()["singular_loci_unsearched"] == []
