@@ -3,6 +3,13 @@
 ``@pytest.mark.slow`` marks long stress runs. CI runs them too, in a bounded form: a slow
 test reads ``stress_scaling.stress_scale()`` and shortens itself unless
 ``DIRAC_FULL_STRESS=1``.
+
+The suite runs on every core with pytest-xdist (``-n auto --dist loadfile`` in
+pyproject.toml; ``pytest -n 0`` runs it in one process): the tests of one file go to one
+worker, so a module-scoped fixture (an analysis, compiled kernels) is still built once and
+the kernels a file's tests share are compiled once. The workers share the cache of
+generated code (``$DIRAC_CACHE_DIR``, else ``~/.cache/dirac/generated``) as a user's
+parallel runs do: every writer of it uses file names of its own before an atomic rename.
 """
 
 from __future__ import annotations

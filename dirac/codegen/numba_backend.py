@@ -30,6 +30,7 @@ import os
 import stat
 import sys
 import tempfile
+import threading
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -115,9 +116,11 @@ def cache_directory() -> Path:
                     warn(f"the cache folder of generated code {candidate} {problem}: not used, since loading code "
                          "from it would run what someone else wrote; set DIRAC_CACHE_DIR to a folder of your own")
                 continue
-            probe = candidate / ".write-test"
-            probe.write_text("ok")
-            probe.unlink()
+            # a probe of its own: with one shared name, a process or thread removing its probe
+            # would fail another's at the same moment, which then fell to the next candidate
+            handle, probe = tempfile.mkstemp(prefix=".write-test-", dir=candidate)
+            os.close(handle)
+            os.unlink(probe)
             return candidate
         except OSError:
             continue
@@ -199,7 +202,7 @@ def write_source(source: str) -> Path:
     """Write ``source`` to :func:`source_path` (unless the file holds it already); its path."""
     path = source_path(source)
     if not path.exists() or path.read_text(encoding="utf-8") != source:
-        temporary = path.with_suffix(f".{os.getpid()}.tmp")
+        temporary = path.with_suffix(f".{os.getpid()}-{threading.get_ident()}.tmp")  # one per writer: no shared file
         temporary.write_text(source, encoding="utf-8")
         os.replace(temporary, path)
     return path

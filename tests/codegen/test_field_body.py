@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 import sympy
@@ -9,6 +11,7 @@ import sympy
 from dirac.codegen.field_source import compile_vector_field, vector_field_source
 
 
+@functools.cache  # the chain of 24 links serves two tests
 def _chain(links: int) -> tuple[list[sympy.Symbol], sympy.Expr, list[sympy.Expr]]:
     """A planar chain of unit masses and unit rods hung at the origin, in Cartesian
     coordinates: ``H = |p|^2 / 2 + g sum y_i``, the rods ``chi_i = |r_i - r_{i-1}|^2 - 1``
@@ -26,13 +29,21 @@ def _chain(links: int) -> tuple[list[sympy.Symbol], sympy.Expr, list[sympy.Expr]
     return [*q, *p], H, [*rods, *velocities]
 
 
+@functools.cache  # differentiated and lambdified once per chain, not at every point
+def _gradients(z: tuple[sympy.Symbol, ...], H: sympy.Expr, constraints: tuple[sympy.Expr, ...]):
+    """``grad H`` and ``D = d(constraints)/dz`` as numpy functions of ``(*z, g)``."""
+    symbols = [*z, sympy.Symbol("g", real=True)]
+    return (sympy.lambdify(symbols, [sympy.diff(H, s) for s in z]),
+            sympy.lambdify(symbols, [[sympy.diff(c, s) for s in z] for c in constraints]))
+
+
 def _numpy_field(z: list[sympy.Symbol], H: sympy.Expr, constraints: list[sympy.Expr], point: np.ndarray,
                  g: float) -> np.ndarray:
     """``J grad H - J D^T C^{-1} D J grad H`` with numpy's dense solve (the definition (240))."""
     n = len(z) // 2
-    symbols = [*z, sympy.Symbol("g", real=True)]
-    grad = np.array(sympy.lambdify(symbols, [sympy.diff(H, s) for s in z])(*point, g), dtype=float)
-    D = np.array(sympy.lambdify(symbols, [[sympy.diff(c, s) for s in z] for c in constraints])(*point, g), dtype=float)
+    gradient, jacobian = _gradients(tuple(z), H, tuple(constraints))
+    grad = np.array(gradient(*point, g), dtype=float)
+    D = np.array(jacobian(*point, g), dtype=float)
     J = np.block([[np.zeros((n, n)), np.eye(n)], [-np.eye(n), np.zeros((n, n))]])
     C = D @ J @ D.T
     flow = J @ grad

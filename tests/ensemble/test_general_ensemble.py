@@ -61,18 +61,21 @@ def test_members_equal_single_runs(tmp_path):
          lambda a, b: [np.sin(a), -np.cos(a), np.sin(a) + np.sin(b), -np.cos(a) - np.cos(b)], None),
         (ANGLES, 'q = { th1 = "a", th2 = "b" }', "midpoint", None, lambda a, b: [a, b], ANGLES),
     ]
+    systems = {}  # one MechanicalSystem per system, used for both of its methods (as a user would)
     for k, (system, initial, method, builtin, q_of, file_text) in enumerate(cases):
         path = _scene(tmp_path, system, initial, f'method = "{method}"\ndt = 0.01\nt_end = 0.7\nsamples = 8',
                       'grid = { a = [-2.0, 2.5, 3], b = [0.5, 1.0, 2] }\nreductions = ["final", "energy_error"]',
                       name=f"s{k}.toml")
         assert run_ensemble(path, tmp_path / f"out{k}").complete
         stored = _arrays(tmp_path / f"out{k}")
-        if builtin:
-            lagrangian = load_system(builtin)
-        else:
-            (tmp_path / "sys.toml").write_text(file_text)
-            lagrangian = load_system(tmp_path / "sys.toml")
-        mechanics = MechanicalSystem.from_lagrangian(lagrangian)
+        if (builtin, file_text) not in systems:
+            if builtin:
+                lagrangian = load_system(builtin)
+            else:
+                (tmp_path / "sys.toml").write_text(file_text)
+                lagrangian = load_system(tmp_path / "sys.toml")
+            systems[builtin, file_text] = MechanicalSystem.from_lagrangian(lagrangian)
+        mechanics = systems[builtin, file_text]
         for i in range(6):
             q0 = np.array(q_of(stored["a"][i], stored["b"][i]))
             problem = ConstrainedProblem(mechanics, q0, np.zeros_like(q0))

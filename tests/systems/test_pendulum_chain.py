@@ -99,11 +99,11 @@ def test_numeric_bracket_is_fast_in_loops(analysis):
 
     points = [analysis.surface_point(seed=s) for s in range(5)]
     analysis.dirac_bracket("x", "p_x", at=points[0])  # compile once
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: another test worker on the same cores does not count
     for _ in range(40):
         for point in points:
             analysis.dirac_bracket("x", "p_x", at=point)
-    assert (time.perf_counter() - start) / 200 < 0.05
+    assert (time.process_time() - start) / 200 < 0.05
 
 
 def test_fixed_parameters_stay_exact():
