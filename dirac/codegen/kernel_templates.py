@@ -152,6 +152,29 @@ def field(z, t, c, out):
     field_into(z, t, c, out, field_work())
 '''
 
+_SOLVE_N = '''
+
+@numba.njit(cache=True, inline="always")
+def lu_solve_n(A, piv, b):
+    """b <- A^{-1} b for the factors of lu_factor of an (__N__, __N__) matrix A, in place (the
+    statements of lu_solve at a fixed size: inlined where the step loop solves in its
+    Newton iteration, where a call with its array arguments costs more than the solve)."""
+    for c in range(__N__):
+        r = piv[c]
+        if r != c:
+            tmp = b[c]
+            b[c] = b[r]
+            b[r] = tmp
+        for r in range(c + 1, __N__):
+            b[r] -= A[r, c] * b[c]
+    for c in range(__N__ - 1, -1, -1):
+        acc = b[c]
+        for r in range(c + 1, __N__):
+            acc -= A[c, r] * b[r]
+        b[c] = acc / A[c, c]
+
+'''
+
 _VELOCITY_BY_ELIMINATION = '''
 
 @numba.njit(cache=True, inline="always")
@@ -161,7 +184,7 @@ def velocity(q, p, t, c, v, work, piv):
     lu_factor(work, piv)
     for i in range(__N__):
         v[i] = p[i]
-    lu_solve(work, piv, v)
+    lu_solve_n(work, piv, v)
 '''
 
 _STAGE_RESIDUAL = '''
@@ -347,6 +370,151 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
             tau = tau1
     report(info, n_steps, False, evals, residual)
 
+'''
+
+#: RATTLE without constraints, as two blocks (replaces the joint ``rattle_general`` when m = 0)
+_UNCONSTRAINED = '''
+
+
+@numba.njit(cache=True)
+def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
+    """RATTLE for H = 1/2 p^T M(q, t)^{-1} p + V(q, t) without constraints (Jay 1996; Hairer,
+    Lubich & Wanner VII.1.4, eq. (1.26): the Stoermer-Verlet scheme (VI.3.4) of a
+    non-separable H), composed with the sub-steps h = dt fractions[s]:
+
+    p_half = p - h/2 H_q(q, p_half, t)                              (1)
+    q1 = q + h/2 (H_p(q, p_half, t) + H_p(q1, p_half, t + h))       (2)
+    p1 = p_half - h/2 H_q(q1, p_half, t + h).
+
+    The implicit system is block triangular: (1) involves p_half alone and, p_half known,
+    (2) involves q1 alone; two simplified Newton iterations of size n replace one of size
+    2n on (p_half, q1). With M = M(q, t) formed once per sub-step, B = [(dM/dq_k) u]_ki
+    at u = M^{-1} p and the force f = dV/dq - 1/2 v^T (dM/dq_k) v:
+
+    (1) for v0 = M^{-1} p_half: r1 = M v0 - p + h/2 f(q, v0, t), Jacobian M - h/2 B;
+    (2) for q1 from q1 = q: r2 = q1 - q - h/2 (v0 + M(q1, t + h)^{-1} p_half), Jacobian
+        I + h/2 M^{-1} B^T (d/dq_k M(q)^{-1} p_half = -M^{-1} (dM/dq_k) v0 at q1 = q),
+
+    both Jacobians in closed form, factored once per sub-step (simplified Newton: they
+    set the speed, the residuals decide). Converged when |r1| <= tol (1 + |p_half|^2)
+    and then |r2| <= tol (1 + |p_half|^2 + min(|q1|, |q1|^2)): both within the joint
+    iteration's tol (1 + |p_half|^2 + |q1|^2), and |r2|, whose rounding floor grows like
+    |q1|, not allowed to grow faster (an angle that winds up, a top's precession angle,
+    would otherwise loosen the tolerance with its square)."""
+    q_save = np.empty(__N__)
+    p_save = np.empty(__N__)
+    x = np.empty(__N__)
+    r = np.empty(__N__)
+    J = np.empty((__N__, __N__))
+    pivx = np.empty(__N__, dtype=np.int64)
+    f = np.empty(__N__)
+    ph = np.empty(__N__)
+    v0 = np.empty(__N__)
+    v1 = np.empty(__N__)
+    col = np.empty(__N__)
+    M0 = np.empty((__N__, __N__))
+    B = np.empty((__N__, __N__))
+    work0 = np.empty((__N__, __N__))
+    piv0 = np.empty(__N__, dtype=np.int64)
+    work = np.empty((__N__, __N__))
+    pivn = np.empty(__N__, dtype=np.int64)
+    evals = 0.0
+    residual = 0.0
+    for step in range(n_steps):
+        for i in range(__N__):
+            q_save[i] = q[i]
+            p_save[i] = p[i]
+        tau = t + step * dt
+        for s in range(fractions.shape[0]):
+            h = dt * fractions[s]
+            tau1 = tau + h
+            # M(q, tau) formed and factored once per sub-step; (1) starts at u = M^{-1} p
+            mass(q, tau, c, M0)
+            for i in range(__N__):
+                x[i] = p[i]
+                for j in range(__N__):
+                    work0[i, j] = M0[i, j]
+            lu_factor(work0, piv0)
+            lu_solve_n(work0, piv0, x)
+            mass_dq_v(q, x, tau, c, B)
+            for i in range(__N__):
+                for j in range(__N__):
+                    J[i, j] = M0[i, j] - 0.5 * h * B[i, j]
+            lu_factor(J, pivx)
+            evals += 1.0
+            extra = 0.0
+            # block 0 solves (1) for x = v0 (its residual first evaluated at x = u), block 1
+            # then (2) for x = q1 (its residual at q1 = q is -h v0: M(q)^{-1} p_half = v0);
+            # one place evaluates each block's residual (numba compiles inlined copies anew)
+            converged = False
+            for block in range(2):
+                converged = False
+                for e in range(1 + max_iter - block):
+                    if e > 0 or block == 1:
+                        lu_solve_n(J, pivx, r)
+                        for i in range(__N__):
+                            x[i] -= r[i]
+                    if block == 0:
+                        force(q, x, tau, c, f)
+                        for i in range(__N__):
+                            acc = 0.0
+                            for j in range(__N__):
+                                acc += M0[i, j] * x[j]
+                            ph[i] = acc
+                            r[i] = acc - p[i] + 0.5 * h * f[i]
+                    else:
+                        velocity(x, ph, tau1, c, v1, work, pivn)
+                        for i in range(__N__):
+                            r[i] = x[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+                    evals += 1.0
+                    if e == 0 and block == 0:
+                        continue
+                    residual = max_abs(r)
+                    bound = scale(ph, __N__)
+                    if block == 1:
+                        size = scale(x, __N__) - 1.0  # |q1|^2
+                        bound = 1.0 + extra + min(size, math.sqrt(size))
+                    if residual <= tol * bound:
+                        converged = True
+                        break
+                    if residual != residual:
+                        break
+                if not converged:
+                    break
+                if block == 0:
+                    # ph = M v0 at the converged v0; (2)'s Jacobian I + h/2 M^{-1} B^T
+                    for i in range(__N__):
+                        v0[i] = x[i]
+                        extra += ph[i] * ph[i]
+                    for k in range(__N__):
+                        for i in range(__N__):
+                            col[i] = B[k, i]
+                        lu_solve_n(work0, piv0, col)
+                        for i in range(__N__):
+                            J[i, k] = 0.5 * h * col[i]
+                        J[k, k] += 1.0
+                    lu_factor(J, pivx)
+                    for i in range(__N__):
+                        x[i] = q[i]
+                        r[i] = -h * v0[i]
+            if not converged:
+                for i in range(__N__):
+                    q[i] = q_save[i]
+                    p[i] = p_save[i]
+                report(info, step, True, evals, residual)
+                return
+            # v1 = M(q1, tau1)^{-1} p_half at the converged q1
+            for i in range(__N__):
+                q[i] = x[i]
+            force(q, v1, tau1, c, f)
+            evals += 1.0
+            for i in range(__N__):
+                p[i] = ph[i] - 0.5 * h * f[i]
+            tau = tau1
+    report(info, n_steps, False, evals, residual)
+'''
+
+_FIELD = '''
 
 @numba.njit(cache=True)
 def field_work():
@@ -503,7 +671,9 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     closed form."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
     by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
-    return _fill(by_elimination + _MECHANICAL + common, n, m, 2 * m)
+    rattle = _MECHANICAL if m > 0 else _UNCONSTRAINED
+    solve = _SOLVE_N if velocity_by_elimination or m == 0 else ""
+    return _fill(solve + by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 
 
 def analysed_templates(n: int, k: int) -> str:
