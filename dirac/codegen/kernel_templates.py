@@ -152,29 +152,6 @@ def field(z, t, c, out):
     field_into(z, t, c, out, field_work())
 '''
 
-_SOLVE_N = '''
-
-@numba.njit(cache=True, inline="always")
-def lu_solve_n(A, piv, b):
-    """b <- A^{-1} b for the factors of lu_factor of an (__N__, __N__) matrix A, in place (the
-    statements of lu_solve at a fixed size: inlined where the step loop solves in its
-    Newton iteration, where a call with its array arguments costs more than the solve)."""
-    for c in range(__N__):
-        r = piv[c]
-        if r != c:
-            tmp = b[c]
-            b[c] = b[r]
-            b[r] = tmp
-        for r in range(c + 1, __N__):
-            b[r] -= A[r, c] * b[c]
-    for c in range(__N__ - 1, -1, -1):
-        acc = b[c]
-        for r in range(c + 1, __N__):
-            acc -= A[c, r] * b[r]
-        b[c] = acc / A[c, c]
-
-'''
-
 _VELOCITY_BY_ELIMINATION = '''
 
 @numba.njit(cache=True, inline="always")
@@ -184,7 +161,7 @@ def velocity(q, p, t, c, v, work, piv):
     lu_factor(work, piv)
     for i in range(__N__):
         v[i] = p[i]
-    lu_solve_n(work, piv, v)
+    lu_solve(work, piv, v)
 '''
 
 _STAGE_RESIDUAL = '''
@@ -405,8 +382,8 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     p_save = np.empty(__N__)
     x = np.empty(__N__)
     r = np.empty(__N__)
-    J = np.empty((__N__, __N__))
-    pivx = np.empty(__N__, dtype=np.int64)
+    J = np.empty((2 * __N__, __N__))  # rows 0 .. n-1: (1)'s Jacobian, n .. 2n-1: (2)'s
+    pivx = np.empty(2 * __N__, dtype=np.int64)
     f = np.empty(__N__)
     ph = np.empty(__N__)
     v0 = np.empty(__N__)
@@ -428,21 +405,20 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
             tau1 = tau + h
-            # M(q, tau) formed and factored once per sub-step; (1) starts at u = M^{-1} p
+            # (1) starts at u = M(q, tau)^{-1} p; M = M(q, tau) and B = [(dM/dq_k) u]_ki give
+            # (1)'s Jacobian M - h/2 B and M times (2)'s, M + h/2 B^T
+            velocity(q, p, tau, c, x, work0, piv0)
             mass(q, tau, c, M0)
-            for i in range(__N__):
-                x[i] = p[i]
-                for j in range(__N__):
-                    work0[i, j] = M0[i, j]
-            lu_factor(work0, piv0)
-            lu_solve_n(work0, piv0, x)
             mass_dq_v(q, x, tau, c, B)
             for i in range(__N__):
                 for j in range(__N__):
                     J[i, j] = M0[i, j] - 0.5 * h * B[i, j]
-            lu_factor(J, pivx)
+                    J[__N__ + i, j] = M0[i, j] + 0.5 * h * B[j, i]
+            lu_factor(J[:__N__], pivx[:__N__])
+            lu_factor(J[__N__:], pivx[__N__:])
             evals += 1.0
             extra = 0.0
+            o = 0
             # block 0 solves (1) for x = v0 (its residual first evaluated at x = u), block 1
             # then (2) for x = q1 (its residual at q1 = q is -h v0: M(q)^{-1} p_half = v0);
             # one place evaluates each block's residual (numba compiles inlined copies anew)
@@ -451,9 +427,17 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                 converged = False
                 for e in range(1 + max_iter - block):
                     if e > 0 or block == 1:
-                        lu_solve_n(J, pivx, r)
+                        # (1): x -= (M - h/2 B)^{-1} r; (2): x -= (M + h/2 B^T)^{-1} M r
                         for i in range(__N__):
-                            x[i] -= r[i]
+                            acc = r[i]
+                            if block == 1:
+                                acc = 0.0
+                                for j in range(__N__):
+                                    acc += M0[i, j] * r[j]
+                            col[i] = acc
+                        lu_solve_n(J, pivx, col, o)
+                        for i in range(__N__):
+                            x[i] -= col[i]
                     if block == 0:
                         force(q, x, tau, c, f)
                         for i in range(__N__):
@@ -463,16 +447,21 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                             ph[i] = acc
                             r[i] = acc - p[i] + 0.5 * h * f[i]
                     else:
-                        velocity(x, ph, tau1, c, v1, work, pivn)
+                        VELOCITY1
                         for i in range(__N__):
                             r[i] = x[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
                     evals += 1.0
                     if e == 0 and block == 0:
                         continue
-                    residual = max_abs(r)
-                    bound = scale(ph, __N__)
+                    residual = 0.0  # max |r_i| (inf if any is NaN)
+                    bound = 1.0  # 1 + |p_half|^2, or 1 + |q1|^2
+                    for i in range(__N__):
+                        a = abs(r[i])
+                        if a > residual or a != a:
+                            residual = a if a == a else np.inf
+                        bound += ph[i] * ph[i] if block == 0 else x[i] * x[i]
                     if block == 1:
-                        size = scale(x, __N__) - 1.0  # |q1|^2
+                        size = bound - 1.0
                         bound = 1.0 + extra + min(size, math.sqrt(size))
                     if residual <= tol * bound:
                         converged = True
@@ -482,19 +471,11 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                 if not converged:
                     break
                 if block == 0:
-                    # ph = M v0 at the converged v0; (2)'s Jacobian I + h/2 M^{-1} B^T
+                    # ph = M v0 at the converged v0; (2) with its Jacobian from x = q
+                    o = __N__
                     for i in range(__N__):
                         v0[i] = x[i]
                         extra += ph[i] * ph[i]
-                    for k in range(__N__):
-                        for i in range(__N__):
-                            col[i] = B[k, i]
-                        lu_solve_n(work0, piv0, col)
-                        for i in range(__N__):
-                            J[i, k] = 0.5 * h * col[i]
-                        J[k, k] += 1.0
-                    lu_factor(J, pivx)
-                    for i in range(__N__):
                         x[i] = q[i]
                         r[i] = -h * v0[i]
             if not converged:
@@ -503,15 +484,22 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                     p[i] = p_save[i]
                 report(info, step, True, evals, residual)
                 return
-            # v1 = M(q1, tau1)^{-1} p_half at the converged q1
-            for i in range(__N__):
-                q[i] = x[i]
-            force(q, v1, tau1, c, f)
+            # v1 = M(q1, tau1)^{-1} p_half at the converged q1 = x
+            force(x, v1, tau1, c, f)
             evals += 1.0
             for i in range(__N__):
+                q[i] = x[i]
                 p[i] = ph[i] - 0.5 * h * f[i]
             tau = tau1
     report(info, n_steps, False, evals, residual)
+'''
+
+#: v1 = M(x, tau1)^{-1} p_half by elimination, at the indentation of its place in _UNCONSTRAINED
+_VELOCITY1 = '''mass(x, tau1, c, work)
+                        lu_factor(work, pivn)
+                        for i in range(__N__):
+                            v1[i] = ph[i]
+                        lu_solve_n(work, pivn, v1, 0)
 '''
 
 _FIELD = '''
@@ -656,6 +644,49 @@ def residuals(z, t, c, out):
 '''
 
 
+#: up to this size the Newton's solve with the LU factors is written out as straight-line code
+UNROLL_MAX = 8
+
+
+def _solve_n(n: int) -> str:
+    """``lu_solve_n(A, piv, b)``: the statements of ``lu_solve`` (:mod:`dirac.codegen.small_solves`)
+    for an ``n x n`` matrix written out without loops or branches (a row exchange with itself
+    leaves ``b`` as it is), in the same order, so with the same numbers; inlined where the
+    unconstrained RATTLE loop solves, where a call with its three array arguments cost more
+    than the solve and a loop nest more to compile. Larger ``n``: the loops of ``lu_solve``."""
+    head = f'''
+
+@numba.njit(cache=True, inline="always")
+def lu_solve_n(A, piv, b, o):
+    """b <- A^{{-1}} b for the factors of lu_factor of the ({n}, {n}) matrix in rows o .. o + {n} - 1
+    of A (row exchanges in piv[o:]), in place."""
+'''
+    if n > UNROLL_MAX:
+        return head + f'''    for c in range({n}):
+        r = piv[o + c]
+        if r != c:
+            tmp = b[c]
+            b[c] = b[r]
+            b[r] = tmp
+        for r in range(c + 1, {n}):
+            b[r] -= A[o + r, c] * b[c]
+    for c in range({n - 1}, -1, -1):
+        acc = b[c]
+        for r in range(c + 1, {n}):
+            acc -= A[o + c, r] * b[r]
+        b[c] = acc / A[o + c, c]
+'''
+    lines = []
+    for c in range(n):
+        if c < n - 1:
+            lines += [f"    r = piv[o + {c}]", f"    tmp = b[{c}]", f"    b[{c}] = b[r]", "    b[r] = tmp"]
+        lines += [f"    b[{r}] -= A[o + {r}, {c}] * b[{c}]" for r in range(c + 1, n)]
+    for c in range(n - 1, -1, -1):
+        terms = "".join(f" - A[o + {c}, {r}] * b[{r}]" for r in range(c + 1, n))
+        lines.append(f"    b[{c}] = (b[{c}]{terms}) / A[o + {c}, {c}]")
+    return head + "\n".join(lines) + "\n"
+
+
 def _fill(text: str, n: int, m: int, k: int) -> str:
     return (text.replace("__NX__", str(2 * n + m)).replace("__N__", str(n)).replace("__M__", str(m))
             .replace("__K__", str(k)))
@@ -671,9 +702,12 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     closed form."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
     by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
-    rattle = _MECHANICAL if m > 0 else _UNCONSTRAINED
-    solve = _SOLVE_N if velocity_by_elimination or m == 0 else ""
-    return _fill(solve + by_elimination + rattle + _FIELD + common, n, m, 2 * m)
+    if m > 0:
+        rattle = _MECHANICAL
+    else:  # v1 = M(q1)^{-1} p_half: in closed form, or eliminated with the inlined solve
+        rattle = _solve_n(n) + _UNCONSTRAINED.replace("VELOCITY1\n", _VELOCITY1 if velocity_by_elimination else
+                                                   "velocity(x, ph, tau1, c, v1, work, pivn)\n")
+    return _fill(by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 
 
 def analysed_templates(n: int, k: int) -> str:
