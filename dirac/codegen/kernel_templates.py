@@ -368,12 +368,14 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     2n on (p_half, q1). With M = M(q, t) formed once per sub-step, B = [(dM/dq_k) u]_ki
     at u = M^{-1} p and the force f = dV/dq - 1/2 v^T (dM/dq_k) v:
 
-    (1) for v0 = M^{-1} p_half: r1 = M v0 - p + h/2 f(q, v0, t), Jacobian M - h/2 B;
+    (1) for v0 = M^{-1} p_half: r1 = M v0 - p + h/2 f(q, v0, t), Jacobian M - h/2 B
+        (df_k/dv_j = -[(dM/dq_k) v]_j, here at v = u);
     (2) for q1 from q1 = q: r2 = q1 - q - h/2 (v0 + M(q1, t + h)^{-1} p_half), Jacobian
-        I + h/2 M^{-1} B^T (d/dq_k M(q)^{-1} p_half = -M^{-1} (dM/dq_k) v0 at q1 = q),
+        I + h/2 M^{-1} B^T (d/dq_k M(q)^{-1} p_half = -M^{-1} (dM/dq_k) v0 at q1 = q, with u
+        for v0), applied as x -= (M + h/2 B^T)^{-1} M r2,
 
-    both Jacobians in closed form, factored once per sub-step (simplified Newton: they
-    set the speed, the residuals decide). Converged when |r1| <= tol (1 + |p_half|^2)
+    both Newton matrices in closed form, factored once per sub-step (simplified Newton:
+    they set the speed, the residuals decide). Converged when |r1| <= tol (1 + |p_half|^2)
     and then |r2| <= tol (1 + |p_half|^2 + min(|q1|, |q1|^2)): both within the joint
     iteration's tol (1 + |p_half|^2 + |q1|^2), and |r2|, whose rounding floor grows like
     |q1|, not allowed to grow faster (an angle that winds up, a top's precession angle,
