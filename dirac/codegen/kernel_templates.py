@@ -347,6 +347,164 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
             tau = tau1
     report(info, n_steps, False, evals, residual)
 
+'''
+
+#: RATTLE without constraints, as two blocks (replaces the joint ``rattle_general`` when m = 0)
+_UNCONSTRAINED = '''
+
+
+@numba.njit(cache=True)
+def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
+    """RATTLE for H = 1/2 p^T M(q, t)^{-1} p + V(q, t) without constraints (Jay 1996; Hairer,
+    Lubich & Wanner VII.1.4, eq. (1.26): the Stoermer-Verlet scheme (VI.3.4) of a
+    non-separable H), composed with the sub-steps h = dt fractions[s]:
+
+    p_half = p - h/2 H_q(q, p_half, t)                              (1)
+    q1 = q + h/2 (H_p(q, p_half, t) + H_p(q1, p_half, t + h))       (2)
+    p1 = p_half - h/2 H_q(q1, p_half, t + h).
+
+    The implicit system is block triangular: (1) involves p_half alone and, p_half known,
+    (2) involves q1 alone; two simplified Newton iterations of size n replace one of size
+    2n on (p_half, q1). With M = M(q, t) formed once per sub-step, B = [(dM/dq_k) u]_ki
+    at u = M^{-1} p and the force f = dV/dq - 1/2 v^T (dM/dq_k) v:
+
+    (1) for v0 = M^{-1} p_half: r1 = M v0 - p + h/2 f(q, v0, t), Jacobian M - h/2 B
+        (df_k/dv_j = -[(dM/dq_k) v]_j, here at v = u);
+    (2) for q1 from q1 = q: r2 = q1 - q - h/2 (v0 + M(q1, t + h)^{-1} p_half), Jacobian
+        I + h/2 M^{-1} B^T (d/dq_k M(q)^{-1} p_half = -M^{-1} (dM/dq_k) v0 at q1 = q, with u
+        for v0), applied as x -= (M + h/2 B^T)^{-1} M r2,
+
+    both Newton matrices in closed form, factored once per sub-step (simplified Newton:
+    they set the speed, the residuals decide). Converged when |r1| <= tol (1 + |p_half|^2)
+    and then |r2| <= tol (1 + |p_half|^2 + min(|q1|, |q1|^2)): both within the joint
+    iteration's tol (1 + |p_half|^2 + |q1|^2), and |r2|, whose rounding floor grows like
+    |q1|, not allowed to grow faster (an angle that winds up, a top's precession angle,
+    would otherwise loosen the tolerance with its square)."""
+    q_save = np.empty(__N__)
+    p_save = np.empty(__N__)
+    x = np.empty(__N__)
+    r = np.empty(__N__)
+    J = np.empty((2 * __N__, __N__))  # rows 0 .. n-1: (1)'s Jacobian, n .. 2n-1: (2)'s
+    pivx = np.empty(2 * __N__, dtype=np.int64)
+    f = np.empty(__N__)
+    ph = np.empty(__N__)
+    v0 = np.empty(__N__)
+    v1 = np.empty(__N__)
+    col = np.empty(__N__)
+    M0 = np.empty((__N__, __N__))
+    B = np.empty((__N__, __N__))
+    work0 = np.empty((__N__, __N__))
+    piv0 = np.empty(__N__, dtype=np.int64)
+    work = np.empty((__N__, __N__))
+    pivn = np.empty(__N__, dtype=np.int64)
+    evals = 0.0
+    residual = 0.0
+    for step in range(n_steps):
+        for i in range(__N__):
+            q_save[i] = q[i]
+            p_save[i] = p[i]
+        tau = t + step * dt
+        for s in range(fractions.shape[0]):
+            h = dt * fractions[s]
+            tau1 = tau + h
+            # (1) starts at u = M(q, tau)^{-1} p; M = M(q, tau) and B = [(dM/dq_k) u]_ki give
+            # (1)'s Jacobian M - h/2 B and M times (2)'s, M + h/2 B^T
+            velocity(q, p, tau, c, x, work0, piv0)
+            mass(q, tau, c, M0)
+            mass_dq_v(q, x, tau, c, B)
+            for i in range(__N__):
+                for j in range(__N__):
+                    J[i, j] = M0[i, j] - 0.5 * h * B[i, j]
+                    J[__N__ + i, j] = M0[i, j] + 0.5 * h * B[j, i]
+            lu_factor(J[:__N__], pivx[:__N__])
+            lu_factor(J[__N__:], pivx[__N__:])
+            evals += 1.0
+            extra = 0.0
+            o = 0
+            # block 0 solves (1) for x = v0 (its residual first evaluated at x = u), block 1
+            # then (2) for x = q1 (its residual at q1 = q is -h v0: M(q)^{-1} p_half = v0);
+            # one place evaluates each block's residual (numba compiles inlined copies anew)
+            converged = False
+            for block in range(2):
+                converged = False
+                for e in range(1 + max_iter - block):
+                    if e > 0 or block == 1:
+                        # (1): x -= (M - h/2 B)^{-1} r; (2): x -= (M + h/2 B^T)^{-1} M r
+                        for i in range(__N__):
+                            acc = r[i]
+                            if block == 1:
+                                acc = 0.0
+                                for j in range(__N__):
+                                    acc += M0[i, j] * r[j]
+                            col[i] = acc
+                        lu_solve_n(J, pivx, col, o)
+                        for i in range(__N__):
+                            x[i] -= col[i]
+                    if block == 0:
+                        force(q, x, tau, c, f)
+                        for i in range(__N__):
+                            acc = 0.0
+                            for j in range(__N__):
+                                acc += M0[i, j] * x[j]
+                            ph[i] = acc
+                            r[i] = acc - p[i] + 0.5 * h * f[i]
+                    else:
+                        VELOCITY1
+                        for i in range(__N__):
+                            r[i] = x[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+                    evals += 1.0
+                    if e == 0 and block == 0:
+                        continue
+                    residual = 0.0  # max |r_i| (inf if any is NaN)
+                    bound = 1.0  # 1 + |p_half|^2, or 1 + |q1|^2
+                    for i in range(__N__):
+                        a = abs(r[i])
+                        if a > residual or a != a:
+                            residual = a if a == a else np.inf
+                        bound += ph[i] * ph[i] if block == 0 else x[i] * x[i]
+                    if block == 1:
+                        size = bound - 1.0
+                        bound = 1.0 + extra + min(size, math.sqrt(size))
+                    if residual <= tol * bound:
+                        converged = True
+                        break
+                    if residual != residual:
+                        break
+                if not converged:
+                    break
+                if block == 0:
+                    # ph = M v0 at the converged v0; (2) with its Jacobian from x = q
+                    o = __N__
+                    for i in range(__N__):
+                        v0[i] = x[i]
+                        extra += ph[i] * ph[i]
+                        x[i] = q[i]
+                        r[i] = -h * v0[i]
+            if not converged:
+                for i in range(__N__):
+                    q[i] = q_save[i]
+                    p[i] = p_save[i]
+                report(info, step, True, evals, residual)
+                return
+            # v1 = M(q1, tau1)^{-1} p_half at the converged q1 = x
+            force(x, v1, tau1, c, f)
+            evals += 1.0
+            for i in range(__N__):
+                q[i] = x[i]
+                p[i] = ph[i] - 0.5 * h * f[i]
+            tau = tau1
+    report(info, n_steps, False, evals, residual)
+'''
+
+#: v1 = M(x, tau1)^{-1} p_half by elimination, at the indentation of its place in _UNCONSTRAINED
+_VELOCITY1 = '''mass(x, tau1, c, work)
+                        lu_factor(work, pivn)
+                        for i in range(__N__):
+                            v1[i] = ph[i]
+                        lu_solve_n(work, pivn, v1, 0)
+'''
+
+_FIELD = '''
 
 @numba.njit(cache=True)
 def field_work():
@@ -488,6 +646,49 @@ def residuals(z, t, c, out):
 '''
 
 
+#: up to this size the Newton's solve with the LU factors is written out as straight-line code
+UNROLL_MAX = 8
+
+
+def _solve_n(n: int) -> str:
+    """``lu_solve_n(A, piv, b)``: the statements of ``lu_solve`` (:mod:`dirac.codegen.small_solves`)
+    for an ``n x n`` matrix written out without loops or branches (a row exchange with itself
+    leaves ``b`` as it is), in the same order, so with the same numbers; inlined where the
+    unconstrained RATTLE loop solves, where a call with its three array arguments cost more
+    than the solve and a loop nest more to compile. Larger ``n``: the loops of ``lu_solve``."""
+    head = f'''
+
+@numba.njit(cache=True, inline="always")
+def lu_solve_n(A, piv, b, o):
+    """b <- A^{{-1}} b for the factors of lu_factor of the ({n}, {n}) matrix in rows o .. o + {n} - 1
+    of A (row exchanges in piv[o:]), in place."""
+'''
+    if n > UNROLL_MAX:
+        return head + f'''    for c in range({n}):
+        r = piv[o + c]
+        if r != c:
+            tmp = b[c]
+            b[c] = b[r]
+            b[r] = tmp
+        for r in range(c + 1, {n}):
+            b[r] -= A[o + r, c] * b[c]
+    for c in range({n - 1}, -1, -1):
+        acc = b[c]
+        for r in range(c + 1, {n}):
+            acc -= A[o + c, r] * b[r]
+        b[c] = acc / A[o + c, c]
+'''
+    lines = []
+    for c in range(n):
+        if c < n - 1:
+            lines += [f"    r = piv[o + {c}]", f"    tmp = b[{c}]", f"    b[{c}] = b[r]", "    b[r] = tmp"]
+        lines += [f"    b[{r}] -= A[o + {r}, {c}] * b[{c}]" for r in range(c + 1, n)]
+    for c in range(n - 1, -1, -1):
+        terms = "".join(f" - A[o + {c}, {r}] * b[{r}]" for r in range(c + 1, n))
+        lines.append(f"    b[{c}] = (b[{c}]{terms}) / A[o + {c}, {c}]")
+    return head + "\n".join(lines) + "\n"
+
+
 def _fill(text: str, n: int, m: int, k: int) -> str:
     return (text.replace("__NX__", str(2 * n + m)).replace("__N__", str(n)).replace("__M__", str(m))
             .replace("__K__", str(k)))
@@ -503,7 +704,12 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     closed form."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
     by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
-    return _fill(by_elimination + _MECHANICAL + common, n, m, 2 * m)
+    if m > 0:
+        rattle = _MECHANICAL
+    else:  # v1 = M(q1)^{-1} p_half: in closed form, or eliminated with the inlined solve
+        rattle = _solve_n(n) + _UNCONSTRAINED.replace("VELOCITY1\n", _VELOCITY1 if velocity_by_elimination else
+                                                   "velocity(x, ph, tau1, c, v1, work, pivn)\n")
+    return _fill(by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 
 
 def analysed_templates(n: int, k: int) -> str:
