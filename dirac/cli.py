@@ -122,6 +122,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: no command given: choose one of {', '.join(COMMANDS)}", file=sys.stderr)
         return 2
     try:
+        if args.verbosity < 0:  # -q: not even the line that announces a compilation
+            from dirac.codegen.tiers import silent_announcements
+
+            with silent_announcements():
+                return int(args.handler(args) or 0)
         return int(args.handler(args) or 0)
     except DiracError as exc:
         message = " ".join(str(exc).split())

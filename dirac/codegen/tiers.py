@@ -30,7 +30,8 @@ import math
 import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -54,7 +55,7 @@ from dirac.codegen.numba_backend import (
     write_source,
 )
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "silent_announcements", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -87,6 +88,7 @@ def background_enabled() -> bool:
     return os.environ.get("DIRAC_BACKGROUND_COMPILE", "1") != "0"
 
 _announced = False
+_silent = False  # silent_announcements() in force
 
 _POLICIES = ("auto", "compiled")
 _policy: str | None = None  # set_policy's choice; None: $DIRAC_KERNELS or "auto"
@@ -119,10 +121,23 @@ def current_policy() -> str:
     return value
 
 
+@contextmanager
+def silent_announcements() -> Iterator[None]:
+    """Inside: no :func:`announce_compilation` line (``-q`` of the command line: no
+    informational stderr lines); the state before is restored on leaving."""
+    global _silent
+    before, _silent = _silent, True
+    try:
+        yield
+    finally:
+        _silent = before
+
+
 def announce_compilation(what: str, why: str) -> None:
-    """One stderr line, once per process, before the first compilation of generated code."""
+    """One stderr line, once per process, before the first compilation of generated code
+    (none inside :func:`silent_announcements`)."""
     global _announced
-    if _announced:
+    if _announced or _silent:
         return
     _announced = True
     print(f"dirac: compiling {what} ({why}); the machine code is cached in {cache_directory()} "

@@ -229,3 +229,33 @@ def test_the_rattle_loop_of_a_configuration_dependent_mass_gives_the_same_number
     p = np.asarray(compiled.outputs["p"])
     assert np.max(np.abs(p[:, 0] - 0.3)) < 1e-13 and np.max(np.abs(p[:, 2] - 2.0)) < 1e-13
     assert np.max(np.abs(np.asarray(compiled.outputs["q"])[:, 1] - 0.5)) > 1e-6  # theta moves: a real run
+
+
+def test_silent_announcements_hold_back_the_line_and_restore_the_state(monkeypatch, tmp_path, capsys) -> None:
+    """``dirac CMD -q`` promises no informational stderr line; the compilation's announcement
+    is one. Inside ``silent_announcements`` a first compilation prints nothing; after it the
+    next first compilation of the process is announced again."""
+    monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(tiers, "_announced", False)
+    source = _SOURCE.replace("for a test", f"for a silent test in {tmp_path.name}")
+    out = np.empty(1)
+    with tiers.silent_announcements():
+        tiers.TieredModule(source, "a silent module").function("run").run_steps(3, None, 0.5, 3, out)
+    assert capsys.readouterr().err == ""
+    tiers.TieredModule(source + "\n# another\n", "a loud module").function("run").run_steps(3, None, 0.5, 3, out)
+    assert capsys.readouterr().err.count("dirac: compiling") == 1
+
+
+def test_run_quiet_prints_no_compilation_line(monkeypatch, tmp_path, run_cli) -> None:
+    """``dirac run SCENE -q`` with a cold cache in a process that has not compiled yet: the
+    results go to the file and stderr stays empty (the line used to appear whenever the
+    process had not announced before, as in a fresh ``dirac run``)."""
+    from pathlib import Path
+
+    monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(tiers, "_announced", False)
+    monkeypatch.setattr(tiers, "_policy", "compiled")  # compile at once, whatever the run's length
+    scene = Path(__file__).resolve().parents[2] / "docs" / "scenes" / "pendulum.toml"
+    status, out, err = run_cli("run", str(scene), "--out", str(tmp_path / "q.npz"), "-q")
+    assert (status, out, err) == (0, "", "")
+    assert (tmp_path / "q.npz").exists()
