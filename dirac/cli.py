@@ -22,7 +22,7 @@ import sys
 from collections.abc import Sequence
 from typing import NoReturn
 
-from dirac.errors import DiracError, install_warning_printer
+from dirac.errors import DiracError, install_warning_printer, quiet_information
 
 #: sub-command name -> its module (which declares its arguments and help text)
 COMMANDS: dict[str, str] = {
@@ -123,9 +123,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         if args.verbosity < 0:  # -q: not even the line that announces a compilation
-            from dirac.codegen.tiers import silent_announcements
-
-            with silent_announcements():
+            with quiet_information():
                 return int(args.handler(args) or 0)
         return int(args.handler(args) or 0)
     except DiracError as exc:

@@ -11,8 +11,12 @@ import os
 import sys
 import types
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 __all__ = [
+    "inform",
+    "quiet_information",
     "DiracError",
     "InputError",
     "InconsistentSystemError",
@@ -137,6 +141,30 @@ def _user_stacklevel() -> int:
         frame = frame.f_back
         level += 1
     return level
+
+
+_quiet = False  # quiet_information() in force
+
+
+@contextmanager
+def quiet_information() -> Iterator[None]:
+    """Inside: :func:`inform` prints nothing (``-q`` of the command line: no informational
+    stderr lines; warnings and errors stay); the state before is restored on leaving."""
+    global _quiet
+    before, _quiet = _quiet, True
+    try:
+        yield
+    finally:
+        _quiet = before
+
+
+def inform(message: str) -> bool:
+    """One informational line on stderr (such as the announcement of a compilation), unless
+    inside :func:`quiet_information`; whether it was printed."""
+    if _quiet:
+        return False
+    print(message, file=sys.stderr, flush=True)
+    return True
 
 
 def install_warning_printer() -> None:

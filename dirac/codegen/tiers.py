@@ -28,10 +28,8 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -54,8 +52,9 @@ from dirac.codegen.numba_backend import (
     source_path,
     write_source,
 )
+from dirac.errors import inform
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "silent_announcements", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -88,7 +87,6 @@ def background_enabled() -> bool:
     return os.environ.get("DIRAC_BACKGROUND_COMPILE", "1") != "0"
 
 _announced = False
-_silent = False  # silent_announcements() in force
 
 _POLICIES = ("auto", "compiled")
 _policy: str | None = None  # set_policy's choice; None: $DIRAC_KERNELS or "auto"
@@ -121,27 +119,15 @@ def current_policy() -> str:
     return value
 
 
-@contextmanager
-def silent_announcements() -> Iterator[None]:
-    """Inside: no :func:`announce_compilation` line (``-q`` of the command line: no
-    informational stderr lines); the state before is restored on leaving."""
-    global _silent
-    before, _silent = _silent, True
-    try:
-        yield
-    finally:
-        _silent = before
-
-
 def announce_compilation(what: str, why: str) -> None:
     """One stderr line, once per process, before the first compilation of generated code
-    (none inside :func:`silent_announcements`)."""
+    (:func:`dirac.errors.inform`: none inside :func:`dirac.errors.quiet_information`, as ``-q``
+    asks; the next compilation outside it is announced)."""
     global _announced
-    if _announced or _silent:
+    if _announced:
         return
-    _announced = True
-    print(f"dirac: compiling {what} ({why}); the machine code is cached in {cache_directory()} "
-          "(set DIRAC_CACHE_DIR to move it) and later runs load it", file=sys.stderr, flush=True)
+    _announced = inform(f"dirac: compiling {what} ({why}); the machine code is cached in {cache_directory()} "
+                        "(set DIRAC_CACHE_DIR to move it) and later runs load it")
 
 
 def is_compiled_or_cached(dispatcher: Any) -> bool:

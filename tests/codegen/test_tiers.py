@@ -231,15 +231,17 @@ def test_the_rattle_loop_of_a_configuration_dependent_mass_gives_the_same_number
     assert np.max(np.abs(np.asarray(compiled.outputs["q"])[:, 1] - 0.5)) > 1e-6  # theta moves: a real run
 
 
-def test_silent_announcements_hold_back_the_line_and_restore_the_state(monkeypatch, tmp_path, capsys) -> None:
+def test_quiet_information_holds_back_the_line_and_restores_the_state(monkeypatch, tmp_path, capsys) -> None:
     """``dirac CMD -q`` promises no informational stderr line; the compilation's announcement
-    is one. Inside ``silent_announcements`` a first compilation prints nothing; after it the
-    next first compilation of the process is announced again."""
+    is one. Inside ``dirac.errors.quiet_information`` a first compilation prints nothing; after
+    it the next first compilation of the process is announced again."""
+    from dirac.errors import quiet_information
+
     monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(tiers, "_announced", False)
     source = _SOURCE.replace("for a test", f"for a silent test in {tmp_path.name}")
     out = np.empty(1)
-    with tiers.silent_announcements():
+    with quiet_information():
         tiers.TieredModule(source, "a silent module").function("run").run_steps(3, None, 0.5, 3, out)
     assert capsys.readouterr().err == ""
     tiers.TieredModule(source + "\n# another\n", "a loud module").function("run").run_steps(3, None, 0.5, 3, out)
