@@ -14,6 +14,8 @@ the sub-step ``s`` of step ``j`` starts at ``t + j dt + dt (c_1 + ... + c_{s-1})
 
 from __future__ import annotations
 
+from dirac.codegen.small_solves import offset_lu_solve_source
+
 __all__ = ["mechanical_templates", "analysed_templates", "RATTLE_NEWTON"]
 
 _COMMON = '''
@@ -646,49 +648,6 @@ def residuals(z, t, c, out):
 '''
 
 
-#: up to this size the Newton's solve with the LU factors is written out as straight-line code
-UNROLL_MAX = 8
-
-
-def _solve_n(n: int) -> str:
-    """``lu_solve_n(A, piv, b)``: the statements of ``lu_solve`` (:mod:`dirac.codegen.small_solves`)
-    for an ``n x n`` matrix written out without loops or branches (a row exchange with itself
-    leaves ``b`` as it is), in the same order, so with the same numbers; inlined where the
-    unconstrained RATTLE loop solves, where a call with its three array arguments cost more
-    than the solve and a loop nest more to compile. Larger ``n``: the loops of ``lu_solve``."""
-    head = f'''
-
-@numba.njit(cache=True, inline="always")
-def lu_solve_n(A, piv, b, o):
-    """b <- A^{{-1}} b for the factors of lu_factor of the ({n}, {n}) matrix in rows o .. o + {n} - 1
-    of A (row exchanges in piv[o:]), in place."""
-'''
-    if n > UNROLL_MAX:
-        return head + f'''    for c in range({n}):
-        r = piv[o + c]
-        if r != c:
-            tmp = b[c]
-            b[c] = b[r]
-            b[r] = tmp
-        for r in range(c + 1, {n}):
-            b[r] -= A[o + r, c] * b[c]
-    for c in range({n - 1}, -1, -1):
-        acc = b[c]
-        for r in range(c + 1, {n}):
-            acc -= A[o + c, r] * b[r]
-        b[c] = acc / A[o + c, c]
-'''
-    lines = []
-    for c in range(n):
-        if c < n - 1:
-            lines += [f"    r = piv[o + {c}]", f"    tmp = b[{c}]", f"    b[{c}] = b[r]", "    b[r] = tmp"]
-        lines += [f"    b[{r}] -= A[o + {r}, {c}] * b[{c}]" for r in range(c + 1, n)]
-    for c in range(n - 1, -1, -1):
-        terms = "".join(f" - A[o + {c}, {r}] * b[{r}]" for r in range(c + 1, n))
-        lines.append(f"    b[{c}] = (b[{c}]{terms}) / A[o + {c}, {c}]")
-    return head + "\n".join(lines) + "\n"
-
-
 def _fill(text: str, n: int, m: int, k: int) -> str:
     return (text.replace("__NX__", str(2 * n + m)).replace("__N__", str(n)).replace("__M__", str(m))
             .replace("__K__", str(k)))
@@ -707,7 +666,7 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     if m > 0:
         rattle = _MECHANICAL
     else:  # v1 = M(q1)^{-1} p_half: in closed form, or eliminated with the inlined solve
-        rattle = _solve_n(n) + _UNCONSTRAINED.replace("VELOCITY1\n", _VELOCITY1 if velocity_by_elimination else
+        rattle = offset_lu_solve_source(n) + _UNCONSTRAINED.replace("VELOCITY1\n", _VELOCITY1 if velocity_by_elimination else
                                                    "velocity(x, ph, tau1, c, v1, work, pivn)\n")
     return _fill(by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 

@@ -26,9 +26,10 @@ faster (the unrolled 6 x 6 took 3-4 times as long), so the compiled tier keeps i
 
 from __future__ import annotations
 
-__all__ = ["solve_source", "lu_source", "unrolled_lu_source", "UNROLLED_MAX_SIZE"]
+__all__ = ["solve_source", "lu_source", "unrolled_lu_source", "offset_lu_solve_source", "UNROLLED_MAX_SIZE"]
 
-#: largest matrix size whose LU is unrolled for the interpreted tier (the source grows like k^3)
+#: largest matrix size whose LU is unrolled (for the interpreted tier; the solve of
+#: :func:`offset_lu_solve_source` for both tiers); the source grows like k^3 (k^2 for a solve)
 UNROLLED_MAX_SIZE = 8
 
 
@@ -186,3 +187,47 @@ def unrolled_lu_source(size: int) -> str:
         lines.append(f"    b{c} = (b{c}{terms}) / float(A[{c}, {c}])")
     lines += [f"    b[{i}] = b{i}" for i in range(k)]
     return "\n".join(lines) + "\n"
+
+
+def offset_lu_solve_source(n: int) -> str:
+    """Source of ``lu_solve_n(A, piv, b, o)``: the solve of :func:`lu_source`'s ``lu_solve``
+    with the factors of an ``n x n`` matrix kept in rows ``o .. o + n - 1`` of ``A`` (row
+    exchanges in ``piv[o:]``), inlined where it is called (the unconstrained RATTLE loop of
+    :mod:`dirac.codegen.kernel_templates`, whose call with three array arguments cost more
+    than the solve).
+
+    Up to :data:`UNROLLED_MAX_SIZE` the statements are written out without loops or
+    branches (a row exchange with itself leaves ``b`` as it is), in the same order, so with
+    the same numbers (and a loop nest less to compile); larger ``n`` keep the loops.
+    """
+    head = f'''
+
+@numba.njit(cache=True, inline="always")
+def lu_solve_n(A, piv, b, o):
+    """b <- A^{{-1}} b for the factors of lu_factor of the ({n}, {n}) matrix in rows o .. o + {n} - 1
+    of A (row exchanges in piv[o:]), in place."""
+'''
+    if n > UNROLLED_MAX_SIZE:
+        return head + f'''    for c in range({n}):
+        r = piv[o + c]
+        if r != c:
+            tmp = b[c]
+            b[c] = b[r]
+            b[r] = tmp
+        for r in range(c + 1, {n}):
+            b[r] -= A[o + r, c] * b[c]
+    for c in range({n - 1}, -1, -1):
+        acc = b[c]
+        for r in range(c + 1, {n}):
+            acc -= A[o + c, r] * b[r]
+        b[c] = acc / A[o + c, c]
+'''
+    lines = []
+    for c in range(n):
+        if c < n - 1:
+            lines += [f"    r = piv[o + {c}]", f"    tmp = b[{c}]", f"    b[{c}] = b[r]", "    b[r] = tmp"]
+        lines += [f"    b[{r}] -= A[o + {r}, {c}] * b[{c}]" for r in range(c + 1, n)]
+    for c in range(n - 1, -1, -1):
+        terms = "".join(f" - A[o + {c}, {r}] * b[{r}]" for r in range(c + 1, n))
+        lines.append(f"    b[{c}] = (b[{c}]{terms}) / A[o + {c}, {c}]")
+    return head + "\n".join(lines) + "\n"
