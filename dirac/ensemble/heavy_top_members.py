@@ -457,7 +457,8 @@ def compute_heavy_top_chunk(scene: HeavyTopEnsembleScene, start: int, stop: int,
         values = scene.source.members(start, stop)
     M, R, C = heavy_top_initial_states(scene, values)
     count = M.shape[0]
-    W = np.ascontiguousarray(C[:, 3:4] * C[:, 4:7])  # m g chi, as HeavyTopProblem.weight_vector
+    with np.errstate(over="ignore"):  # a weight that overflows fails its member (a non-finite state)
+        W = np.ascontiguousarray(C[:, 3:4] * C[:, 4:7])  # m g chi, as HeavyTopProblem.weight_vector
     axes, rates, fractions, casimir = _sequences(C[:, :3], compiled.splitting)
     starts, ends, per_interval, dt = step_grid(scene)
     n_cross, n_ext, n_poin, k_max = compiled.module.HT_SHAPES
