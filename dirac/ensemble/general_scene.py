@@ -245,9 +245,9 @@ def load_lagrangian(system: dict, base_dir: str | Path, where: str = "[system]")
     name = system.get("name")
     if not isinstance(name, str):
         raise InputError(f"{where} needs name (a built-in system), file (a system file) or an inline system")
-    if name == "heavy_top":
-        raise InputError(f"{where} name = 'heavy_top': heavy-top ensembles are not available yet; "
-                         "write the top as a system file (Euler angles) or run single scenes")
+    if name == "heavy_top":  # an ensemble scene of the top is read by parse_heavy_top_scene, without a Lagrangian
+        raise InputError(f"{where} name = 'heavy_top' is the numerical heavy top, not a Lagrangian system; "
+                         "write the top as a system file (Euler angles) to analyse it as one")
     known = builtin_systems()
     if name not in known:
         raise unknown_name_error("system", name, [*known, "rigid_body"], f"{where} name", hint="or give file = a system file")
@@ -560,6 +560,7 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
     def describe(self) -> dict[str, object]:
         described = super().describe()
         described["initial"] = {self.rate_kind: list(self.initial_momentum), "R": [list(row) for row in self.initial_R]}
+        described["heavy_top"] = True  # its Poincaré sections are stored as <name>_M and <name>_R
         return described
 
 

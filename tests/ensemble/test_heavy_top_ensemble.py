@@ -49,12 +49,12 @@ def _tilted(angle: float) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def chart(tmp_path_factory):
-    """The stability chart of the sleeping top: (scene path, stored arrays)."""
+    """The stability chart of the sleeping top: (scene path, stored arrays, output folder)."""
     folder = tmp_path_factory.mktemp("chart")
     path = folder / "chart.toml"
     path.write_text(CHART)
     assert run_ensemble(path, folder / "out").complete
-    return path, _arrays(folder / "out")
+    return path, _arrays(folder / "out"), folder / "out"
 
 
 def test_members_equal_single_runs(chart):
@@ -64,7 +64,7 @@ def test_members_equal_single_runs(chart):
     from dirac.flows import integrate
     from dirac.flows.problems import HeavyTopProblem
 
-    _, stored = chart
+    _, stored, _ = chart
     for i in (0, 3, 9, 15):
         spin, mgl = float(stored["spin"][i]), float(stored["mgl"][i])
         problem = HeavyTopProblem([1.0, 1.0, 0.4 + 0.1 * mgl], [0.0, 0.0, spin], _tilted(TILT), mass_gravity=mgl,
@@ -102,7 +102,7 @@ def test_maxwell_routh_stability_chart(chart):
     stored max is over every step, t_end = 30 is long enough for the slowest unstable member
     (growth rate sqrt(4 I m g l - M3^2) / (2 I) >= 0.6) to reach its lowest point.
     """
-    _, stored = chart
+    _, stored, _ = chart
     spin, mgl, tilt = stored["spin"], stored["mgl"], stored["max_tilt"]
     u0 = np.cos(TILT)
     ratio = spin**2 / (4 * mgl)
@@ -181,11 +181,35 @@ def test_crossings_sections_early_stop_and_failures(tmp_path):
         Omega2 = single.outputs["M"][:, 1] / float(stored["b"][i])
         change = np.flatnonzero((((M1[:-1] < 0) & (M1[1:] >= 0)) | ((M1[:-1] > 0) & (M1[1:] <= 0))) & (Omega2[1:] > 0))
         assert single.t[change[0]] <= stored["swing"][i] <= single.t[change[0] + 1]
+    # the section's picture: gamma_i from the third row of the stored R, M_i from the stored M
+    from dirac.ensemble.plot import picture_data
+
+    data = picture_data(tmp_path / "out", "section", x="gamma_2", y="M_3")
+    assert data["kind"] == "section" and np.isfinite(data["x"]).sum() == 6  # 2 points of each of 3 members
+    assert np.array_equal(data["x"], R_sec[..., 2, 1].ravel(), equal_nan=True)
+    assert np.array_equal(data["y"], M_sec[..., 2].ravel(), equal_nan=True)
+
+
+def test_chart_map_puts_each_member_at_its_grid_point(chart):
+    """The map of a grid listed as (spin, mgl) -- not in alphabetical order, as meta.json
+    lists it -- has row i = spin_i, column j = mgl_j: the member numbered i * 2 + j."""
+    from dirac.ensemble.plot import picture_data
+
+    _, stored, out = chart
+    data = picture_data(out, "max_tilt")
+    assert data["x"] == ("spin", 0.4, 4.6) and data["y"] == ("mgl", 0.5, 1.0)
+    assert data["values"].shape == (8, 2)
+    for i in range(8):
+        for j in range(2):
+            member = i * 2 + j
+            assert stored["spin"][member] == pytest.approx(0.4 + 0.6 * i)
+            assert stored["mgl"][member] == pytest.approx(0.5 + 0.5 * j)
+            assert data["values"][i, j] == stored["max_tilt"][member]
 
 
 def test_chart_identical_local_dask_and_resumed(chart, tmp_path):
     """The chart does not depend on where or in how many pieces it is computed."""
-    path, reference = chart
+    path, reference, _ = chart
     assert run_ensemble(path, tmp_path / "dask", cluster="local", n_workers=2, chunk_size=4).complete
     stored = _arrays(tmp_path / "dask")
     for name in ("max_tilt", "final_M", "final_R", "energy_error"):
