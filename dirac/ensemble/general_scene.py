@@ -45,6 +45,11 @@ Expressions of reductions use the coordinates, their velocities ``<q>_dot``, mom
 ``p_<q>``, the parameters and ``t``. A member whose reductions are all decided (its
 crossings found) stops early when the scene asks for nothing that needs the rest of the
 run (``max``, ``min``, ``final``, ``energy_error``, ``constraint_error``).
+
+``[system] name = "heavy_top"`` is read by :func:`parse_heavy_top_scene` into a
+:class:`HeavyTopEnsembleScene` (the keys of a single heavy-top scene, each entry a number or
+an expression of the ensemble variables; reductions in the names of :func:`heavy_top_names`),
+whose members :mod:`dirac.ensemble.heavy_top_members` advances.
 """
 
 from __future__ import annotations
