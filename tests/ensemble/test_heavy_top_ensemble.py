@@ -78,6 +78,32 @@ def test_members_equal_single_runs(chart):
     assert np.max(stored["constraint_error"]) < 1e-12  # R stays orthogonal: every sub-step is a rotation
 
 
+def test_members_follow_a_single_runs_calls(chart, monkeypatch):
+    """A single run advances a sample interval in calls of at most CHUNK_STEPS steps, and the
+    kernel merges the half kicks between two steps of one call (so the grouping shows in the
+    last bits): with calls of 37 steps (100 steps per interval: calls of 37, 37, 26) members
+    still equal single runs bit for bit, and differ from the run in one call per interval."""
+    import dirac.flows.integration as integration
+    from dirac.ensemble.heavy_top_members import compute_heavy_top_chunk
+    from dirac.ensemble.scene import load_ensemble_scene
+    from dirac.flows import integrate
+    from dirac.flows.problems import HeavyTopProblem
+
+    path, stored, _ = chart
+    scene = load_ensemble_scene(path)
+    monkeypatch.setattr(integration, "CHUNK_STEPS", 37)
+    monkeypatch.setattr(integration, "MIN_CHUNK_STEPS", 10)
+    arrays = compute_heavy_top_chunk(scene, 0, 4)
+    for i in range(4):
+        spin, mgl = float(arrays["spin"][i]), float(arrays["mgl"][i])
+        problem = HeavyTopProblem([1.0, 1.0, 0.4 + 0.1 * mgl], [0.0, 0.0, spin], _tilted(TILT), mass_gravity=mgl,
+                                  center_of_mass=[0.0, 0.0, 1.0])
+        single = integrate(problem, "lie-poisson-4", t_end=30.0, dt=0.01, samples=31, outputs=["M", "R"])
+        assert np.array_equal(single.outputs["M"][-1], arrays["final_M"][i])
+        assert np.array_equal(single.outputs["R"][-1], arrays["final_R"][i])
+    assert not np.array_equal(arrays["final_M"], stored["final_M"][:4])
+
+
 def test_maxwell_routh_stability_chart(chart):
     """The sleeping top (I1 = I2 = I, chi = (0, 0, l), M = (0, 0, M3), tilted by a from the
     vertical) is stable iff M3^2 > 4 I m g l (Maxwell; Routh), whatever I3.
