@@ -596,8 +596,8 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
     ``center_of_mass``), ``[initial]`` one of ``M``, ``omega`` (``M = I omega``) or ``m``
     (lab, ``M = R^T m``) and ``R`` (default the identity); every entry may be an
     expression of the ensemble variables. ``[run] method`` is a ``lie-poisson-*`` method
-    (kick + Lie–Poisson free step, as a single heavy-top run); ``auto`` means
-    ``lie-poisson-2``. Reductions use the names of :func:`heavy_top_names`.
+    (kick + Lie–Poisson free step) or ``exact-kick-*`` (kick + exact free flow), as for a
+    single heavy-top run; ``auto`` means ``lie-poisson-2``. Reductions use the names of :func:`heavy_top_names`.
 
     Raises
     ------
@@ -645,13 +645,12 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
         if isinstance(value, str):
             parse_expression(value, variables, what=where, unknown_hint=hint)
 
+    from dirac.flows.methods.registry import get_method
+
     method = run.get("method", "auto")
     method = "lie-poisson-2" if method == "auto" else method
-    if method not in SCHEMES:
-        usable = sorted(SCHEMES)
-        if isinstance(method, str) and method.startswith("exact-kick-"):
-            raise InputError(f"[run] method = {method!r} is not available in heavy-top ensembles yet; use a "
-                             "lie-poisson-* method (kick + Lie-Poisson free step), e.g. lie-poisson-4")
+    usable = [*SCHEMES, *(f"exact-kick-{order}" for order in (2, 4, 6, 8))]
+    if method not in usable:
         raise unknown_name_error("method", str(method), usable, "[run] method of a heavy-top ensemble")
     if "dt" not in run:
         raise InputError("[run] needs 'dt' (the fixed step)")
@@ -699,7 +698,7 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
         system=dict(system), base_dir=str(Path(base_dir).resolve()), coordinate_names=(),
         parameter_names=TOP_PARAMETERS, forced=False, source=source, initial_q={}, initial_rates={},
         rate_kind=given[0], parameters=parameters, project=False, method=str(method),
-        order=int(SCHEMES[method].order), dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end,
+        order=int(get_method(str(method)).order), dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end,
         samples=samples, steps_per_sample=steps_per_sample, reductions=reductions, chunk_size=chunk_size, path=path,
         initial_momentum=momentum, initial_R=attitude,
     )

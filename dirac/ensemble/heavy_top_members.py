@@ -4,7 +4,8 @@ A heavy top (``H = sum_i M_i^2 / (2 I_i) + m g <chi, gamma>``, ``gamma = R^T e_z
 splitting: the gravity kick ``K(tau): M += tau m g gamma x chi`` (exact flow of the potential)
 composed with a Strang step ``F`` of the free body's Lie–Poisson splitting,
 ``prod_i K(g_i dt/2) F(g_i dt) K(g_i dt/2)`` (Celledoni, Fassò, Säfström & Zanna, SIAM J.
-Sci. Comput. 30 (2008); Touma & Wisdom 1994). A single run
+Sci. Comput. 30 (2008); Touma & Wisdom 1994); for ``exact-kick-*`` ``F`` is the exact
+free flow (:func:`dirac.rigidbody.exact_step.exact_kick_advance`, the same loop). A single run
 (:class:`dirac.flows.methods.heavy_top.HeavyTopSplittingStepper`) calls
 :func:`dirac.rigidbody.heavy_top.heavy_top_advance` once per sample interval (in calls of at
 most :data:`dirac.flows.integration.CHUNK_STEPS` steps), which merges the two half kicks
@@ -12,7 +13,7 @@ between consecutive steps of one call into one kick.
 
 :func:`compiled_heavy_top` generates, once per process and scene, a numba module whose
 ``ht_member`` runs that same arithmetic -- the same compiled ``kick`` and
-``advance_sequence`` in the same order, the kicks merged within the same calls -- so a
+``advance_sequence`` (or ``free_flow_step``) in the same order, the kicks merged within the same calls -- so a
 member's state at every sample time equals a single run's to the last bit. After every step
 it observes the state (between two steps of one call the merged kick is not yet applied:
 the observed ``M`` is completed by the first half kick on a copy, which is the state a call
@@ -49,6 +50,7 @@ import numpy as np
 import numba
 from dirac.rigidbody.heavy_top import kick
 from dirac.rigidbody.splitting import advance_sequence
+from dirac.rigidbody.exact_step import free_flow_step
 
 '''
 
@@ -64,7 +66,8 @@ class CompiledTop:
     gammas : numpy.ndarray
         The composition's step fractions (the method's coefficients).
     splitting : str
-        The free step's splitting (``"axes"`` or ``"symmetric"``).
+        The free step: a Lie–Poisson splitting (``"axes"`` or ``"symmetric"``), or
+        ``"exact"`` (the exact free flow of ``exact-kick-*``).
     layout : dict
         Where each reduction's values sit in the kernel's arrays.
     """
@@ -136,15 +139,26 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
               emit_function("ht_conditions", "the when conditions (lhs - rhs)", arrays, scalars,
                             [c for c, _ in conditions], (max(1, len(conditions)),), parameters),
               emit_function("ht_energy", "H = sum M_i^2 / (2 I_i) + m g <chi, gamma>", arrays, [("t", None)],
-                            [names["energy"]], None, parameters),
-              _loop_source(layout, conditions, len(exprs), "energy_error" in kinds, "constraint_error" in kinds)]
+                            [names["energy"]], None, parameters)]
+    exact = scene.method.startswith("exact-kick-")
+    source.append(_loop_source(layout, conditions, len(exprs), "energy_error" in kinds, "constraint_error" in kinds,
+                               exact))
     module = import_source("\n\n".join(source))
+    if exact:
+        from dirac.flows.methods.registry import get_method
+
+        return CompiledTop(module, np.asarray(get_method(scene.method).data, dtype=float), "exact", layout)
     scheme = SCHEMES[scene.method]
     return CompiledTop(module, np.asarray(scheme.coefficients, dtype=float), scheme.splitting, layout)
 
 
-def _loop_source(layout: dict, conditions: list, n_exprs: int, energy: bool, constraint: bool) -> str:
-    """``ht_locate``, ``ht_member`` and ``ht_run`` (module docstring)."""
+def _loop_source(layout: dict, conditions: list, n_exprs: int, energy: bool, constraint: bool,
+                 exact: bool = False) -> str:
+    """``ht_locate``, ``ht_member`` and ``ht_run`` (module docstring); the free step is
+    ``advance_sequence`` (``lie-poisson-*``) or, with ``exact``, ``free_flow_step``
+    (``exact-kick-*``: :func:`dirac.rigidbody.exact_step.exact_kick_advance`'s loop)."""
+    from dirac.rigidbody.exact_step import _LEVELS
+
     n_cross, n_ext, n_poin = len(layout["cross"]), len(layout["ext"]), len(layout["poincare"])
     k_max = max([count for _, _, count in layout["poincare"]], default=1)
     lines: list[str] = ['''
@@ -203,7 +217,7 @@ def ht_locate(e, Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs, flo, fhi):
         lines.append("    " * depth + text)
 
     w(0, "@numba.njit(cache=True)")
-    w(0, "def ht_member(i, MM, RR, C, W, AXES, RATES, FRACS, CAS, gammas, dt, starts, ends, per_interval, call, early,")
+    w(0, "def ht_member(i, MM, RR, C, W, AXES, RATES, FRACS, CAS, A, gammas, dt, starts, ends, per_interval, call, early,")
     w(0, "              CROSS, EXT, EERR, CERR, PT, PM, PR, STATUS, STEPS):")
     w(1, '"""Member i from t = 0 to the end or until its reductions are decided (module docstring)."""')
     w(1, "M = MM[i]")
@@ -215,6 +229,11 @@ def ht_locate(e, Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs, flo, fhi):
     w(1, "fractions = FRACS[i]")
     w(1, "casimir_rate = CAS[i]")
     w(1, "s = gammas.shape[0]")
+    if exact:
+        w(1, "a = A[i]")
+        w(1, "p = np.zeros(21)")
+        w(1, f"em = np.zeros({_LEVELS})")
+        w(1, f"en = np.zeros({_LEVELS})")
     w(1, "Mo = np.empty(3)")
     w(1, "Ma = np.empty(3)")
     w(1, "Ra = np.empty((3, 3))")
@@ -242,15 +261,21 @@ def ht_locate(e, Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs, flo, fhi):
     w(1, "steps = 0")
     w(1, "stop = False")
     w(1, "for k in range(starts.shape[0]):")
-    w(2, "a = starts[k]")
+    w(2, "t_k = starts[k]")
     w(2, "done = 0")
     w(2, "while done < per_interval and not stop:")
     w(3, "n = min(call, per_interval - done)")
-    w(3, "# heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n), observed after each step")
+    if exact:
+        w(3, "# exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en), observed after each step")
+    else:
+        w(3, "# heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n), observed after each step")
     w(3, "kick(M, R, w, 0.5 * gammas[0] * dt)")
     w(3, "for step in range(n):")
     w(4, "for j in range(s):")
-    w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)")
+    if exact:
+        w(5, "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
+    else:
+        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)")
     w(5, "if j < s - 1:")
     w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[j + 1]) * dt)")
     w(5, "elif step < n - 1:")
@@ -263,8 +288,8 @@ def ht_locate(e, Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs, flo, fhi):
     w(6, "for x in range(3):")
     w(7, "Mo[x] = M[x]")
     w(4, "steps += 1")
-    w(4, "ta = a + (done + step) * dt")
-    w(4, "tb = a + (done + step + 1) * dt")
+    w(4, "ta = t_k + (done + step) * dt")
+    w(4, "tb = t_k + (done + step + 1) * dt")
     w(4, "bad = False")
     w(4, "for x in range(3):")
     w(5, "if not (abs(Mo[x]) < np.inf):")
@@ -332,11 +357,11 @@ def ht_locate(e, Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs, flo, fhi):
     lines.append(f'''
 
 @numba.njit(cache=True, parallel=True)
-def ht_run(lo, hi, MM, RR, C, W, AXES, RATES, FRACS, CAS, gammas, dt, starts, ends, per_interval, call, early,
+def ht_run(lo, hi, MM, RR, C, W, AXES, RATES, FRACS, CAS, A, gammas, dt, starts, ends, per_interval, call, early,
            CROSS, EXT, EERR, CERR, PT, PM, PR, STATUS, STEPS):
     """ht_member for members lo .. hi-1, in parallel over members (numba.prange)."""
     for i in numba.prange(lo, hi):
-        ht_member(i, MM, RR, C, W, AXES, RATES, FRACS, CAS, gammas, dt, starts, ends, per_interval, call, early,
+        ht_member(i, MM, RR, C, W, AXES, RATES, FRACS, CAS, A, gammas, dt, starts, ends, per_interval, call, early,
                   CROSS, EXT, EERR, CERR, PT, PM, PR, STATUS, STEPS)
 
 
@@ -459,7 +484,12 @@ def compute_heavy_top_chunk(scene: HeavyTopEnsembleScene, start: int, stop: int,
     count = M.shape[0]
     with np.errstate(over="ignore"):  # a weight that overflows fails its member (a non-finite state)
         W = np.ascontiguousarray(C[:, 3:4] * C[:, 4:7])  # m g chi, as HeavyTopProblem.weight_vector
-    axes, rates, fractions, casimir = _sequences(C[:, :3], compiled.splitting)
+    if compiled.splitting == "exact":  # the exact free flow takes 1 / I (as ExactKickStepper: 1.0 / inertia)
+        axes, rates, fractions, casimir = (np.zeros((count, 1), dtype=np.int64), np.zeros((count, 1)),
+                                           np.zeros((count, 1)), np.zeros(count))
+    else:
+        axes, rates, fractions, casimir = _sequences(C[:, :3], compiled.splitting)
+    inverse = np.ascontiguousarray(1.0 / C[:, :3])
     starts, ends, per_interval, dt = step_grid(scene)
     n_cross, n_ext, n_poin, k_max = compiled.module.HT_SHAPES
     CROSS = np.full((count, n_cross), np.nan)
@@ -472,7 +502,7 @@ def compute_heavy_top_chunk(scene: HeavyTopEnsembleScene, start: int, stop: int,
     STATUS = np.zeros(count)
     STEPS = np.zeros(count)
     with KERNEL_LOCK:
-        compiled.module.ht_run(0, count, M, R, C, W, axes, rates, fractions, casimir, compiled.gammas, dt, starts,
+        compiled.module.ht_run(0, count, M, R, C, W, axes, rates, fractions, casimir, inverse, compiled.gammas, dt, starts,
                                ends, per_interval, single_run_call_steps(), scene.early_stop,
                                CROSS, EXT, EERR, CERR, PT, PM, PR, STATUS, STEPS)
     results: dict[str, np.ndarray] = {name: values[:, k].copy() for k, name in enumerate(scene.source.names)}

@@ -78,6 +78,30 @@ def test_members_equal_single_runs(chart):
     assert np.max(stored["constraint_error"]) < 1e-12  # R stays orthogonal: every sub-step is a rotation
 
 
+def test_exact_kick_members_equal_single_runs(tmp_path):
+    """exact-kick-4 (kick + the exact free flow of Jacobi elliptic functions): an asymmetric
+    top's members with the inertia and omega (M = I omega) varying equal dirac.integrate to
+    the last bit."""
+    from dirac.flows import integrate
+    from dirac.flows.problems import HeavyTopProblem
+
+    path = tmp_path / "exact.toml"
+    path.write_text(ASYMMETRIC.replace('"lie-poisson-sym-2"', '"exact-kick-4"').replace("k*1e308", "k")
+                    .replace("m = [0.1, 0.2, 2.0]", 'omega = [0.1, "b", 2.0]').replace("t_end = 6.0", "t_end = 1.0")
+                    .replace("samples = 601", "samples = 5").replace("dt = 0.01", "dt = 0.05")
+                    .replace('  { kind = "poincare", name = "section", expr = "gamma1", count = 2 },\n', '  "final",\n'))
+    assert run_ensemble(path, tmp_path / "out").complete
+    stored = _arrays(tmp_path / "out")
+    for i in range(6):
+        b, k = float(stored["b"][i]), float(stored["k"][i])
+        inertia = np.array([1.0, b, 0.6])
+        problem = HeavyTopProblem(inertia, inertia * np.array([0.1, b, 2.0]), _tilted(0.4), mass_gravity=1.0 + k,
+                                  center_of_mass=[0.3, 0.0, 10.0])
+        single = integrate(problem, "exact-kick-4", t_end=1.0, dt=0.05, samples=5, outputs=["M", "R"])
+        assert np.array_equal(single.outputs["M"][-1], stored["final_M"][i])
+        assert np.array_equal(single.outputs["R"][-1], stored["final_R"][i])
+
+
 def test_members_follow_a_single_runs_calls(chart, monkeypatch):
     """A single run advances a sample interval in calls of at most CHUNK_STEPS steps, and the
     kernel merges the half kicks between two steps of one call (so the grouping shows in the
@@ -259,7 +283,7 @@ def _cli(scene, out):
     (('"0.4 + 0.1*mgl"', '"0.4 + 0.1*c"'), "unknown name 'c'"),  # a variable used but not defined
     (('expr = "1 - gamma_3"', 'expr = "1 - gama_3"'), "did you mean 'gamma_3'"),  # a misspelt state name
     (('"cos(0.01)", "-sin(0.01)"', '"cos(0.01)", "sin(0.01)"'), "is not orthogonal"),  # R is no rotation
-    (('"lie-poisson-4"', '"exact-kick-4"'), "not available in heavy-top ensembles"),
+    (('"lie-poisson-4"', '"rattle-4"'), "unknown method 'rattle-4'"),
     (("0.4, 4.6, 8]", "0.4, 4.6, 0]"), "n = 0 must be an integer >= 1"),
 ])
 def test_bad_input_is_refused_before_anything_is_written(tmp_path, change, message):
