@@ -196,9 +196,9 @@ def picture_data(out: str | Path, array: str | None = None, x: str | None = None
     (xname, (xlo, xhi, nx)), (yname, (ylo, yhi, ny)) = grid.items()
     # meta.json lists the grid's variables sorted by name; the members are numbered in the
     # scene's order (C order, its last variable fastest): the variable that changes between
-    # members 0 and 1 goes last
+    # members 0 and 1 goes last (when they are computed)
     first = _read_array(group, xname)
-    if first.size > 1 and first[0] != first[1]:
+    if first.size > 1 and bool(np.all(np.isfinite(first[:2]))) and first[0] != first[1]:
         (xname, xlo, xhi, nx), (yname, ylo, yhi, ny) = (yname, ylo, yhi, ny), (xname, xlo, xhi, nx)
     values = _read_array(group, array).reshape(int(nx), int(ny))
     return {"kind": "map", "values": values, "x": (xname, float(xlo), float(xhi)), "y": (yname, float(ylo), float(yhi)),
