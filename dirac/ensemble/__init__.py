@@ -20,6 +20,7 @@ Modules, one job each:
 - :mod:`dirac.ensemble.general_scene` -- scenes of any other system, their reductions;
 - :mod:`dirac.ensemble.general_kernel` -- the system's own step batched over members (generated);
 - :mod:`dirac.ensemble.general_chunk` -- one chunk of such an ensemble;
+- :mod:`dirac.ensemble.heavy_top_members` -- the heavy top's member loop (a single run's kernels, generated);
 - :mod:`dirac.ensemble.kernel_lock` -- the lock around the parallel kernels.
 
 The command lines are in :mod:`dirac.commands` (``ensemble``, ``bench_ensemble``,

@@ -11,7 +11,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.general_scene import GeneralEnsembleScene, HeavyTopEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.ensemble.reductions import casimir_of, energy_of, make_reductions
 from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, AnyScene
@@ -93,6 +93,10 @@ def compute_chunk(
         Array name -> array with ``stop - start`` rows (trajectory outputs have shape
         ``(n, samples, ...)``, reductions ``(n, ...)``).
     """
+    if isinstance(scene, HeavyTopEnsembleScene):
+        from dirac.ensemble.heavy_top_members import compute_heavy_top_chunk
+
+        return compute_heavy_top_chunk(scene, start, stop, members)  # type: ignore[arg-type]
     if isinstance(scene, GeneralEnsembleScene):
         from dirac.ensemble.general_chunk import compute_general_chunk
 

@@ -46,7 +46,7 @@ from dirac.ensemble.arguments import ArgumentError
 from dirac.ensemble.chunk_plan import chunk_count, default_chunk_size
 from dirac.ensemble.chunk_work import ChunkWork
 from dirac.ensemble.dask_executor import run_dask
-from dirac.ensemble.general_scene import GeneralEnsembleScene
+from dirac.ensemble.general_scene import GeneralEnsembleScene, HeavyTopEnsembleScene
 from dirac.ensemble.local_executor import run_local
 from dirac.ensemble.run_record import RunRecord, new_meta
 from dirac.ensemble.scene import AnyScene, EnsembleScene, load_ensemble_scene
@@ -206,7 +206,11 @@ def run_ensemble(
     n_chunks = chunk_count(scene.count, chunk_size)
     local = scheduler is None and cluster is None and client is None
     if meta is None:
-        if isinstance(scene, GeneralEnsembleScene):
+        if isinstance(scene, HeavyTopEnsembleScene):
+            from dirac.ensemble.heavy_top_members import check_heavy_top_states
+
+            check_heavy_top_states(scene)  # bad numbers of a member: refused before anything is written
+        elif isinstance(scene, GeneralEnsembleScene):
             from dirac.ensemble.general_chunk import check_initial_states
 
             # bad initial data: refused before anything is written (locally the projected

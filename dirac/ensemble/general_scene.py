@@ -45,6 +45,11 @@ Expressions of reductions use the coordinates, their velocities ``<q>_dot``, mom
 ``p_<q>``, the parameters and ``t``. A member whose reductions are all decided (its
 crossings found) stops early when the scene asks for nothing that needs the rest of the
 run (``max``, ``min``, ``final``, ``energy_error``, ``constraint_error``).
+
+``[system] name = "heavy_top"`` is read by :func:`parse_heavy_top_scene` into a
+:class:`HeavyTopEnsembleScene` (the keys of a single heavy-top scene, each entry a number or
+an expression of the ensemble variables; reductions in the names of :func:`heavy_top_names`),
+whose members :mod:`dirac.ensemble.heavy_top_members` advances.
 """
 
 from __future__ import annotations
@@ -64,7 +69,8 @@ from dirac.errors import InputError
 from dirac.io.scene import reject_unknown_keys, scene_number
 from dirac.validate import unknown_name_error
 
-__all__ = ["GeneralEnsembleScene", "ReductionSpec", "parse_general_scene", "is_general_scene", "REDUCTION_KINDS"]
+__all__ = ["GeneralEnsembleScene", "HeavyTopEnsembleScene", "ReductionSpec", "parse_general_scene", "is_general_scene",
+           "REDUCTION_KINDS", "heavy_top_names"]
 
 #: Reduction kinds and the keys each takes besides ``kind`` and ``name``.
 REDUCTION_KINDS: dict[str, set[str]] = {
@@ -244,9 +250,9 @@ def load_lagrangian(system: dict, base_dir: str | Path, where: str = "[system]")
     name = system.get("name")
     if not isinstance(name, str):
         raise InputError(f"{where} needs name (a built-in system), file (a system file) or an inline system")
-    if name == "heavy_top":
-        raise InputError(f"{where} name = 'heavy_top': heavy-top ensembles are not available yet; "
-                         "write the top as a system file (Euler angles) or run single scenes")
+    if name == "heavy_top":  # an ensemble scene of the top is read by parse_heavy_top_scene, without a Lagrangian
+        raise InputError(f"{where} name = 'heavy_top' is the numerical heavy top, not a Lagrangian system; "
+                         "write the top as a system file (Euler angles) to analyse it as one")
     known = builtin_systems()
     if name not in known:
         raise unknown_name_error("system", name, [*known, "rigid_body"], f"{where} name", hint="or give file = a system file")
@@ -338,6 +344,8 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
     for section in ("system", "initial", "run", "ensemble"):
         if not isinstance(data.get(section), dict):
             raise InputError(f"an ensemble scene needs a [{section}] table; see docs/ensembles.md")
+    if is_heavy_top_scene(data):
+        return parse_heavy_top_scene(data, base_dir, path)
     if "impulses" in data:
         raise InputError("[[impulses]] are not available in ensembles yet (a member's steps would be cut at each "
                          "impulse time); run the members with impulses one by one with dirac run")
@@ -481,3 +489,216 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
         kind = "a forced system" if forced else "an ensemble of this system"
         raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {usable}")
     return str(name), int(get_method(name).order)
+
+
+# ----------------------------------------------------------------------------- the heavy top
+# ``[system] name = "heavy_top"`` in an ensemble scene: the keys of a single heavy-top scene
+# (dirac.io.scene), any number of which may be expressions of the ensemble variables; its
+# members are advanced by dirac.ensemble.heavy_top_members.
+
+_TOP_SYSTEM_KEYS = {"name", "inertia", "mass_gravity", "center_of_mass", "description"}
+_TOP_INITIAL_KEYS = {"M", "omega", "m", "R"}
+_TOP_RUN_KEYS = {"t_end", "method", "dt", "samples", "outputs"}
+
+#: The parameters of a heavy top, in the order of a member's parameter row.
+TOP_PARAMETERS = ("I_1", "I_2", "I_3", "mass_gravity", "chi_1", "chi_2", "chi_3")
+
+
+def is_heavy_top_scene(data: dict) -> bool:
+    """Whether an ensemble scene's ``[system]`` is the built-in heavy top."""
+    system = data.get("system", {})
+    return isinstance(system, dict) and not ({"file", "lagrangian"} & set(system)) and system.get("name") == "heavy_top"
+
+
+def heavy_top_names() -> dict[str, Any]:
+    """The names a heavy-top reduction may use -> sympy expressions of the state.
+
+    The state is ``M_i`` (body angular momentum) and ``R_ij`` (attitude, body to lab); the
+    parameters ``I_i``, ``mass_gravity`` (``m g``) and ``chi_i`` (centre of mass, body
+    frame). Derived: ``gamma_i = R_3i`` (``gamma = R^T e_z``), ``Omega_i = M_i / I_i``, and
+    the heavy top's outputs of :func:`dirac.integrate`: ``energy = sum M_i^2 / (2 I_i) +
+    m g <chi, gamma>`` and ``lab_momentum_z = <gamma, M>``; ``t``. Each indexed name is also
+    accepted without its underscore (``M3``, ``gamma3``, ``R31``, ``I1``).
+    """
+    import sympy
+
+    symbol = {name: sympy.Symbol(name, real=True) for name in
+              [*(f"M_{i}" for i in (1, 2, 3)), *(f"R_{i}{j}" for i in (1, 2, 3) for j in (1, 2, 3)),
+               *TOP_PARAMETERS, "t"]}
+    names: dict[str, Any] = dict(symbol)
+    for i in (1, 2, 3):
+        names[f"gamma_{i}"] = symbol[f"R_3{i}"]
+        names[f"Omega_{i}"] = symbol[f"M_{i}"] / symbol[f"I_{i}"]
+    names["energy"] = sum(symbol[f"M_{i}"] ** 2 / (2 * symbol[f"I_{i}"]) for i in (1, 2, 3)) + symbol["mass_gravity"] * sum(
+        symbol[f"chi_{i}"] * symbol[f"R_3{i}"] for i in (1, 2, 3))
+    names["lab_momentum_z"] = sum(symbol[f"R_3{i}"] * symbol[f"M_{i}"] for i in (1, 2, 3))
+    for name in list(names):
+        if "_" in name and name[-1].isdigit() and name.split("_")[0] in ("M", "R", "gamma", "Omega", "I", "chi"):
+            names[name.replace("_", "")] = names[name]
+    return names
+
+
+@dataclass(frozen=True)
+class HeavyTopEnsembleScene(GeneralEnsembleScene):
+    """A validated ensemble scene of the heavy top (see :func:`parse_heavy_top_scene`).
+
+    ``parameters`` holds the top's numbers by the names of :data:`TOP_PARAMETERS` (numbers
+    or expressions of the ensemble variables); ``initial_momentum`` the three entries of
+    ``[initial] M`` (or ``omega``, ``m``: ``rate_kind``), ``initial_R`` the nine of ``R``.
+    """
+
+    initial_momentum: tuple[float | str, ...] = ()
+    initial_R: tuple[tuple[float | str, ...], ...] = ()
+
+    heavy_top = True
+
+    def array_layout(self) -> dict[str, tuple[int, ...]]:
+        """Array name -> shape of one member's entry: ``final`` gives ``final_M`` (3,) and
+        ``final_R`` (3, 3); ``poincare`` gives ``<name>_t``, ``<name>_M``, ``<name>_R``."""
+        layout: dict[str, tuple[int, ...]] = {name: () for name in self.source.names}
+        for reduction in self.reductions:
+            layout.update(top_arrays(reduction))
+        layout["failures"] = ()
+        layout["steps"] = ()
+        return layout
+
+    def describe(self) -> dict[str, object]:
+        described = super().describe()
+        described["initial"] = {self.rate_kind: list(self.initial_momentum), "R": [list(row) for row in self.initial_R]}
+        described["heavy_top"] = True  # its Poincaré sections are stored as <name>_M and <name>_R
+        return described
+
+
+def top_arrays(reduction: ReductionSpec) -> dict[str, tuple[int, ...]]:
+    """The arrays a heavy-top reduction stores: name -> shape of one member's entry."""
+    if reduction.kind == "final":
+        return {"final_M": (3,), "final_R": (3, 3)}
+    if reduction.kind == "poincare":
+        return {f"{reduction.name}_t": (reduction.count,), f"{reduction.name}_M": (reduction.count, 3),
+                f"{reduction.name}_R": (reduction.count, 3, 3)}
+    return {reduction.name: ()}
+
+
+def _top_entries(value: object, where: str, shape: tuple[int, ...]) -> tuple:
+    """A vector (3,) or matrix (3, 3) whose entries are numbers or expressions (strings)."""
+    label = f"{where} must be {'a list of 3' if len(shape) == 1 else 'a 3 x 3 list of lists of'} numbers or expressions"
+    if not isinstance(value, list) or len(value) != shape[0]:
+        raise InputError(label)
+    if len(shape) == 1:
+        return tuple(_expression_value(v, f"{where}[{k}]") for k, v in enumerate(value))
+    return tuple(_top_entries(row, f"{where}[{k}]", shape[1:]) for k, row in enumerate(value))
+
+
+def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | None = None) -> HeavyTopEnsembleScene:
+    """Validate an ensemble scene of the heavy top.
+
+    ``[system]`` takes the keys of a single heavy-top scene (``inertia``, ``mass_gravity``,
+    ``center_of_mass``), ``[initial]`` one of ``M``, ``omega`` (``M = I omega``) or ``m``
+    (lab, ``M = R^T m``) and ``R`` (default the identity); every entry may be an
+    expression of the ensemble variables. ``[run] method`` is a ``lie-poisson-*`` method
+    (kick + Lie–Poisson free step) or ``exact-kick-*`` (kick + exact free flow), as for a
+    single heavy-top run; ``auto`` means ``lie-poisson-2``. Reductions use the names of :func:`heavy_top_names`.
+
+    Raises
+    ------
+    InputError
+        Any invalid key or value, or an expression with an unknown name, named with the fix.
+    """
+    import sympy
+
+    from dirac.model.expressions import parse_expression
+    from dirac.rigidbody.schemes import SCHEMES
+
+    if "impulses" in data or "forces" in data:
+        raise InputError("[forces] and [[impulses]] are not available in heavy-top ensembles; run a driven top "
+                         "with dirac run")
+    reject_unknown_keys(data, {"system", "initial", "run", "ensemble"}, "the scene", kind="section")
+    system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
+    reject_unknown_keys(system, _TOP_SYSTEM_KEYS, "[system]")
+    reject_unknown_keys(initial, _TOP_INITIAL_KEYS, "[initial]")
+    reject_unknown_keys(run, _TOP_RUN_KEYS, "[run]")
+    reject_unknown_keys(ensemble, _ENSEMBLE_KEYS, "[ensemble]")
+    source = parse_variables(ensemble)
+    for name in source.names:
+        if name in ("failures", "steps", "t") or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+            raise InputError(f"[ensemble] variable {name!r}: give an identifier other than failures, steps and t "
+                             "(the store's own arrays)")
+    variables = {name: sympy.Symbol(name, real=True) for name in source.names}
+    hint = f"define it under [ensemble] grid or [ensemble.variables] (the ensemble variables are: {', '.join(source.names) or 'none'})"
+
+    if "inertia" not in system:
+        raise InputError("[system] lacks 'inertia' (the principal moments [I1, I2, I3] about the fixed point)")
+    inertia = _top_entries(system["inertia"], "[system] inertia", (3,))
+    weight = _expression_value(system.get("mass_gravity", 1.0), "[system] mass_gravity")
+    chi = _top_entries(system.get("center_of_mass", [0.0, 0.0, 1.0]), "[system] center_of_mass", (3,))
+    parameters: dict[str, float | str] = dict(zip(TOP_PARAMETERS, (*inertia, weight, *chi)))
+    given = [key for key in ("M", "omega", "m") if key in initial]
+    if len(given) != 1:
+        raise InputError("[initial] must give exactly one of M (body angular momentum), omega (body angular velocity) "
+                         f"or m (lab angular momentum); it gives {', '.join(given) or 'none'}")
+    momentum = _top_entries(initial[given[0]], f"[initial] {given[0]}", (3,))
+    attitude = _top_entries(initial.get("R", [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), "[initial] R", (3, 3))
+    checks = [*((f"[system] {key}", value) for key, value in parameters.items()),
+              *((f"[initial] {given[0]}[{k}]", value) for k, value in enumerate(momentum)),
+              *((f"[initial] R[{i}][{j}]", value) for i, row in enumerate(attitude) for j, value in enumerate(row))]
+    for where, value in checks:
+        if isinstance(value, str):
+            parse_expression(value, variables, what=where, unknown_hint=hint)
+
+    from dirac.flows.methods.registry import get_method
+
+    method = run.get("method", "auto")
+    method = "lie-poisson-2" if method == "auto" else method
+    usable = [*SCHEMES, *(f"exact-kick-{order}" for order in (2, 4, 6, 8))]
+    if method not in usable:
+        raise unknown_name_error("method", str(method), usable, "[run] method of a heavy-top ensemble")
+    if "dt" not in run:
+        raise InputError("[run] needs 'dt' (the fixed step)")
+    dt = scene_number(run["dt"], "[run] dt", positive=True)
+    if "t_end" not in run:
+        raise InputError("[run] needs 't_end'")
+    t_end = scene_number(run["t_end"], "[run] t_end", positive=True)
+    samples = run.get("samples", 101)
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
+        raise InputError(f"[run] samples = {samples!r} must be an integer >= 2")
+    if run.get("outputs"):
+        raise InputError("[run] outputs (full trajectories) are not stored by heavy-top ensembles; ask for reductions "
+                         "(final, max, min, poincare, ...) under [ensemble] reductions")
+    spacing = t_end / (samples - 1)
+    steps_per_sample = max(1, math.ceil(spacing / dt * (1.0 - 1e-12)))
+
+    listed = ensemble.get("reductions", [])
+    tables = ensemble.get("reduction", [])
+    if not isinstance(listed, list) or not isinstance(tables, list):
+        raise InputError("[ensemble] reductions must be a list (of kinds or tables); [[ensemble.reduction]] tables")
+    reductions = tuple(_reduction(item, i) for i, item in enumerate([*listed, *tables]))
+    if not reductions:
+        raise InputError(f"the scene asks for nothing: give [ensemble] reductions (from {', '.join(REDUCTION_KINDS)})")
+    state = heavy_top_names()
+    usable_names = "reductions of a heavy top use M_i, Omega_i, R_ij, gamma_i, energy, lab_momentum_z, I_i, mass_gravity, chi_i and t"
+    taken: dict[str, str] = {name: "an ensemble variable" for name in source.names}
+    for reduction in reductions:
+        for array in top_arrays(reduction):
+            if array in taken or array in ("failures", "steps", "t"):
+                raise InputError(f"[ensemble] reduction {reduction.kind!r}: the array name {array!r} is taken "
+                                 f"({taken.get(array, 'by the store')}); give it another name = ...")
+            taken[array] = f"reduction {reduction.kind}"
+        for k, text in enumerate(reduction.exprs):
+            where = f"[ensemble] reduction {reduction.name} expr"
+            parse_expression(text, state, what=where, unknown_hint=usable_names)
+            when = reduction.whens[k] if reduction.whens else None
+            if when is not None:
+                for side in split_condition(when, where)[0::2]:
+                    parse_expression(side, state, what=f"[ensemble] reduction {reduction.name} when",
+                                     unknown_hint=usable_names)
+    chunk_size = ensemble.get("chunk_size")
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1):
+        raise InputError(f"[ensemble] chunk_size = {chunk_size!r} must be an integer >= 1")
+    return HeavyTopEnsembleScene(
+        system=dict(system), base_dir=str(Path(base_dir).resolve()), coordinate_names=(),
+        parameter_names=TOP_PARAMETERS, forced=False, source=source, initial_q={}, initial_rates={},
+        rate_kind=given[0], parameters=parameters, project=False, method=str(method),
+        order=int(get_method(str(method)).order), dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end,
+        samples=samples, steps_per_sample=steps_per_sample, reductions=reductions, chunk_size=chunk_size, path=path,
+        initial_momentum=momentum, initial_R=attitude,
+    )

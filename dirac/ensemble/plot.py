@@ -170,6 +170,8 @@ def picture_data(out: str | Path, array: str | None = None, x: str | None = None
         array = poincare[0] if poincare and not scalar else (scalar[0] if scalar else None)
         if array is None:
             raise InputError(f"{out} has no reduction to draw (first_crossing, max, min, poincare, ...)")
+    if array in poincare and scene.get("heavy_top"):
+        return _top_section(group, array, x, y)
     if array in poincare:
         names = [*coordinates, *(f"p_{c}" for c in coordinates)]
         x = x or coordinates[0]
@@ -192,9 +194,34 @@ def picture_data(out: str | Path, array: str | None = None, x: str | None = None
         raise InputError(f"a map needs a two-dimensional grid (and no random draws); {out} has grid variables "
                          f"{', '.join(grid) or 'none'}")
     (xname, (xlo, xhi, nx)), (yname, (ylo, yhi, ny)) = grid.items()
+    # meta.json lists the grid's variables sorted by name; the members are numbered in the
+    # scene's order (C order, its last variable fastest): the variable that changes between
+    # members 0 and 1 goes last (when they are computed)
+    first = _read_array(group, xname)
+    if first.size > 1 and bool(np.all(np.isfinite(first[:2]))) and first[0] != first[1]:
+        (xname, xlo, xhi, nx), (yname, ylo, yhi, ny) = (yname, ylo, yhi, ny), (xname, xlo, xhi, nx)
     values = _read_array(group, array).reshape(int(nx), int(ny))
     return {"kind": "map", "values": values, "x": (xname, float(xlo), float(xhi)), "y": (yname, float(ylo), float(yhi)),
             "label": array}
+
+
+def _top_section(group: zarr.Group, array: str, x: str | None, y: str | None) -> dict:
+    """A heavy top's Poincaré section (:func:`picture_data`): axes among ``M_1 .. M_3`` (the
+    stored ``<array>_M``) and ``gamma_1 .. gamma_3`` (the third row of ``<array>_R``);
+    default ``M_1`` against ``M_2``."""
+    columns = {**{f"M_{i}": ("M", i - 1) for i in (1, 2, 3)}, **{f"gamma_{i}": ("R", i - 1) for i in (1, 2, 3)}}
+    x, y = x or "M_1", y or "M_2"
+    points = {}
+    for axis, name in (("x", x), ("y", y)):
+        if name not in columns:
+            from dirac.validate import unknown_name_error
+
+            raise unknown_name_error("quantity", name, columns, f"--{axis} of a heavy top's section")
+        stored, k = columns[name]
+        values = _read_array(group, f"{array}_{stored}")
+        points[axis] = (values[..., k] if stored == "M" else values[..., 2, k]).ravel()
+    return {"kind": "section", "x": points["x"], "y": points["y"], "xlabel": x, "ylabel": y,
+            "title": f"Poincaré section {array!r}: {int(np.isfinite(points['x']).sum())} points"}
 
 
 def _coordinates(scene: dict) -> list[str]:
