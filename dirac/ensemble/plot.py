@@ -193,12 +193,14 @@ def picture_data(out: str | Path, array: str | None = None, x: str | None = None
     if len(grid) != 2 or scene["variables"]["draws"] != 1 or scene["variables"]["random"]:
         raise InputError(f"a map needs a two-dimensional grid (and no random draws); {out} has grid variables "
                          f"{', '.join(grid) or 'none'}")
-    (xname, (xlo, xhi, nx)), (yname, (ylo, yhi, ny)) = grid.items()
     # meta.json lists the grid's variables sorted by name; the members are numbered in the
-    # scene's order (C order, its last variable fastest): the variable that changes between
+    # scene's order (C order, its last variable fastest), which "order" keeps when it is not
+    # alphabetical. A store written before "order" existed: the variable that changes between
     # members 0 and 1 goes last (when they are computed)
+    listed = scene["variables"].get("order", {}).get("grid")
+    (xname, (xlo, xhi, nx)), (yname, (ylo, yhi, ny)) = ((name, grid[name]) for name in listed) if listed else grid.items()
     first = _read_array(group, xname)
-    if first.size > 1 and bool(np.all(np.isfinite(first[:2]))) and first[0] != first[1]:
+    if not listed and first.size > 1 and bool(np.all(np.isfinite(first[:2]))) and first[0] != first[1]:
         (xname, xlo, xhi, nx), (yname, ylo, yhi, ny) = (yname, ylo, yhi, ny), (xname, xlo, xhi, nx)
     values = _read_array(group, array).reshape(int(nx), int(ny))
     return {"kind": "map", "values": values, "x": (xname, float(xlo), float(xhi)), "y": (yname, float(ylo), float(yhi)),

@@ -118,12 +118,25 @@ class VariableSource:
         return np.ascontiguousarray(np.stack(columns, axis=1))
 
     def describe(self) -> dict[str, object]:
-        return {
+        """The variables as plain data (``meta.json``; the scene's fingerprint hashes it).
+
+        JSON writes a table's keys sorted, but the order of the grid variables numbers the
+        members and the order of the random ones picks their streams: when either is not
+        alphabetical, ``order`` keeps both as lists (so two scenes that list the same
+        variables in another order have other fingerprints, and a map is drawn the right way
+        round).
+        """
+        described: dict[str, object] = {
             "grid": {a.name: [a.lo, a.hi, a.n] for a in self.grid},
             "random": {r.name: r.describe() for r in self.random},
             "draws": self.draws,
             "seed": self.seed,
         }
+        grid_names = [a.name for a in self.grid]
+        random_names = [r.name for r in self.random]
+        if grid_names != sorted(grid_names) or random_names != sorted(random_names):
+            described["order"] = {"grid": grid_names, "random": random_names}
+        return described
 
 
 def _number(value: object, where: str) -> float:
