@@ -390,14 +390,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     and then |r2| <= tol (1 + |p_half|^2 + min(|q1|, |q1|^2)): both within the joint
     iteration's tol (1 + |p_half|^2 + |q1|^2), and |r2|, whose rounding floor grows like
     |q1|, not allowed to grow faster (an angle that winds up, a top's precession angle,
-    would otherwise loosen the tolerance with its square).
-
-    Every expression of the system has one place in this loop: a sub-step is a sequence
-    of stages (0: u = M(q, t)^{-1} p and the Newton matrices, 1: the iterates of (1),
-    2: those of (2), 3: the closing force at (q1, v1)) run by one loop, in which v = M^{-1} p
-    is evaluated at one place (stages 0 and 2) and the force at one place (stages 1 and 3):
-    numba compiles each inlined copy of an expression anew, and its cost is most of the
-    kernel's compile time.""\"
+    would otherwise loosen the tolerance with its square).""\"
     q_save = np.empty(__N__)
     p_save = np.empty(__N__)
     x = np.empty(__N__)
@@ -423,7 +416,13 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
             tau1 = tau + h
-            # stage 0 evaluates v1 = M(x, ta)^{-1} ph at x = q, ph = p, ta = tau: u
+            # every expression of the system has one place in this loop (numba types and lowers
+            # each inlined copy anew: the copies were most of the kernel's compile time): a
+            # sub-step is a sequence of stages run by one loop, 0: u = M(q, t)^{-1} p and the
+            # Newton matrices, 1: the iterates of (1), 2: those of (2), 3: the closing force at
+            # (q1, v1); v = M^{-1} p is evaluated at one place (stages 0 and 2), the force at
+            # one place (stages 1 and 3). Stage 0 evaluates v1 = M(x, ta)^{-1} ph at x = q,
+            # ph = p, ta = tau: u
             for i in range(__N__):
                 x[i] = q[i]
                 ph[i] = p[i]
