@@ -16,7 +16,16 @@ from __future__ import annotations
 
 from dirac.codegen.small_solves import offset_lu_solve_source
 
-__all__ = ["mechanical_templates", "analysed_templates", "RATTLE_NEWTON"]
+__all__ = ["mechanical_templates", "analysed_templates", "RATTLE_NEWTON", "UNROLLED_NEWTON_MAX"]
+
+#: the largest n whose unconstrained RATTLE loop inlines the unrolled solve of its Newton
+#: matrices (:func:`dirac.codegen.small_solves.offset_lu_solve_source`); larger n call the
+#: LU's own solve on the block's rows. The unrolled solve has n^2 statements and numba types
+#: and lowers each: for an N-link pendulum in angles, N = 5, the kernel compiled in 2 s
+#: more CPU with it (whole process 6.9 s against 4.7 s, paired runs) for a step 12 % faster
+#: (2.25 against 2.53 us); at N = 2 the call on a slice costs more than the solve (a step
+#: 440 ns inlined, about 1 us called)
+UNROLLED_NEWTON_MAX = 3
 
 _COMMON = '''
 
@@ -352,12 +361,12 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
 '''
 
 #: RATTLE without constraints, as two blocks (replaces the joint ``rattle_general`` when m = 0)
-_UNCONSTRAINED = '''
+_UNCONSTRAINED = """
 
 
 @numba.njit(cache=True)
 def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
-    """RATTLE for H = 1/2 p^T M(q, t)^{-1} p + V(q, t) without constraints (Jay 1996; Hairer,
+    ""\"RATTLE for H = 1/2 p^T M(q, t)^{-1} p + V(q, t) without constraints (Jay 1996; Hairer,
     Lubich & Wanner VII.1.4, eq. (1.26): the Stoermer-Verlet scheme (VI.3.4) of a
     non-separable H), composed with the sub-steps h = dt fractions[s]:
 
@@ -381,7 +390,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     and then |r2| <= tol (1 + |p_half|^2 + min(|q1|, |q1|^2)): both within the joint
     iteration's tol (1 + |p_half|^2 + |q1|^2), and |r2|, whose rounding floor grows like
     |q1|, not allowed to grow faster (an angle that winds up, a top's precession angle,
-    would otherwise loosen the tolerance with its square)."""
+    would otherwise loosen the tolerance with its square).""\"
     q_save = np.empty(__N__)
     p_save = np.empty(__N__)
     x = np.empty(__N__)
@@ -395,8 +404,6 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     col = np.empty(__N__)
     M0 = np.empty((__N__, __N__))
     B = np.empty((__N__, __N__))
-    work0 = np.empty((__N__, __N__))
-    piv0 = np.empty(__N__, dtype=np.int64)
     work = np.empty((__N__, __N__))
     pivn = np.empty(__N__, dtype=np.int64)
     evals = 0.0
@@ -409,102 +416,133 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
         for s in range(fractions.shape[0]):
             h = dt * fractions[s]
             tau1 = tau + h
-            # (1) starts at u = M(q, tau)^{-1} p; M = M(q, tau) and B = [(dM/dq_k) u]_ki give
-            # (1)'s Jacobian M - h/2 B and M times (2)'s, M + h/2 B^T
-            velocity(q, p, tau, c, x, work0, piv0)
-            mass(q, tau, c, M0)
-            mass_dq_v(q, x, tau, c, B)
+            # every expression of the system has one place in this loop (numba types and lowers
+            # each inlined copy anew: the copies were most of the kernel's compile time): a
+            # sub-step is a sequence of stages run by one loop, 0: u = M(q, t)^{-1} p and the
+            # Newton matrices, 1: the iterates of (1), 2: those of (2), 3: the closing force at
+            # (q1, v1); v = M^{-1} p is evaluated at one place (stages 0 and 2), the force at
+            # one place (stages 1 and 3). Stage 0 evaluates v1 = M(x, ta)^{-1} ph at x = q,
+            # ph = p, ta = tau: u
             for i in range(__N__):
-                for j in range(__N__):
-                    J[i, j] = M0[i, j] - 0.5 * h * B[i, j]
-                    J[__N__ + i, j] = M0[i, j] + 0.5 * h * B[j, i]
-            lu_factor(J[:__N__], pivx[:__N__])
-            lu_factor(J[__N__:], pivx[__N__:])
-            evals += 1.0
+                x[i] = q[i]
+                ph[i] = p[i]
+            ta = tau
+            stage = 0
+            first = True  # the iterate is the stage's starting point
+            updates = 0  # Newton corrections in this stage
             extra = 0.0
             o = 0
-            # block 0 solves (1) for x = v0 (its residual first evaluated at x = u), block 1
-            # then (2) for x = q1 (its residual at q1 = q is -h v0: M(q)^{-1} p_half = v0);
-            # one place evaluates each block's residual (numba compiles inlined copies anew)
             converged = False
-            for block in range(2):
-                converged = False
-                for e in range(1 + max_iter - block):
-                    if e > 0 or block == 1:
-                        # (1): x -= (M - h/2 B)^{-1} r; (2): x -= (M + h/2 B^T)^{-1} M r
-                        for i in range(__N__):
-                            acc = r[i]
-                            if block == 1:
-                                acc = 0.0
-                                for j in range(__N__):
-                                    acc += M0[i, j] * r[j]
-                            col[i] = acc
-                        lu_solve_n(J, pivx, col, o)
-                        for i in range(__N__):
-                            x[i] -= col[i]
-                    if block == 0:
-                        force(q, x, tau, c, f)
-                        for i in range(__N__):
+            for _k in range(3 + 2 * max_iter):
+                if stage == 2 or (stage == 1 and not first):
+                    # (1): x -= (M - h/2 B)^{-1} r; (2): x -= (M + h/2 B^T)^{-1} M r
+                    for i in range(__N__):
+                        acc = r[i]
+                        if stage == 2:
                             acc = 0.0
                             for j in range(__N__):
-                                acc += M0[i, j] * x[j]
-                            ph[i] = acc
-                            r[i] = acc - p[i] + 0.5 * h * f[i]
-                    else:
-                        VELOCITY1
-                        for i in range(__N__):
-                            r[i] = x[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+                                acc += M0[i, j] * r[j]
+                        col[i] = acc
+                    NEWTON_SOLVE
+                    for i in range(__N__):
+                        x[i] -= col[i]
+                    updates += 1
+                if stage == 1 or stage == 3:
+                    # stage 1: f(q, v0, tau) at the iterate x = v0; stage 3: f(q1, v1, tau1) with
+                    # q = q1 and x = v1
+                    force(q, x, ta, c, f)
                     evals += 1.0
-                    if e == 0 and block == 0:
+                    if stage == 3:
+                        for i in range(__N__):
+                            p[i] = ph[i] - 0.5 * h * f[i]
+                        converged = True
+                        break
+                    for i in range(__N__):
+                        acc = 0.0
+                        for j in range(__N__):
+                            acc += M0[i, j] * x[j]
+                        ph[i] = acc
+                        r[i] = acc - p[i] + 0.5 * h * f[i]
+                else:
+                    VELOCITY
+                    evals += 1.0
+                    if stage == 0:
+                        # (1) starts at u; M = M(q, tau) and B = [(dM/dq_k) u]_ki give (1)'s
+                        # Jacobian M - h/2 B and M times (2)'s, M + h/2 B^T
+                        MASS0
+                        mass_dq_v(q, v1, tau, c, B)
+                        for i in range(__N__):
+                            x[i] = v1[i]
+                            for j in range(__N__):
+                                J[i, j] = M0[i, j] - 0.5 * h * B[i, j]
+                                J[__N__ + i, j] = M0[i, j] + 0.5 * h * B[j, i]
+                        lu_factor(J[:__N__], pivx[:__N__])
+                        lu_factor(J[__N__:], pivx[__N__:])
+                        stage = 1
                         continue
+                    for i in range(__N__):
+                        r[i] = x[i] - q[i] - 0.5 * h * (v0[i] + v1[i])
+                if first and stage == 1:
+                    first = False
+                else:
                     residual = 0.0  # max |r_i| (inf if any is NaN)
                     bound = 1.0  # 1 + |p_half|^2, or 1 + |q1|^2
                     for i in range(__N__):
                         a = abs(r[i])
                         if a > residual or a != a:
                             residual = a if a == a else np.inf
-                        bound += ph[i] * ph[i] if block == 0 else x[i] * x[i]
-                    if block == 1:
+                        bound += ph[i] * ph[i] if stage == 1 else x[i] * x[i]
+                    if stage == 2:
                         size = bound - 1.0
                         bound = 1.0 + extra + min(size, math.sqrt(size))
                     if residual <= tol * bound:
-                        converged = True
-                        break
+                        if stage == 1:
+                            # ph = M v0 at the converged v0; (2) with its Jacobian from x = q (its
+                            # residual there is -h v0: M(q)^{-1} p_half = v0)
+                            o = __N__
+                            for i in range(__N__):
+                                v0[i] = x[i]
+                                extra += ph[i] * ph[i]
+                                x[i] = q[i]
+                                r[i] = -h * v0[i]
+                            stage = 2
+                            ta = tau1
+                            updates = 0
+                        else:
+                            # v1 = M(q1, tau1)^{-1} p_half at the converged q1 = x
+                            for i in range(__N__):
+                                q[i] = x[i]
+                                x[i] = v1[i]
+                            stage = 3
+                        continue
                     if residual != residual:
                         break
-                if not converged:
+                if updates >= max_iter:
                     break
-                if block == 0:
-                    # ph = M v0 at the converged v0; (2) with its Jacobian from x = q
-                    o = __N__
-                    for i in range(__N__):
-                        v0[i] = x[i]
-                        extra += ph[i] * ph[i]
-                        x[i] = q[i]
-                        r[i] = -h * v0[i]
             if not converged:
                 for i in range(__N__):
                     q[i] = q_save[i]
                     p[i] = p_save[i]
                 report(info, step, True, evals, residual)
                 return
-            # v1 = M(q1, tau1)^{-1} p_half at the converged q1 = x
-            force(x, v1, tau1, c, f)
-            evals += 1.0
-            for i in range(__N__):
-                q[i] = x[i]
-                p[i] = ph[i] - 0.5 * h * f[i]
             tau = tau1
     report(info, n_steps, False, evals, residual)
-'''
+"""
 
-#: v1 = M(x, tau1)^{-1} p_half by elimination, at the indentation of its place in _UNCONSTRAINED
-_VELOCITY1 = '''mass(x, tau1, c, work)
-                        lu_factor(work, pivn)
+#: v1 = M(x, ta)^{-1} ph by elimination (at stage 0 also M0 = M(q, tau)), at the
+#: indentation of its place in _UNCONSTRAINED; the solve is the LU's own (a function of its
+#: own: the unrolled lu_solve_n, n^2 statements, would be a second copy in the loop, whose
+#: compile time grows with its statements)
+_VELOCITY_ELIMINATED = """mass(x, ta, c, work)
+                    if stage == 0:
                         for i in range(__N__):
-                            v1[i] = ph[i]
-                        lu_solve_n(work, pivn, v1, 0)
-'''
+                            for j in range(__N__):
+                                M0[i, j] = work[i, j]
+                    lu_factor(work, pivn)
+                    for i in range(__N__):
+                        v1[i] = ph[i]
+                    lu_solve(work, pivn, v1)
+"""
 
 _FIELD = '''
 
@@ -665,9 +703,16 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
     by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
     if m > 0:
         rattle = _MECHANICAL
-    else:  # v1 = M(q1)^{-1} p_half: in closed form, or eliminated with the inlined solve
-        rattle = offset_lu_solve_source(n) + _UNCONSTRAINED.replace("VELOCITY1\n", _VELOCITY1 if velocity_by_elimination else
-                                                   "velocity(x, ph, tau1, c, v1, work, pivn)\n")
+    else:  # v1 = M(x)^{-1} ph: in closed form (and M0 from mass), or eliminated with the inlined solve
+        if velocity_by_elimination:
+            unconstrained = _UNCONSTRAINED.replace("VELOCITY\n", _VELOCITY_ELIMINATED).replace("                        MASS0\n", "")
+        else:
+            unconstrained = (_UNCONSTRAINED.replace("VELOCITY\n", "velocity(x, ph, ta, c, v1, work, pivn)\n")
+                             .replace("MASS0\n", "mass(q, tau, c, M0)\n"))
+        if n <= UNROLLED_NEWTON_MAX:
+            rattle = offset_lu_solve_source(n) + unconstrained.replace("NEWTON_SOLVE\n", "lu_solve_n(J, pivx, col, o)\n")
+        else:
+            rattle = unconstrained.replace("NEWTON_SOLVE\n", "lu_solve(J[o:o + __N__], pivx[o:o + __N__], col)\n")
     return _fill(by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 
 
