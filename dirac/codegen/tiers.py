@@ -377,7 +377,12 @@ class TieredFunction:
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
                          "compile", args)
             return
-        if background_enabled() and not self.background_failed and (spare_core() or remaining <= estimate):
+        if remaining <= estimate:
+            # the interpreted remainder costs less than compiling: a compilation, in this process or
+            # beside it, would cost more CPU than it could save (a double pendulum's t_end = 100 run
+            # spent 9 s of CPU where its interpreted run alone took 5)
+            return
+        if background_enabled() and not self.background_failed and spare_core():
             announce_compilation(f"{self.name} of {self.module.title}",
                                  f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
