@@ -47,7 +47,7 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
 
-__all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "specialised_function", "INLINE_MARK",
+__all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "specialised_function", "function_text", "INLINE_MARK",
            "SEPARATE", "SMALL"]
 
 #: the decorator generated modules put on a helper to be inlined
@@ -563,7 +563,7 @@ def specialise_solves(source: str, max_size: int | None = None) -> str:
     return ast.unparse(tree) + "\n" + "".join(unrolled_lu_source(size) for size in sorted(used))
 
 
-def _function_text(source: str, name: str) -> str | None:
+def function_text(source: str, name: str) -> str | None:
     """The text of the top-level ``def name(...)`` of ``source`` (up to the next line that
     starts in the first column), or None."""
     start = source.find(f"\ndef {name}(")
@@ -582,11 +582,11 @@ def specialised_function(source: str, name: str, max_size: int | None = None) ->
     one function), or None when it has none. Only this function is parsed: the interpreted
     tier specialises the functions it runs, when it first runs them, and a module whose
     loops never solve with a fixed matrix (a constant mass) pays nothing."""
-    text = _function_text(source, name)
+    text = function_text(source, name)
     if text is None or ("lu_factor(" not in text and "lu_solve(" not in text) or "np.empty((" not in text \
             and "np.zeros((" not in text:
         return None
-    helpers = "".join(t for t in (_function_text(source, "lu_factor"), _function_text(source, "lu_solve")) if t)
+    helpers = "".join(t for t in (function_text(source, "lu_factor"), function_text(source, "lu_solve")) if t)
     specialised = specialise_solves(helpers + text, max_size)
     if specialised == helpers + text:
         return None

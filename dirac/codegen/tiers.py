@@ -43,7 +43,7 @@ from dirac.codegen.background import (
     mark_ready,
     record_compile_seconds,
 )
-from dirac.codegen.flatten import flatten_source, specialised_function
+from dirac.codegen.flatten import flatten_source, function_text, specialised_function
 from dirac.codegen.numba_backend import (
     cache_directory,
     import_source,
@@ -52,6 +52,7 @@ from dirac.codegen.numba_backend import (
     source_path,
     write_source,
 )
+from dirac.codegen.scalar_arrays import scalar_function
 from dirac.errors import inform
 
 __all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
@@ -169,12 +170,16 @@ class TieredModule:
 
     def interpreted_function(self, name: str) -> Callable[..., Any]:
         """Function ``name`` of :attr:`interpreted`, its LU solves of fixed size unrolled
-        (:func:`~dirac.codegen.flatten.specialised_function`: the same operations in the same
-        order, so the same numbers, in a fraction of the interpreter's time); specialised
+        (:func:`~dirac.codegen.flatten.specialised_function`), its loops of literal length
+        unrolled and its small work arrays made Python floats
+        (:func:`~dirac.codegen.scalar_arrays.scalar_function`): the same operations in the same
+        order, so the same numbers, in a fraction of the interpreter's time; specialised
         when first asked for, and put in the interpreted module in place of the looped one."""
         module = self.interpreted
         if name not in self._specialised:
             text = specialised_function(self.source, name)
+            scalar = scalar_function(text if text is not None else (function_text(self.source, name) or ""), name)
+            text = scalar if scalar is not None else text
             if text is not None:
                 exec(compile(text, f"<dirac generated {module.__name__} {name}>", "exec"), module.__dict__)
             self._specialised.add(name)
