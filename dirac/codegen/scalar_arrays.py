@@ -37,6 +37,8 @@ import ast
 import itertools
 from typing import Any
 
+from dirac.codegen.flatten import copy_tree, walk
+
 __all__ = ["scalar_function", "unroll_loops", "scalarise_arrays", "item_loads", "UNROLL_MAX"]
 
 #: the longest literal loop unrolled (the kernels' loops run over the coordinates and
@@ -118,7 +120,7 @@ def _own_jumps(statements: list[ast.stmt]) -> bool:
 
 def _binds(statements: list[ast.stmt], name: str) -> bool:
     return any(isinstance(sub, ast.Name) and sub.id == name and not isinstance(sub.ctx, ast.Load)
-               for node in statements for sub in ast.walk(node))
+               for node in statements for sub in walk(node))
 
 
 def _literal_range(loop: ast.For) -> int | None:
@@ -159,19 +161,13 @@ def _unroll_block(statements: list[ast.stmt]) -> list[ast.stmt]:
             if count is not None and isinstance(target, ast.Name) and not _own_jumps(statement.body) \
                     and not _binds(statement.body, target.id):
                 for value in range(count):
-                    copies = [_Fold().visit(_Substitute(target.id, value).visit(_copy(s))) for s in statement.body]
+                    copies = [_Fold().visit(_Substitute(target.id, value).visit(copy_tree(s))) for s in statement.body]
                     out.extend(_unroll_block(copies))
                 if count:
                     out.append(ast.Assign(targets=[ast.Name(id=target.id, ctx=ast.Store())], value=ast.Constant(count - 1)))
                 continue
         out.append(statement)
     return out
-
-
-def _copy(node: ast.stmt) -> ast.stmt:
-    from dirac.codegen.flatten import _copy as copy_tree
-
-    return copy_tree(node)
 
 
 def unroll_loops(function: ast.FunctionDef) -> None:
@@ -245,19 +241,19 @@ def scalarise_arrays(function: ast.FunctionDef) -> bool:
         return False
     allowed: set[int] = set()  # the Name nodes that are the array of a literal subscript
     stores: dict[str, int] = {}
-    for node in ast.walk(function):
+    for node in walk(function):
         if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in candidates:
             if _literal_index(node, candidates[node.value.id][1]) is not None:
                 allowed.add(id(node.value))
         if isinstance(node, ast.Name) and not isinstance(node.ctx, ast.Load):
             stores[node.id] = stores.get(node.id, 0) + 1
-    for node in ast.walk(function):
+    for node in walk(function):
         if isinstance(node, ast.Name) and node.id in candidates and id(node) not in allowed:
             if not (isinstance(node.ctx, ast.Store) and stores.get(node.id) == 1):
                 candidates.pop(node.id)  # used whole, sliced, indexed by a variable or rebound
     if not candidates:
         return False
-    taken = {node.id for node in ast.walk(function) if isinstance(node, ast.Name)} | arguments
+    taken = {node.id for node in walk(function) if isinstance(node, ast.Name)} | arguments
     names: dict[str, str] = {}
     for name in candidates:
         prefix = f"_a_{name}"
@@ -299,7 +295,7 @@ def item_loads(function: ast.FunctionDef) -> None:
     allocation becomes ``a.item(i, j)``."""
     arrays = {a.arg for a in function.args.args}
     arrays |= {found[0] for found in map(_allocation, function.body) if found is not None}
-    stored = {node.id for node in ast.walk(function) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)}
+    stored = {node.id for node in walk(function) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)}
     arrays = {name for name in arrays if name not in stored or name in
               {found[0] for found in map(_allocation, function.body) if found is not None}}
     function.body = [_ItemLoads(arrays).visit(statement) for statement in function.body]

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -178,8 +179,13 @@ class TieredModule:
         module = self.interpreted
         if name not in self._specialised:
             text = specialised_function(self.source, name)
-            scalar = scalar_function(text if text is not None else (function_text(self.source, name) or ""), name)
-            text = scalar if scalar is not None else text
+            plain = text if text is not None else function_text(self.source, name)
+            signature = re.search(rf"def {name}\(([^)]*)\)", plain or "")
+            if plain is not None and signature is not None and "n_steps" in signature.group(1):
+                # a step loop (its rewriting, tens of milliseconds, pays back over its steps; a
+                # function called once per sample would not repay it)
+                scalar = scalar_function(plain, name)
+                text = scalar if scalar is not None else text
             if text is not None:
                 exec(compile(text, f"<dirac generated {module.__name__} {name}>", "exec"), module.__dict__)
             self._specialised.add(name)
