@@ -515,15 +515,29 @@ def flatten_source(source: str, policy: Callable[[_Helper], bool] = straight) ->
     return ast.unparse(tree) + "\n"
 
 
-def _square_allocations(function: ast.FunctionDef) -> dict[str, int]:
-    """Names that ``function`` binds once, to ``np.empty((k, k))`` or ``np.zeros((k, k))`` with a literal ``k``."""
+def _literal_int(node: ast.AST | None) -> int | None:
+    """An integer literal, or sums, differences and products of them (``2 * 2``), else None."""
+    if isinstance(node, ast.Constant) and type(node.value) is int:
+        return node.value
+    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Sub, ast.Mult)):
+        left, right = _literal_int(node.left), _literal_int(node.right)
+        if left is None or right is None:
+            return None
+        return left + right if isinstance(node.op, ast.Add) else left - right if isinstance(node.op, ast.Sub) \
+            else left * right
+    return None
+
+
+def _matrix_allocations(function: ast.FunctionDef) -> dict[str, tuple[int, int]]:
+    """Names that ``function`` binds once, to ``np.empty((r, c))`` or ``np.zeros((r, c))`` with
+    literal ``r`` and ``c`` (``2 * 2`` counts as literal): their shapes."""
     stores: dict[str, int] = {}
     for node in walk(function):
         if isinstance(node, ast.Name) and isinstance(node.ctx, (ast.Store, ast.Del)):
             stores[node.id] = stores.get(node.id, 0) + 1
     for argument in function.args.args:
         stores[argument.arg] = stores.get(argument.arg, 0) + 1
-    sizes: dict[str, int] = {}
+    shapes: dict[str, tuple[int, int]] = {}
     for node in walk(function):
         if not (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)
                 and stores.get(node.targets[0].id) == 1 and isinstance(node.value, ast.Call)):
@@ -533,16 +547,34 @@ def _square_allocations(function: ast.FunctionDef) -> dict[str, int]:
                 and call.func.value.id == "np" and call.func.attr in ("empty", "zeros") and len(call.args) == 1
                 and not call.keywords and isinstance(call.args[0], ast.Tuple) and len(call.args[0].elts) == 2):
             continue
-        rows, columns = call.args[0].elts
-        if isinstance(rows, ast.Constant) and isinstance(columns, ast.Constant) and type(rows.value) is int \
-                and rows.value == columns.value:
-            sizes[node.targets[0].id] = rows.value
-    return sizes
+        rows, columns = (_literal_int(e) for e in call.args[0].elts)
+        if rows is not None and columns is not None and rows >= 1 and columns >= 1:
+            shapes[node.targets[0].id] = (rows, columns)
+    return shapes
+
+
+def _square_size(argument: ast.expr, shapes: dict[str, tuple[int, int]]) -> int:
+    """The size ``k`` of a square matrix argument: a name allocated ``(k, k)``, or a slice
+    ``A[lo:hi]`` of literal bounds of a name allocated ``(r, k)`` with ``hi - lo = k`` (the
+    blocks of one allocation, ``J[:2]`` and ``J[2:]`` of a ``(4, 2)``); 0 otherwise."""
+    if isinstance(argument, ast.Name) and argument.id in shapes:
+        rows, columns = shapes[argument.id]
+        return rows if rows == columns else 0
+    if isinstance(argument, ast.Subscript) and isinstance(argument.value, ast.Name) and argument.value.id in shapes \
+            and isinstance(argument.slice, ast.Slice) and argument.slice.step is None:
+        rows, columns = shapes[argument.value.id]
+        low = 0 if argument.slice.lower is None else _literal_int(argument.slice.lower)
+        high = rows if argument.slice.upper is None else _literal_int(argument.slice.upper)
+        if low is not None and high is not None and 0 <= low < high <= rows and high - low == columns:
+            return columns
+    return 0
 
 
 def specialise_solves(source: str, max_size: int | None = None) -> str:
     """``source`` for the interpreted tier: each call ``lu_factor(A, piv)`` / ``lu_solve(A, piv, b)``
-    on a matrix ``A`` that its function allocates once as ``np.empty((k, k))`` (a literal
+    on a matrix ``A`` that its function allocates once as ``np.empty((k, k))``, or on a block
+    ``J[lo:hi]`` of literal bounds of a ``np.empty((r, k))`` with ``hi - lo = k`` (the two
+    Newton matrices of the unconstrained RATTLE loop), (a literal
     ``k`` from 1 to ``max_size``, default
     :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`) calls the straight-line
     ``lu_factor_<k>`` / ``lu_solve_<k>`` of :func:`~dirac.codegen.small_solves.unrolled_lu_source`
@@ -567,14 +599,14 @@ def specialise_solves(source: str, max_size: int | None = None) -> str:
     for function in tree.body:
         if not isinstance(function, ast.FunctionDef) or function.name in ("lu_factor", "lu_solve"):
             continue
-        sizes = _square_allocations(function)
-        if not sizes:
+        shapes = _matrix_allocations(function)
+        if not shapes:
             continue
         for node in walk(function):
             if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
                     and node.func.id in ("lu_factor", "lu_solve") and node.args \
-                    and isinstance(node.args[0], ast.Name) and 1 <= sizes.get(node.args[0].id, 0) <= limit:
-                size = sizes[node.args[0].id]
+                    and 1 <= _square_size(node.args[0], shapes) <= limit:
+                size = _square_size(node.args[0], shapes)
                 name = f"{node.func.id}_{size}"
                 if name in defined:  # the module has a function of that name already: leave the call
                     continue
