@@ -56,7 +56,7 @@ from dirac.codegen.numba_backend import (
 from dirac.codegen.scalar_arrays import scalar_function
 from dirac.errors import inform
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -67,6 +67,10 @@ COMPILE_SECONDS = 1.0
 #: wait still not exceed the interpreted run); below it, a background compilation lets the
 #: run go on interpreted
 WAIT_FACTOR = 2.0
+#: CPU seconds of ``import numba`` in a fresh process (0.5-0.55 s measured on the 2-core machine
+#: of docs/performance.md, where a bare interpreter starts in 0.04 s), which a first compilation
+#: pays on top of the compile times the history records
+NUMBA_IMPORT_SECONDS = 0.5
 #: interpreted seconds between two looks at a background compilation (a step loop runs in
 #: parts of about this length while one is in flight)
 CHECK_SECONDS = 0.05
@@ -259,8 +263,14 @@ class TieredFunction:
 
     def compile_estimate(self) -> float:
         """Estimated seconds to compile this function (:func:`estimate_compile_seconds` of
-        the module's source size and the measured history in the cache)."""
-        return estimate_compile_seconds(self.kernel_chars())
+        the module's source size and the measured history in the cache), plus
+        :data:`NUMBA_IMPORT_SECONDS` while numba is not imported in this process (the history
+        times the compilation alone; a first compilation, here or in a child, imports numba
+        first)."""
+        import sys
+
+        start = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
+        return estimate_compile_seconds(self.kernel_chars()) + start
 
     def kernel_chars(self) -> int:
         """The size of what numba compiles for this function (:func:`kernel_chars`)."""
