@@ -181,10 +181,10 @@ def run_breakdown(models: Sequence[str] = ("pendulum_angle", "double_pendulum_an
     empty cache as :func:`run_latency` times it, cut into phases by CPU time stamps: the
     interpreter's start, ``import dirac`` (with numpy), the model (sympy's import and the
     Lagrangian), the problem (the generated kernel source and its flattening), ``auto``'s
-    pilot runs, compilations (from the cache's compile history, without numba's import,
-    which counts in the run: in this process, or in a background child whose CPU the
-    total includes), the run itself, and the exit (the interpreter's shutdown, the rest of
-    the child's CPU)."""
+    pilot runs, compilations in the process (from the cache's compile history, without
+    numba's import, which counts in the run), the run itself, the exit (the interpreter's
+    shutdown, the rest of the child's CPU) and, apart, a compilation in a background child
+    (in the total, within the exit, only when the run waited for it to finish)."""
     compile_bytecode(pythonpath)
     rows = []
     for name in models:
@@ -207,8 +207,9 @@ def run_breakdown(models: Sequence[str] = ("pendulum_angle", "double_pendulum_an
         phases["auto's pilot runs"] = result["pilots"]
         phases["compilation in the process"] = compiled_here
         phases["the run (steps, sampling)"] = integrate - result["pilots"] - compiled_here
-        phases["background compilation (child)"] = in_background
         phases["exit and the rest"] = cpu - sum(phases.values())
+        # a child the run reaped counts in the total (in "exit and the rest"), one it left running does not
+        phases["background compilation (child)"] = in_background
         rows.append(BreakdownRow(name, result["method"], result["steps"], phases, cpu, result["modules"]))
     return rows
 

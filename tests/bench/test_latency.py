@@ -51,7 +51,8 @@ def test_the_breakdown_of_a_fresh_run_accounts_for_its_cpu_by_phase() -> None:
     assert row.modules == ["sympy"]
     assert all(value >= -0.02 for value in row.phases.values())
     assert row.phases["model (sympy, Lagrangian)"] > row.phases["interpreter start"]
-    assert math.isclose(sum(row.phases.values()), row.total, abs_tol=1e-9)
+    background = row.phases["background compilation (child)"]
+    assert math.isclose(sum(row.phases.values()) - background, row.total, abs_tol=1e-9)
     table = format_breakdown(rows)
     assert "pendulum_angle" in table and "auto's pilot runs" in table
 
