@@ -170,9 +170,11 @@ def _unroll_block(statements: list[ast.stmt]) -> list[ast.stmt]:
     return out
 
 
-def unroll_loops(function: ast.FunctionDef) -> None:
-    """Step 1 of the module docstring, in place."""
+def unroll_loops(function: ast.FunctionDef) -> bool:
+    """Step 1 of the module docstring, in place; whether a loop was unrolled."""
+    loops = sum(isinstance(node, ast.For) for node in walk(function))
     function.body = _unroll_block([_Fold().visit(s) for s in function.body])
+    return sum(isinstance(node, ast.For) for node in walk(function)) != loops
 
 
 def _allocation(statement: ast.stmt) -> tuple[str, tuple[int, ...], bool] | None:
@@ -278,6 +280,7 @@ def scalarise_arrays(function: ast.FunctionDef) -> bool:
 class _ItemLoads(ast.NodeTransformer):
     def __init__(self, arrays: set[str]) -> None:
         self.arrays = arrays
+        self.changed = False
 
     def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
         self.generic_visit(node)
@@ -286,11 +289,12 @@ class _ItemLoads(ast.NodeTransformer):
         parts = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
         if any(isinstance(part, (ast.Slice, ast.Starred)) for part in parts):
             return node  # a view, not an element
+        self.changed = True
         item = ast.Attribute(value=ast.Name(id=node.value.id, ctx=ast.Load()), attr="item", ctx=ast.Load())
         return ast.copy_location(ast.Call(func=item, args=list(parts), keywords=[]), node)
 
 
-def item_loads(function: ast.FunctionDef) -> None:
+def item_loads(function: ast.FunctionDef) -> bool:
     """Step 3 of the module docstring, in place: ``a[i, j]`` read from an array argument or
     allocation becomes ``a.item(i, j)``."""
     arrays = {a.arg for a in function.args.args}
@@ -298,7 +302,9 @@ def item_loads(function: ast.FunctionDef) -> None:
     stored = {node.id for node in walk(function) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store)}
     arrays = {name for name in arrays if name not in stored or name in
               {found[0] for found in map(_allocation, function.body) if found is not None}}
-    function.body = [_ItemLoads(arrays).visit(statement) for statement in function.body]
+    loads = _ItemLoads(arrays)
+    function.body = [loads.visit(statement) for statement in function.body]
+    return loads.changed
 
 
 def scalar_function(text: str, name: str) -> str | None:
@@ -312,11 +318,10 @@ def scalar_function(text: str, name: str) -> str | None:
     function = next((node for node in tree.body if isinstance(node, ast.FunctionDef) and node.name == name), None)
     if function is None:
         return None
-    before = ast.dump(function)
-    unroll_loops(function)
-    scalarise_arrays(function)
-    item_loads(function)
-    if ast.dump(function) == before:
+    changed = unroll_loops(function)
+    changed = scalarise_arrays(function) or changed
+    changed = item_loads(function) or changed
+    if not changed:
         return None
     ast.fix_missing_locations(tree)
     return ast.unparse(tree) + "\n"
