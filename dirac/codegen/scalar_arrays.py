@@ -10,9 +10,10 @@ several times that on Python floats. For the interpreted tier only
 rewrites one function:
 
 1. every loop ``for i in range(K)`` with a literal ``K`` (at most :data:`UNROLL_MAX`
-   iterations, no ``break``/``continue``/``else`` of its own, its variable not rebound in
-   its body) is unrolled: its body repeated with ``i`` replaced by ``0 .. K - 1`` in order,
-   then ``i = K - 1`` as the loop leaves it; integer arithmetic on literals is folded
+   iterations and :data:`UNROLL_STATEMENTS` statements unrolled, no
+   ``break``/``continue``/``else`` of its own, its variable not rebound in its body) is
+   unrolled: its body repeated with ``i`` replaced by ``0 .. K - 1`` in order, then
+   ``i = K - 1`` as the loop leaves it; integer arithmetic on literals is folded
    (``2 + 1`` -> ``3``) and ``if`` on a literal comparison keeps the side that runs;
 2. every array that the function allocates once at its top level with ``np.empty`` /
    ``np.zeros`` of a literal shape, and that it uses only through subscripts of literal
@@ -44,6 +45,9 @@ __all__ = ["scalar_function", "unroll_loops", "scalarise_arrays", "item_loads", 
 #: the longest literal loop unrolled (the kernels' loops run over the coordinates and
 #: constraints of a small system; a longer one is left as a loop)
 UNROLL_MAX = 8
+#: the most statements one unrolled loop may become (its inner loops already unrolled): a
+#: nest of long loops stays a loop rather than growing the function past what pays
+UNROLL_STATEMENTS = 512
 #: the largest array (elements) replaced by locals
 SCALAR_MAX = 64
 
@@ -158,8 +162,9 @@ def _unroll_block(statements: list[ast.stmt]) -> list[ast.stmt]:
         if isinstance(statement, ast.For):
             count = _literal_range(statement)
             target = statement.target
+            size = sum(isinstance(node, ast.stmt) for s in statement.body for node in walk(s))
             if count is not None and isinstance(target, ast.Name) and not _own_jumps(statement.body) \
-                    and not _binds(statement.body, target.id):
+                    and not _binds(statement.body, target.id) and count * size <= UNROLL_STATEMENTS:
                 for value in range(count):
                     copies = [_Fold().visit(_Substitute(target.id, value).visit(copy_tree(s))) for s in statement.body]
                     out.extend(_unroll_block(copies))

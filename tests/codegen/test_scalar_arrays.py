@@ -110,3 +110,25 @@ def test_a_loop_that_breaks_a_variable_index_and_a_long_loop_are_kept() -> None:
 def test_a_function_with_nothing_to_rewrite_is_left_alone() -> None:
     assert scalar_function("def run(a, b):\n    return a + b\n", "run") is None
     assert scalar_function("def other(a):\n    return a\n", "run") is None
+
+
+def test_a_nest_that_would_grow_past_the_statement_limit_stays_a_loop() -> None:
+    """Three nested loops of 8 (512 iterations of a two-statement body, 1024 statements and
+    more): the innermost two are unrolled (64 iterations), the outer one is kept; the sum
+    is the hand count, 8 * 8 * 8 = 512, on both forms."""
+    text = '''
+def run(out):
+    total = 0.0
+    for i in range(8):
+        for j in range(8):
+            for k in range(8):
+                total += 1.0
+                out[1] = total
+    out[0] = total
+'''
+    rewritten = scalar_function(text, "run")
+    assert rewritten is not None and rewritten.count("for i in range(8)") == 1 and "for k in" not in rewritten
+    for source in (text, rewritten):
+        out = np.zeros(2)
+        _run(source, out)
+        assert out.tolist() == [512.0, 512.0]
