@@ -47,7 +47,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-__all__ = ["LatencyRow", "run_latency", "format_latency", "CORPUS", "ANALYZE_TARGETS", "FIRST_TARGET", "STUDY_TARGET"]
+__all__ = ["LatencyRow", "run_latency", "format_latency", "BreakdownRow", "run_breakdown", "format_breakdown", "CORPUS", "ANALYZE_TARGETS", "FIRST_TARGET", "STUDY_TARGET"]
 
 #: the corpus (names of ``dirac_systems.latency_models.MODELS``)
 CORPUS = ("pendulum_angle", "double_pendulum_angles", "triple_pendulum_angles", "pendulum_cartesian",
@@ -129,6 +129,103 @@ if spec.get("angles"):
     result["angles"] = solution.y[: len(y0) // 2].T.tolist()
 print(json.dumps(result))
 '''
+
+_BREAKDOWN = r'''
+import json, sys, time
+stamps = [("interpreter start", time.process_time())]
+import numpy as np
+import dirac
+stamps.append(("import numpy, dirac", time.process_time()))
+spec = json.loads(sys.argv[1])
+from dirac_systems.latency_models import MODELS
+model = MODELS[spec["model"]]()
+stamps.append(("model (sympy, Lagrangian)", time.process_time()))
+n = len(model.state) // 2
+problem = dirac.ConstrainedProblem(model.system, q0=model.state[:n], p0=model.state[n:])
+stamps.append(("problem (kernel source, flattening)", time.process_time()))
+import dirac.flows.methods.auto as auto
+chosen = auto.choose_method
+pilots = []
+def timed_choice(*args, **kwargs):
+    start = time.process_time()
+    try:
+        return chosen(*args, **kwargs)
+    finally:
+        pilots.append(time.process_time() - start)
+auto.choose_method = timed_choice
+start = time.process_time()
+run = dirac.integrate(problem, t_end=spec["t_end"], samples=spec["samples"])
+stamps.append(("integrate", time.process_time()))
+print(json.dumps({"stamps": stamps, "pilots": sum(pilots), "method": run.method, "steps": int(run.steps),
+                  "modules": sorted(m for m in ("numba", "scipy", "sympy", "tqdm") if m in sys.modules)}))
+'''
+
+
+@dataclass
+class BreakdownRow:
+    """Where the CPU of one fresh-process run goes (:func:`run_breakdown`), seconds."""
+
+    system: str
+    method: str
+    steps: int
+    phases: dict[str, float]
+    total: float
+    modules: list[str]
+    failed: str = ""
+
+
+def run_breakdown(models: Sequence[str] = ("pendulum_angle", "double_pendulum_angles", "pendulum_cartesian",
+                                           "double_pendulum_cartesian"), *, t_end: float = 100.0, samples: int = 101,
+                  pythonpath: str | None = None, timeout: float = 600.0) -> list[BreakdownRow]:
+    """The ``t_end`` run with the default method of each system, in a fresh process with an
+    empty cache as :func:`run_latency` times it, cut into phases by CPU time stamps: the
+    interpreter's start, ``import dirac`` (with numpy), the model (sympy's import and the
+    Lagrangian), the problem (the generated kernel source and its flattening), ``auto``'s
+    pilot runs, compilations in the process (from the cache's compile history, without
+    numba's import, which counts in the run), the run itself, the exit (the interpreter's
+    shutdown, the rest of the child's CPU) and, apart, a compilation in a background child
+    (in the total, within the exit, only when the run waited for it to finish)."""
+    compile_bytecode(pythonpath)
+    rows = []
+    for name in models:
+        spec = {"model": name, "t_end": t_end, "samples": samples}
+        wall, cpu, out, err, code, compilations = _child(["-c", _BREAKDOWN, json.dumps(spec)], pythonpath, timeout)
+        lines = [line for line in out.splitlines() if line.startswith("{")]
+        if code != 0 or not lines:
+            tail = [line for line in err.strip().splitlines() if line.strip()]
+            rows.append(BreakdownRow(name, "", 0, {}, cpu, [], tail[-1][:160] if tail else f"exit status {code}"))
+            continue
+        result = json.loads(lines[-1])
+        stamps = result["stamps"]
+        phases = {label: stamps[0][1] if index == 0 else stamps[index][1] - stamps[index - 1][1]
+                  for index, (label, _) in enumerate(stamps)}
+        integrate = phases.pop("integrate")
+        compiled_here = sum(float(str(c.get("seconds", 0.0))) for c in compilations
+                            if isinstance(c, dict) and "background" not in str(c.get("what", "")))
+        in_background = sum(float(str(c.get("seconds", 0.0))) for c in compilations
+                            if isinstance(c, dict) and "background" in str(c.get("what", "")))
+        phases["auto's pilot runs"] = result["pilots"]
+        phases["compilation in the process"] = compiled_here
+        phases["the run (steps, sampling)"] = integrate - result["pilots"] - compiled_here
+        phases["exit and the rest"] = cpu - sum(phases.values())
+        # a child the run reaped counts in the total (in "exit and the rest"), one it left running does not
+        phases["background compilation (child)"] = in_background
+        rows.append(BreakdownRow(name, result["method"], result["steps"], phases, cpu, result["modules"]))
+    return rows
+
+
+def format_breakdown(rows: list[BreakdownRow]) -> str:
+    """The phases of :func:`run_breakdown` as a table (CPU seconds, one column per system)."""
+    good = [row for row in rows if not row.failed]
+    labels = list(good[0].phases) if good else []
+    lines = [f"{'CPU seconds':36s}" + "".join(f" {row.system[:26]:>26s}" for row in good)]
+    for label in labels:
+        lines.append(f"{label:36s}" + "".join(f" {row.phases[label]:26.2f}" for row in good))
+    lines.append(f"{'total (child user + system)':36s}" + "".join(f" {row.total:26.2f}" for row in good))
+    lines.append(f"{'method, steps':36s}" + "".join(f" {row.method + ', ' + str(row.steps):>26s}" for row in good))
+    lines.append(f"{'imported':36s}" + "".join(f" {' '.join(row.modules):>26s}" for row in good))
+    lines += [f"{row.system}: FAILED: {row.failed}" for row in rows if row.failed]
+    return "\n".join(lines)
 
 
 @dataclass

@@ -216,7 +216,10 @@ def mechanical_kernel_source(
                                list(inverse * sympy.Matrix(p_symbols)), (n,), parameters)
         # the signature of the eliminating version: its work arrays are not needed here
         functions.append(source.replace("def velocity(q, p, t, c, out):", "def velocity(q, p, t, c, out, work, piv):"))
-        functions.append(_stage_residual(q, parameters, inverse, force, v, list(chi), time))
+        if m or forces is not None:  # the constrained RATTLE and the forced loops solve with it;
+            # the unconstrained loop of an unforced system never calls it (a third of the
+            # symbolic work of a double pendulum's module)
+            functions.append(_stage_residual(q, parameters, inverse, force, v, list(chi), time))
     if constant:  # M^{-1} once, symbolically; the constant-mass RATTLE is unrolled into scalars
         functions.append(constant_mass_rattle_source(q, parameters, mass.inv(), potential, list(chi), time))
     body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m, not closed_velocity)

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -43,7 +44,7 @@ from dirac.codegen.background import (
     mark_ready,
     record_compile_seconds,
 )
-from dirac.codegen.flatten import flatten_source, specialised_function
+from dirac.codegen.flatten import flatten_source, function_text, specialised_function
 from dirac.codegen.numba_backend import (
     cache_directory,
     import_source,
@@ -52,9 +53,10 @@ from dirac.codegen.numba_backend import (
     source_path,
     write_source,
 )
+from dirac.codegen.scalar_arrays import scalar_function
 from dirac.errors import inform
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CHECK_SECONDS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
            "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
@@ -65,6 +67,10 @@ COMPILE_SECONDS = 1.0
 #: wait still not exceed the interpreted run); below it, a background compilation lets the
 #: run go on interpreted
 WAIT_FACTOR = 2.0
+#: CPU seconds of ``import numba`` in a fresh process (0.5-0.55 s measured on the 2-core machine
+#: of docs/performance.md, where a bare interpreter starts in 0.04 s), which a first compilation
+#: pays on top of the compile times the history records
+NUMBA_IMPORT_SECONDS = 0.5
 #: interpreted seconds between two looks at a background compilation (a step loop runs in
 #: parts of about this length while one is in flight)
 CHECK_SECONDS = 0.05
@@ -169,12 +175,21 @@ class TieredModule:
 
     def interpreted_function(self, name: str) -> Callable[..., Any]:
         """Function ``name`` of :attr:`interpreted`, its LU solves of fixed size unrolled
-        (:func:`~dirac.codegen.flatten.specialised_function`: the same operations in the same
-        order, so the same numbers, in a fraction of the interpreter's time); specialised
+        (:func:`~dirac.codegen.flatten.specialised_function`), its loops of literal length
+        unrolled and its small work arrays made Python floats
+        (:func:`~dirac.codegen.scalar_arrays.scalar_function`): the same operations in the same
+        order, so the same numbers, in a fraction of the interpreter's time; specialised
         when first asked for, and put in the interpreted module in place of the looped one."""
         module = self.interpreted
         if name not in self._specialised:
             text = specialised_function(self.source, name)
+            plain = text if text is not None else function_text(self.source, name)
+            signature = re.search(rf"def {name}\(([^)]*)\)", plain or "")
+            if plain is not None and signature is not None and "n_steps" in signature.group(1):
+                # a step loop (its rewriting, tens of milliseconds, pays back over its steps; a
+                # function called once per sample would not repay it)
+                scalar = scalar_function(plain, name)
+                text = scalar if scalar is not None else text
             if text is not None:
                 exec(compile(text, f"<dirac generated {module.__name__} {name}>", "exec"), module.__dict__)
             self._specialised.add(name)
@@ -248,8 +263,14 @@ class TieredFunction:
 
     def compile_estimate(self) -> float:
         """Estimated seconds to compile this function (:func:`estimate_compile_seconds` of
-        the module's source size and the measured history in the cache)."""
-        return estimate_compile_seconds(self.kernel_chars())
+        the module's source size and the measured history in the cache), plus
+        :data:`NUMBA_IMPORT_SECONDS` while numba is not imported in this process (the history
+        times the compilation alone; a first compilation, here or in a child, imports numba
+        first)."""
+        import sys
+
+        start = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
+        return estimate_compile_seconds(self.kernel_chars()) + start
 
     def kernel_chars(self) -> int:
         """The size of what numba compiles for this function (:func:`kernel_chars`)."""
@@ -377,7 +398,12 @@ class TieredFunction:
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
                          "compile", args)
             return
-        if background_enabled() and not self.background_failed and (spare_core() or remaining <= estimate):
+        if remaining <= estimate:
+            # the interpreted remainder costs less than compiling: a compilation, in this process or
+            # beside it, would cost more CPU than it could save (a double pendulum's t_end = 100 run
+            # spent 9 s of CPU where its interpreted run alone took 5)
+            return
+        if background_enabled() and not self.background_failed and spare_core():
             announce_compilation(f"{self.name} of {self.module.title}",
                                  f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")

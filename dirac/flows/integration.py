@@ -281,6 +281,16 @@ def _names_for(kind: str) -> list[str]:
     return ["auto"] + [n for n in method_names() if n in METHODS and METHODS[n].accepts(kind)]
 
 
+class _NoBar:
+    """What the loop uses of a tqdm bar, doing nothing (``progress=False``)."""
+
+    def update(self, n: int = 1) -> None:
+        """Nothing to draw."""
+
+    def close(self) -> None:
+        """Nothing to close."""
+
+
 class _Loop:
     """One run of the loop (keeps the bookkeeping out of :func:`integrate`)."""
 
@@ -359,13 +369,17 @@ class _Loop:
 
     # ------------------------------------------------------------------ the loop
     def run(self) -> Solution:
-        from tqdm import tqdm
-
         kind = self.stepper.kind
         intervals = self._intervals() if kind == "fixed" else []
         total = sum(n for _, _, n in intervals) if kind == "fixed" else len(self.times)
-        bar = tqdm(total=total, disable=not self.progress, unit=("step" if kind == "fixed" else "sample"),
-                   file=sys.stderr, leave=False, dynamic_ncols=True, desc=self.method.name)
+        bar: Any
+        if self.progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=total, unit=("step" if kind == "fixed" else "sample"), file=sys.stderr, leave=False,
+                       dynamic_ncols=True, desc=self.method.name)
+        else:  # no bar asked: tqdm is not imported (a few hundredths of a second of every fresh run)
+            bar = _NoBar()
         start = time.process_time()
         try:
             if kind == "exact":

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from dirac.bench.latency import CORPUS, format_latency, run_latency
+from dirac.bench.latency import CORPUS, format_breakdown, format_latency, run_breakdown, run_latency
 from dirac.bench.report import wrap_title
 from dirac_systems.latency_models import MODELS
 
@@ -37,6 +37,24 @@ def test_a_tiny_corpus_runs_in_fresh_processes_and_conserves_energy() -> None:
     assert all(row.wall > 0 and row.cpu >= 0 for row in rows)
     table = format_latency(rows)
     assert "pendulum_angle" in table and "scipy pendulum" in table and "energy" in table
+
+
+def test_the_breakdown_of_a_fresh_run_accounts_for_its_cpu_by_phase() -> None:
+    """The pendulum in its angle over t = 0.5 with the default method: a fresh process that
+    imports sympy to build its model and neither numba nor scipy (a short run stays
+    interpreted and needs no scipy); the phases are CPU times (none below rounding, the model
+    taking sympy's import: more than the interpreter's start) and add up to the child's CPU."""
+    rows = run_breakdown(["pendulum_angle"], t_end=0.5, samples=3, timeout=300)
+    assert [row.failed for row in rows] == [""]
+    row = rows[0]
+    assert row.method.startswith("rattle-") and row.steps >= 1
+    assert row.modules == ["sympy"]
+    assert all(value >= -0.02 for value in row.phases.values())
+    assert row.phases["model (sympy, Lagrangian)"] > row.phases["interpreter start"]
+    background = row.phases["background compilation (child)"]
+    assert math.isclose(sum(row.phases.values()) - background, row.total, abs_tol=1e-9)
+    table = format_breakdown(rows)
+    assert "pendulum_angle" in table and "auto's pilot runs" in table
 
 
 @pytest.mark.parametrize("name", ["bead_on_rotating_hoop", "double_pendulum_cartesian"])

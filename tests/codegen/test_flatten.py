@@ -156,3 +156,48 @@ def test_one_function_is_specialised_alone_when_the_interpreter_first_runs_it() 
     exec(compile(text, "<specialised fixed>", "exec"), module.__dict__)
     module.fixed(unrolled)
     assert looped.tobytes() == unrolled.tobytes()
+
+
+_BLOCKS = '''"""blocks -- generated for a test"""
+import math
+import numpy as np
+import numba
+''' + lu_source() + '''
+
+@numba.njit(cache=True)
+def blocks(b, c):
+    """Two 2 x 2 matrices stacked in one (4, 2) allocation, factored as the blocks J[:2] and J[2:]."""
+    J = np.empty((2 * 2, 2))
+    piv = np.empty(2 * 2, dtype=np.int64)
+    J[0, 0] = 1.0
+    J[0, 1] = 2.0
+    J[1, 0] = 3.0
+    J[1, 1] = 4.0
+    J[2, 0] = 0.5
+    J[2, 1] = -1.0
+    J[3, 0] = 2.0
+    J[3, 1] = 0.25
+    lu_factor(J[:2], piv[:2])
+    lu_factor(J[2:], piv[2:])
+    lu_solve(J[:2], piv[:2], b)
+    lu_solve(J[2:], piv[2:], c)
+'''
+
+
+def test_the_square_blocks_of_one_allocation_are_unrolled_too() -> None:
+    """``lu_factor(J[:2], ...)`` and ``lu_factor(J[2:], ...)`` of a ``(2 * 2, 2)`` allocation (the
+    two Newton matrices of the unconstrained RATTLE loop) call the unrolled 2 x 2 forms; the
+    solutions are the loops' bit for bit and Cramer's rule's: [[1, 2], [3, 4]] x = (1, 1) gives
+    x = (-1, 1), [[0.5, -1], [2, 0.25]] y = (1, 2) gives y = (18 / 17, -8 / 17) (determinants -2
+    and 2.125)."""
+    specialised = specialise_solves(_BLOCKS)
+    assert "lu_factor_2(J[:2], piv[:2])" in specialised and "lu_factor_2(J[2:], piv[2:])" in specialised
+    assert "lu_solve_2(J[2:], piv[2:], c)" in specialised
+    results = []
+    for source in (_BLOCKS, specialised):
+        b, c = np.array([1.0, 1.0]), np.array([1.0, 2.0])
+        interpret_source(source).blocks(b, c)
+        results.append(b.tobytes() + c.tobytes())
+        np.testing.assert_allclose(b, [-1.0, 1.0], rtol=1e-15)
+        np.testing.assert_allclose(c, [18.0 / 17.0, -8.0 / 17.0], rtol=1e-15)
+    assert results[0] == results[1]

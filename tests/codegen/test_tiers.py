@@ -136,12 +136,13 @@ def _loop_module(tmp_path, monkeypatch) -> tiers.TieredFunction:
 
 
 def test_a_long_loop_compiles_in_the_background_and_switches_at_a_step_boundary(tmp_path, monkeypatch, capsys) -> None:
-    """Planned beyond a second of interpreted work, yet less than the compilation is estimated
-    to cost, with an idle core: a child process compiles while the loop goes on interpreted in
-    parts; after it is done the next part runs compiled. The iterates are the hand loop's to
-    the last bit (the same operations)."""
+    """Planned beyond a second of interpreted work and beyond the estimated compilation, yet
+    less than twice it, with an idle core: a child process compiles while the loop goes on
+    interpreted in parts; after it is done the next part runs compiled. The iterates are the
+    hand loop's to the last bit (the same operations)."""
     monkeypatch.setattr(tiers, "spare_core", lambda: True)
-    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
+    # 0.6 of the interpreted remainder (measured rate times the 10^9 steps planned): remainder / estimate = 1.67
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 0.6 * (self.seconds_per_step() or 0.0) * 1e9)
     function = _loop_module(tmp_path, monkeypatch)
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(300, 10**9, x, 0.0, 0.1, 300, info)
@@ -195,6 +196,19 @@ def test_kernel_size_counts_the_function_and_what_it_calls_not_the_module() -> N
     assert kernel_chars(source, "a") == len(a) + len(b) + len(c)
     assert kernel_chars(source, "c") == len(c)
     assert kernel_chars(source, "unused") == len(source) - 7  # all four definitions: the source less its separators
+
+
+def test_a_loop_shorter_than_its_compilation_starts_none_even_with_an_idle_core(tmp_path, monkeypatch) -> None:
+    """Planned beyond a second of interpreted work but below the estimated compile time: no
+    compilation, in the process or beside it, since it would cost more CPU than the whole
+    interpreted remainder; the loop runs interpreted to the end, the hand loop's iterates."""
+    monkeypatch.setattr(tiers, "spare_core", lambda: True)
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
+    function = _loop_module(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(300, 10**9, x, 0.0, 0.1, 300, info)
+    assert function.background is None and function.tier == "interpreted"
+    assert x[0] == _hand_loop(0.5, 300) and info[0] == 300 and info[2] == 300
 
 
 def test_a_short_loop_stays_interpreted_and_starts_no_compilation(tmp_path, monkeypatch) -> None:
