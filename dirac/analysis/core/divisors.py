@@ -146,6 +146,11 @@ def denominator_factors(
     ))  # every denominator of the tree, in one walk (no gcd: a factor the numerator cancels is kept)
     if settled is not None:
         bases = [b for b in bases if not settled(b)]
+    return _irreducible_factors(bases, names)
+
+
+def _irreducible_factors(bases: Sequence[sympy.Expr], names: set) -> list[sympy.Expr]:
+    """The distinct irreducible factors of the ``bases`` that depend on ``names``, without real-zero-free ones."""
     found: list[sympy.Expr] = []
     for base in bases:
         try:
@@ -196,7 +201,7 @@ def divisions(
         for f in denominator_factors(e, variables, settled):
             found.setdefault(f, Division(f, stage, what))
     if skipped and unsearched is not None:
-        unsearched.append(Unsearched(skipped, stage, what))
+        unsearched.append(Unsearched(skipped, stage, what, STRUCTURAL_NODES if structural else None))
     return list(found.values())
 
 
@@ -224,7 +229,7 @@ STRUCTURAL_NODES = 200_000
 
 def structural_divisors(
     expr: sympy.Expr, variables: Sequence[sympy.Symbol], settled: Callable[[sympy.Expr], bool] | None = None,
-    seen: set | None = None, limit: int = STRUCTURAL_NODES,
+    seen: set | None = None, limit: int | None = None,
 ) -> list[sympy.Expr] | None:
     """The divisors of an expression too long to factor, read off its tree: the bases of its negative powers.
 
@@ -242,6 +247,7 @@ def structural_divisors(
     distinct nodes not seen before.
     """
     names = set(variables)
+    limit = STRUCTURAL_NODES if limit is None else limit
     seen = set() if seen is None else seen
     memo: dict = {}  # free symbols of shared sub-trees, walked once
     stack = [expr]
@@ -261,7 +267,7 @@ def structural_divisors(
     out: list[sympy.Expr] = []
     for base in dict.fromkeys(bases):
         if not _nested(base) and prints_shorter(base, DIVISOR_TEXT_LIMIT):  # proofs and factoring expand: short polynomials only
-            factors = [] if settled is not None and settled(base) else denominator_factors(1 / base, variables, settled)
+            factors = [] if settled is not None and settled(base) else _irreducible_factors([base], names)
         else:
             factors = [base]  # kept as written (assumptions such as is_positive cost seconds on a nested pivot)
         out += [f for f in factors if f not in out]
@@ -287,11 +293,14 @@ class Unsearched:
     count: int
     stage: int
     what: str
+    #: when the trees were walked for their divisors (:func:`structural_divisors`): the most distinct nodes walked
+    nodes: int | None = None
 
     def __str__(self) -> str:
+        walked = "" if self.nodes is None else f", and their trees have more than {self.nodes} distinct nodes to walk"
         return (f"not searched in {self.count} expression{'s' if self.count != 1 else ''} of stage {self.stage} "
-                f"(longer than {DIVISOR_TEXT_LIMIT} characters, too long to factor): whether {self.what} on part of "
-                "the surface is neither found nor ruled out")
+                f"(longer than {DIVISOR_TEXT_LIMIT} characters, too long to factor{walked}): whether {self.what} on "
+                "part of the surface is neither found nor ruled out")
 
 
 def fixed_values(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> dict[sympy.Symbol, sympy.Expr]:
