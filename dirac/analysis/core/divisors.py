@@ -527,8 +527,11 @@ def nonvanishing_on(surface: Sequence[sympy.Expr], variables: Sequence[sympy.Sym
 CONSTANT_TEST_EQUATIONS = 200
 
 
-#: seconds the decisions on the divisors read off trees (:func:`structural_divisors`) may take in all
-STRUCTURAL_BUDGET = 1.0
+#: CPU seconds the decisions on the divisors read off trees (:func:`structural_divisors`) may take in all
+#: (CPU, not wall time: what is decided should not depend on the load of the machine)
+STRUCTURAL_BUDGET = 2.0
+#: divisors read off trees searched for a point of their locus, at most (each search compiles the divisor's gradient)
+STRUCTURAL_SEARCHES = 8
 
 
 @dataclass(frozen=True)
@@ -561,7 +564,8 @@ def shown(expr: sympy.Expr, limit: int = DIVISOR_TEXT_LIMIT) -> str:
 NOT_FOUND = (f"no point of the surface where it vanishes was found in {LOCUS_ATTEMPTS} projections, which "
              "is no proof that there is none")
 #: ... and when the time budget ran out before it was searched
-OUT_OF_TIME = f"not searched: the {STRUCTURAL_BUDGET:g} s budget for divisors read off long expressions ran out"
+OUT_OF_TIME = (f"not searched: the budget for divisors read off long expressions ({STRUCTURAL_SEARCHES} searches, "
+               f"{STRUCTURAL_BUDGET:g} s of CPU time) ran out")
 
 
 def value_on_surface(
@@ -651,8 +655,8 @@ def singular_loci(
     regular at that point, and if so the locus is one of the solved form only
     (:data:`PIVOT_SINGULAR`); otherwise its ``what`` says that a numerator may cancel
     (:data:`AS_WRITTEN`). No point found is no proof: such a divisor goes to
-    ``undecided`` (:class:`Undecided`), as do those left when ``budget`` seconds of these
-    decisions have run out.
+    ``undecided`` (:class:`Undecided`), as do those left when ``budget`` CPU seconds of these
+    decisions, or ``STRUCTURAL_SEARCHES`` searches, have run out.
     """
     fixed = fixed_values(list(surface), variables)
     seen: dict[sympy.Expr, Division] = {}
@@ -662,14 +666,15 @@ def singular_loci(
     memo: dict = {}  # free symbols of the constraints, walked once for all the divisors
     cache: dict = {}  # values on the surface of the nodes of the divisors read off trees (value_on_surface)
     deadline: float | None = None
+    searched = 0  # divisors read off trees searched for a point so far (at most STRUCTURAL_SEARCHES)
     plain = {d.divisor: not d.structural or (not _nested(d.divisor) and prints_shorter(d.divisor, DIVISOR_TEXT_LIMIT))
              for d in seen.values()}
     # the divisors read off trees after the others, short polynomials first: the budget goes to the cheap ones
     for d in sorted(seen.values(), key=lambda d: (d.structural, not plain[d.divisor])):
         short = plain[d.divisor]
         if d.structural:
-            deadline = time.monotonic() + budget if deadline is None else deadline
-            if time.monotonic() > deadline:
+            deadline = time.process_time() + budget if deadline is None else deadline
+            if time.process_time() > deadline or searched >= STRUCTURAL_SEARCHES:
                 if undecided is not None:
                     undecided.append(Undecided(d.divisor, d.stage, d.what, OUT_OF_TIME))
                 continue
@@ -683,6 +688,7 @@ def singular_loci(
             proven = value_on_surface(d.divisor, surface, variables, memo, cache)
             if proven is not None and proven != 0:
                 continue  # built from parts constant on the surface, into a nonzero constant: no locus
+        searched += d.structural
         try:
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:
