@@ -350,7 +350,8 @@ class ConstraintAnalysis:
         if not found:
             self._unsearched = tuple(unsearched)
             return ()
-        numerics = Numerics(self._space, self._generic, seed=self._seed + 1, time=self.time)
+        # the analysis' compiled functions shared (the constraints' gradients are compiled already), fresh random points
+        numerics = self._numerics.sharing_compiled(self._generic, seed=self._seed + 1)
         numerics.avoid = list(self._numerics.avoid)
         undecided: list[Undecided] = []
         loci = singular_loci(found, surface, numerics, variables, undecided=undecided,

@@ -532,6 +532,9 @@ CONSTANT_TEST_EQUATIONS = 200
 STRUCTURAL_BUDGET = 2.0
 #: divisors read off trees searched for a point of their locus, at most (each search compiles the divisor's gradient)
 STRUCTURAL_SEARCHES = 8
+#: ... and only those that print shorter than this (characters): the projections onto a longer one, a nested pivot
+#: of (228) of thousands of characters, cost a third of a second each and found no point there
+SEARCH_TEXT_LIMIT = 1000
 
 
 @dataclass(frozen=True)
@@ -563,6 +566,9 @@ def shown(expr: sympy.Expr, limit: int = DIVISOR_TEXT_LIMIT) -> str:
 #: why a divisor read off a tree stays undecided when no point of the locus is found
 NOT_FOUND = (f"no point of the surface where it vanishes was found in {LOCUS_ATTEMPTS} projections, which "
              "is no proof that there is none")
+#: ... when it is too long to search
+TOO_LONG_TO_SEARCH = (f"not searched: it prints to {SEARCH_TEXT_LIMIT} characters or more (the projections onto "
+                      "its zeros would cost more than the analysis)")
 #: ... and when the time budget ran out before it was searched
 OUT_OF_TIME = (f"not searched: the budget for divisors read off long expressions ({STRUCTURAL_SEARCHES} searches, "
                f"{STRUCTURAL_BUDGET:g} s of CPU time) ran out")
@@ -688,6 +694,10 @@ def singular_loci(
             proven = value_on_surface(d.divisor, surface, variables, memo, cache)
             if proven is not None and proven != 0:
                 continue  # built from parts constant on the surface, into a nonzero constant: no locus
+        if d.structural and not prints_shorter(d.divisor, SEARCH_TEXT_LIMIT):
+            if undecided is not None:
+                undecided.append(Undecided(d.divisor, d.stage, d.what, TOO_LONG_TO_SEARCH))
+            continue
         searched += d.structural
         try:
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
