@@ -356,7 +356,7 @@ class ConstraintAnalysis:
         undecided: list[Undecided] = []
         loci = singular_loci(found, surface, numerics, variables, undecided=undecided,
                              regular_at=self._solved_block_regular(numerics))
-        self._unsearched = tuple(unsearched + undecided)
+        self._unsearched = (*unsearched, *undecided)
         return loci
 
     def _solved_block_regular(self, numerics: Numerics) -> Callable[[np.ndarray], bool] | None:
