@@ -603,7 +603,7 @@ def value_on_surface(
             parts = []
             if polynomial:
                 whole = sympy.Add(*polynomial)
-                parts.append(constant_on_surface(whole, surface, variables, memo)  # (it expands)
+                parts.append(_ring_constant(whole, surface, variables, memo)
                              if prints_shorter(whole, DIVISOR_TEXT_LIMIT) else None)
             for arg in node.args:
                 if parts and parts[-1] is None:
@@ -635,6 +635,67 @@ def value_on_surface(
         return cache[key]
 
     return value(expr)
+
+
+def _ring_constant(
+    expr: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict
+) -> sympy.Expr | None:
+    """:func:`constant_on_surface` of a polynomial ``expr``, with the polynomials built by ring arithmetic.
+
+    The same identity ``expr = c + sum_i a_i phi_i`` (numbers or parameters ``a_i``, the
+    polynomial constraints in ``expr``'s variables), decided by the same linear system;
+    ``expr`` and the constraints become elements of ``QQ(parameters)[variables]`` by one walk
+    of their trees (:func:`~dirac.analysis.core.algebra.ring_value`) instead of ``expand``
+    and ``Poly`` (a tenth of the time on the pivots of (19)). ``None`` says nothing.
+    """
+    from sympy.polys.rings import ring as polynomial_ring
+
+    from dirac.analysis.core.algebra import NotInRing, ring_value
+
+    names = set(variables)
+    own = tuple(sorted(free_symbols_of([expr], memo) & names, key=lambda v: v.name))
+    if not own:
+        return None
+    key = ("ring constraints", own)
+    if key not in memo:
+        params = sorted(set().union(*(free_symbols_of([c], memo) for c in surface)) - names, key=lambda v: v.name)
+        domain = sympy.QQ.frac_field(*params) if params else sympy.QQ
+        R, *gens = polynomial_ring(list(own), domain)
+        mapping: dict = dict(zip(own, gens))
+        mapping.update({p: R(domain.from_sympy(p)) for p in params})
+        used = []
+        for c in surface:
+            inside = free_symbols_of([c], memo) & names
+            if inside and inside <= set(own):
+                try:
+                    used.append(ring_value(c, mapping, R))
+                except NotInRing:
+                    continue
+        memo[key] = (R, mapping, used)
+    R, mapping, used = memo[key]
+    if not used:
+        return None
+    try:
+        value = ring_value(expr, mapping, R)
+    except (NotInRing, sympy.CoercionFailed):
+        return None
+    if set(free_symbols_of([expr], memo)) - names - set(mapping):
+        return None  # a symbol outside the ring's parameters
+    polys = [value, *used]
+    field = R.domain
+    monomials = sorted({m for p in polys for m in p.keys()})
+    if len(monomials) > CONSTANT_TEST_EQUATIONS:
+        return None
+    constant = (0,) * len(own)
+    rows = [[field.one if m == constant else field.zero, *(p.get(m, field.zero) for p in used), value.get(m, field.zero)]
+            for m in monomials]
+    reduced, pivots = DomainMatrix(rows, (len(rows), len(used) + 2), field).rref()
+    if len(used) + 1 in pivots or 0 not in pivots:
+        return None
+    row = reduced.to_Matrix().row(pivots.index(0))
+    if any(row[j] != 0 for j in range(1, len(used) + 1) if j not in pivots):
+        return None
+    return _exact_value(row[len(used) + 1])
 
 
 def singular_loci(
