@@ -26,6 +26,15 @@ an exact identity ``f = c + sum a_i phi_i`` with a constant ``c != 0``
 divisor by sampling: a Gauss–Newton projection onto ``S`` and ``f = 0`` together
 (:meth:`~dirac.analysis.core.numeric.Numerics.surface_points`) finds a point of the
 locus, or shows none nearby in its attempts.
+
+An expression too long to factor (over ``DIVISOR_TEXT_LIMIT`` characters: the multiplier
+solutions of the rigid body's (228) and (19), nested eliminations) is not passed over: its
+divisors as written are the bases of its negative powers, read off its graph
+(:func:`structural_divisors`), and each is proven nonzero on the surface (the proofs
+above, or node by node from parts constant there, :func:`value_on_surface`), found to
+vanish at a point of it (for the multiplier solution, a pivot of the elimination where
+the block it inverts is regular is a locus of the solved form only, :data:`PIVOT_SINGULAR`),
+or left open with the reason (:class:`Undecided`): no point found is no proof.
 """
 
 from __future__ import annotations
