@@ -28,13 +28,14 @@ from dirac.analysis.core.divisors import (
     MULTIPLIERS_SINGULAR,
     Division,
     SingularLocus,
+    Undecided,
     Unsearched,
     divisions,
     nonvanishing_on,
     singular_loci,
 )
 from dirac.analysis.core.linear_solve import SolveTooLarge
-from dirac.analysis.core.numeric import Numerics, independent_rows
+from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.numeric_map import LegendreMap, MomentumSymbols
@@ -286,7 +287,7 @@ class ConstraintAnalysis:
         self.components: list = []
         self._generic_analysis: ConstraintAnalysis | None = None
         self._singular_loci: tuple[SingularLocus, ...] | None = None
-        self._unsearched: tuple[Unsearched, ...] = ()
+        self._unsearched: tuple[Unsearched | Undecided, ...] = ()
         self._seed = seed
         if self.parameters:
             self.special_parameter_values, searched = self._special_values(chain, C, cls.second_indices, seed)
@@ -311,10 +312,13 @@ class ConstraintAnalysis:
         return self._singular_loci
 
     @property
-    def singular_loci_unsearched(self) -> tuple[Unsearched, ...]:
-        """The expressions of the analysis too long to search for divisions by zero
-        (:class:`~dirac.analysis.core.divisors.Unsearched`, one record per place and stage; empty
-        when every expression was searched): a division by zero in them is neither among
+    def singular_loci_unsearched(self) -> tuple[Unsearched | Undecided, ...]:
+        """What the search for divisions by zero left open: the expressions of the analysis too long to
+        search (:class:`~dirac.analysis.core.divisors.Unsearched`, one record per place and stage, for
+        the elimination of multipliers in the chain, or a tree too large to walk), and the divisors read
+        off the trees of long expressions that are neither proven nonzero on the surface nor found to
+        vanish there (:class:`~dirac.analysis.core.divisors.Undecided`, one per divisor, with the
+        reason); empty when everything was decided. A division by zero there is neither among
         :attr:`singular_loci` nor ruled out, and the report says so."""
         _ = self.singular_loci
         return self._unsearched
@@ -325,27 +329,49 @@ class ConstraintAnalysis:
         legendre = self._legendre
         surface = [*self.constraints, *self.reducible_constraints]
         settled = nonvanishing_on(surface, variables)  # denominators proven nonzero on the surface are not factored
-        unsearched: list[Unsearched] = list(self._chain.unsearched)
+        unsearched: list[Unsearched | Undecided] = list(self._chain.unsearched)
+        skipped: list[Unsearched] = []
         found: list[Division] = divisions(
             [*legendre.velocity_solution.values(), self.canonical_hamiltonian], 1, LEGENDRE_SINGULAR, variables, settled,
-            unsearched=unsearched,
+            unsearched=skipped, structural=True,
         )
         found += self._chain.divisions
         solution = self.multiplier_solution
         if self._chain.multiplier_solution is not None and self.constraints:
             exprs = [*solution.particular.values(), *(e for vec in solution.null_vectors for e in vec.values())]
-            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables, settled, unsearched=unsearched)
+            found += divisions(exprs, len(self.stages), MULTIPLIERS_SINGULAR, variables, settled, unsearched=skipped,
+                               structural=True)
         if 0 < len(self.second_class) <= SMALL_DETERMINANT:
             C = bracket_matrix(self._space, self.second_class)
             found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
                                "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
-                               "constraints drops rank)", variables, unsearched=unsearched)
-        self._unsearched = tuple(unsearched)
+                               "constraints drops rank)", variables, unsearched=skipped, structural=True)
+        unsearched += skipped
         if not found:
+            self._unsearched = tuple(unsearched)
             return ()
-        numerics = Numerics(self._space, self._generic, seed=self._seed + 1, time=self.time)
+        # the analysis' compiled functions shared (the constraints' gradients are compiled already), fresh random points
+        numerics = self._numerics.sharing_compiled(self._generic, seed=self._seed + 1)
         numerics.avoid = list(self._numerics.avoid)
-        return singular_loci(found, surface, numerics, variables)
+        undecided: list[Undecided] = []
+        loci = singular_loci(found, surface, numerics, variables, undecided=undecided,
+                             regular_at=self._solved_block_regular(numerics))
+        self._unsearched = (*unsearched, *undecided)
+        return loci
+
+    def _solved_block_regular(self, numerics: Numerics) -> Callable[[np.ndarray], bool] | None:
+        """``z -> bool``: whether the block ``A_PQ`` the exact multiplier solution inverts has full rank at the
+        point ``z`` (finite values, rank by SVD); ``None`` when there is no such block."""
+        chain_solution = self._chain.multiplier_solution
+        block = getattr(chain_solution, "matrix", None)
+        if block is None or block.shape[0] == 0:
+            return None
+
+        def regular(z: np.ndarray) -> bool:
+            values = numerics.evaluate(list(block), [z]).reshape(block.shape)
+            return bool(np.all(np.isfinite(values))) and numeric_rank(values) == block.shape[0]
+
+        return regular
 
     @property
     def multipliers(self) -> Mapping[str, sympy.Expr]:

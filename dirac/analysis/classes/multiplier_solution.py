@@ -75,6 +75,7 @@ class MultiplierSolution:
         null_vectors: list[dict[str, sympy.Expr]] | None,
         free: tuple[sympy.Symbol, ...] = (),
         solve: Callable[[], tuple[dict[str, sympy.Expr], list[dict[str, sympy.Expr]]]] | None = None,
+        matrix: sympy.Matrix | None = None,
     ) -> None:
         if (particular is None or null_vectors is None) and solve is None:
             raise ValueError("a multiplier solution needs its particular solution and null vectors, or a solve that gives them")
@@ -85,6 +86,9 @@ class MultiplierSolution:
         self._particular = particular
         self._null_vectors = null_vectors
         self._solve = solve if (particular is None or null_vectors is None) else None
+        #: the square block ``A_PQ`` of the consistency conditions that the exact solve inverts (``None`` when
+        #: not known): where it is regular the multipliers are finite, whatever the solved expressions divide by
+        self.matrix = matrix
 
     def __repr__(self) -> str:
         state = "solved" if self.solved else "exact solve on first use"
@@ -289,5 +293,6 @@ def general_multiplier_solution(
         return particular, null_vectors
 
     return MultiplierSolution(
-        multipliers, list(primary), canonical_hamiltonian, None, None, free_parameters(len(F), taken), solve=solve
+        multipliers, list(primary), canonical_hamiltonian, None, None, free_parameters(len(F), taken), solve=solve,
+        matrix=a_rows[:, Q],
     )

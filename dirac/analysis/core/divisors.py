@@ -26,23 +26,34 @@ an exact identity ``f = c + sum a_i phi_i`` with a constant ``c != 0``
 divisor by sampling: a Gauss–Newton projection onto ``S`` and ``f = 0`` together
 (:meth:`~dirac.analysis.core.numeric.Numerics.surface_points`) finds a point of the
 locus, or shows none nearby in its attempts.
+
+An expression too long to factor (over ``DIVISOR_TEXT_LIMIT`` characters: the multiplier
+solutions of the rigid body's (228) and (19), nested eliminations) is not passed over: its
+divisors as written are the bases of its negative powers, read off its graph
+(:func:`structural_divisors`), and each is proven nonzero on the surface (the proofs
+above, or node by node from parts constant there, :func:`value_on_surface`), found to
+vanish at a point of it (for the multiplier solution, a pivot of the elimination where
+the block it inverts is regular is a locus of the solved form only, :data:`PIVOT_SINGULAR`),
+or left open with the reason (:class:`Undecided`): no point found is no proof.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from math import factorial
 
+import numpy as np
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from dirac.analysis.core.algebra import prints_shorter
+from dirac.analysis.core.algebra import printed, prints_shorter
 from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.errors import AnalysisError
 
 __all__ = [
-    "Division", "SingularLocus", "Unsearched", "too_long_to_search", "denominator_factors", "singular_loci",
+    "Division", "SingularLocus", "Unsearched", "Undecided", "too_long_to_search", "structural_divisors", "value_on_surface", "denominator_factors", "singular_loci",
     "constant_on_surface", "square_on_surface", "determinant_grid", "nonvanishing_on", "LEGENDRE_SINGULAR",
     "MULTIPLIERS_SINGULAR",
 ]
@@ -64,6 +75,15 @@ LEGENDRE_SINGULAR = (
 )
 #: what happens on the locus of a divisor of the multiplier solution
 MULTIPLIERS_SINGULAR = "the multiplier solution divides by zero"
+#: what happens on the locus of a pivot of the multiplier solution's elimination where the solved matrix is regular
+PIVOT_SINGULAR = (
+    "the multiplier solution as written divides by zero (a pivot of the elimination that solved it); the block "
+    "A_PQ of the consistency conditions it inverts is regular at a point of the locus, so the multipliers are "
+    "finite there: the division is one of the solved form, not of the multipliers (evaluate them near the locus "
+    "by another pivot order, or numerically)"
+)
+#: added to what happens on the locus of a divisor read off a tree (no cancellation tried) when nothing else decides
+AS_WRITTEN = " (as written: read off an expression too long to cancel, so a numerator may cancel the division)"
 
 
 @dataclass(frozen=True)
@@ -73,6 +93,9 @@ class Division:
     divisor: sympy.Expr
     stage: int
     what: str
+    #: found as the base of a negative power of an expression too long to factor (:func:`structural_divisors`):
+    #: a division as written, which a numerator may cancel
+    structural: bool = False
 
 
 @dataclass(frozen=True)
@@ -100,10 +123,10 @@ class SingularLocus:
 
     def to_json(self) -> dict:
         """``{"expression", "where", "stage", "what"}`` (the ``"singular_loci"`` entries of the analysis JSON)."""
-        return {"expression": str(self.expression), "where": self.where, "stage": self.stage, "what": self.what}
+        return {"expression": shown(self.expression), "where": self.where, "stage": self.stage, "what": self.what}
 
     def __str__(self) -> str:
-        return f"{self.where} (divisor {self.expression}, stage {self.stage}): {self.what}"
+        return f"{self.where} (divisor {shown(self.expression)}, stage {self.stage}): {self.what}"
 
 
 def _never_zero(factor: sympy.Expr) -> bool:
@@ -132,6 +155,11 @@ def denominator_factors(
     ))  # every denominator of the tree, in one walk (no gcd: a factor the numerator cancels is kept)
     if settled is not None:
         bases = [b for b in bases if not settled(b)]
+    return _irreducible_factors(bases, names)
+
+
+def _irreducible_factors(bases: Sequence[sympy.Expr], names: set) -> list[sympy.Expr]:
+    """The distinct irreducible factors of the ``bases`` that depend on ``names``, without real-zero-free ones."""
     found: list[sympy.Expr] = []
     for base in bases:
         try:
@@ -153,32 +181,114 @@ def denominator_factors(
 def divisions(
     exprs: Sequence[sympy.Expr], stage: int, what: str, variables: Sequence[sympy.Symbol],
     settled: Callable[[sympy.Expr], bool] | None = None, *, unsearched: list[Unsearched] | None = None,
+    structural: bool = False,
 ) -> list[Division]:
     """One :class:`Division` per distinct denominator factor of ``exprs`` (:func:`denominator_factors`; ``settled``
     names denominators proven nonzero on the surface, which are not factored).
 
     An expression in the ``variables`` too long to search (:func:`too_long_to_search`) gives
-    no division; ``unsearched`` (when given) then receives one :class:`Unsearched` record of
-    how many there were, so that the caller can say what was not searched.
+    no division, unless ``structural``: then the bases of its negative powers are collected
+    (:func:`structural_divisors`) and each becomes a :class:`Division` marked ``structural``.
+    What is left unsearched (all of it without ``structural``; with it, the expressions whose
+    trees exceed ``STRUCTURAL_NODES`` distinct nodes) is counted in one :class:`Unsearched`
+    record, appended to ``unsearched`` when given, so that the caller can say what was not searched.
     """
     found: dict[sympy.Expr, Division] = {}
     skipped = 0
+    seen: set = set()  # nodes shared between the expressions are walked once
+    memo: dict = {}  # ... and their free symbols found once
     for e in exprs:
         e = sympy.sympify(e)
-        if too_long_to_search(e, variables):
-            skipped += 1
+        if too_long_to_search(e, variables, memo):
+            bases = structural_divisors(e, variables, settled, seen) if structural else None
+            if bases is None:
+                skipped += 1
+                continue
+            for f in bases:
+                found.setdefault(f, Division(f, stage, what, structural=True))
             continue
         for f in denominator_factors(e, variables, settled):
             found.setdefault(f, Division(f, stage, what))
     if skipped and unsearched is not None:
-        unsearched.append(Unsearched(skipped, stage, what))
+        unsearched.append(Unsearched(skipped, stage, what, STRUCTURAL_NODES if structural else None))
     return list(found.values())
 
 
-def too_long_to_search(expr: sympy.Expr, variables: Sequence[sympy.Symbol]) -> bool:
+def _nested(expr: sympy.Expr) -> bool:
+    """Whether ``expr`` holds a division or a fractional power (a pivot ``a - b c/d`` of an elimination)."""
+    return any(isinstance(node, sympy.Pow) and not (node.exp.is_Integer and node.exp > 0)
+               for node in _nodes(expr))
+
+
+def _nodes(expr: sympy.Expr) -> set:
+    """The distinct nodes of ``expr`` (its graph, each shared sub-tree once)."""
+    seen: set = set()
+    stack = [expr]
+    while stack:
+        node = stack.pop()
+        if node not in seen:
+            seen.add(node)
+            stack.extend(node.args)
+    return seen
+
+
+#: distinct nodes of one expression's tree that :func:`structural_divisors` walks before it gives up
+STRUCTURAL_NODES = 200_000
+
+
+def structural_divisors(
+    expr: sympy.Expr, variables: Sequence[sympy.Symbol], settled: Callable[[sympy.Expr], bool] | None = None,
+    seen: set | None = None, limit: int | None = None,
+) -> list[sympy.Expr] | None:
+    """The divisors of an expression too long to factor, read off its tree: the bases of its negative powers.
+
+    ``expr`` is walked as the directed acyclic graph it is (a node shared by many
+    sub-trees once: an exact solve by elimination nests its pivots, so that the printed
+    form of the multiplier solution of the rigid body (228) has tens of millions of
+    nodes but its graph a few thousand). Every base ``f`` of a power ``f**(-n)`` that
+    depends on the ``variables`` is a divisor of ``expr`` as written: ``expr`` is not
+    defined where ``f = 0``. No ``together`` or ``cancel`` of the whole is taken, so a
+    numerator may cancel the division (an elimination's pivot ``D_k/D_(k-1)``, a ratio of
+    leading minors, vanishes where the solution need not). Short bases are factored
+    (:func:`denominator_factors`), long ones kept whole; bases for which ``settled`` is
+    true (proven nonzero on the surface) are left out. ``seen`` holds nodes already
+    walked (shared between calls). ``None`` when the graph has more than ``limit``
+    distinct nodes not seen before.
+    """
+    names = set(variables)
+    limit = STRUCTURAL_NODES if limit is None else limit
+    seen = set() if seen is None else seen
+    memo: dict = {}  # free symbols of shared sub-trees, walked once
+    stack = [expr]
+    bases: list[sympy.Expr] = []
+    fresh = 0
+    while stack:
+        node = stack.pop()
+        if node in seen or not node.args:
+            continue
+        seen.add(node)
+        fresh += 1
+        if fresh > limit:
+            return None
+        if node.is_Pow and node.exp.is_negative and free_symbols_of([node.base], memo) & names:
+            bases.append(node.base)
+        stack.extend(node.args)
+    out: list[sympy.Expr] = []
+    for base in dict.fromkeys(bases):
+        if not _nested(base) and prints_shorter(base, DIVISOR_TEXT_LIMIT):  # proofs and factoring expand: short polynomials only
+            factors = [] if settled is not None and settled(base) else _irreducible_factors([base], names)
+        else:
+            factors = [base]  # kept as written (assumptions such as is_positive cost seconds on a nested pivot)
+        out += [f for f in factors if f not in out]
+    return out
+
+
+def too_long_to_search(expr: sympy.Expr, variables: Sequence[sympy.Symbol], memo: dict | None = None) -> bool:
     """Whether ``expr`` depends on the ``variables`` and prints longer than ``DIVISOR_TEXT_LIMIT``
-    characters: :func:`denominator_factors` gives ``[]`` for it without looking at its denominators."""
-    return not prints_shorter(expr, DIVISOR_TEXT_LIMIT) and bool(free_symbols_of([expr]) & set(variables))
+    characters: :func:`denominator_factors` gives ``[]`` for it without looking at its denominators.
+    ``memo`` (:func:`~dirac.analysis.core.phase_space.free_symbols_of`) shares the walk of sub-trees
+    between calls: the multipliers of one solve share most of theirs."""
+    return not prints_shorter(expr, DIVISOR_TEXT_LIMIT) and bool(free_symbols_of([expr], memo) & set(variables))
 
 
 @dataclass(frozen=True)
@@ -192,11 +302,14 @@ class Unsearched:
     count: int
     stage: int
     what: str
+    #: when the trees were walked for their divisors (:func:`structural_divisors`): the most distinct nodes walked
+    nodes: int | None = None
 
     def __str__(self) -> str:
+        walked = "" if self.nodes is None else f", and their trees have more than {self.nodes} distinct nodes to walk"
         return (f"not searched in {self.count} expression{'s' if self.count != 1 else ''} of stage {self.stage} "
-                f"(longer than {DIVISOR_TEXT_LIMIT} characters, too long to factor): whether {self.what} on part of "
-                "the surface is neither found nor ruled out")
+                f"(longer than {DIVISOR_TEXT_LIMIT} characters, too long to factor{walked}): whether {self.what} on "
+                "part of the surface is neither found nor ruled out")
 
 
 def fixed_values(constraints: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> dict[sympy.Symbol, sympy.Expr]:
@@ -246,12 +359,22 @@ def constant_on_surface(
         return None
     names = set(variables)
     memo = {} if memo is None else memo
-    used = [c for c in surface if (inside := free_symbols_of([c], memo) & names) and inside <= set(own)]
-    if not used:
+    key = ("constraint polynomials", tuple(own))
+    if key not in memo:  # the same constraints in the same generators, for every divisor in them
+        used = [c for c in surface if (inside := free_symbols_of([c], memo) & names) and inside <= set(own)]
+        try:
+            memo[key] = sympy.parallel_poly_from_expr(used, *own)[0] if used else []
+        except (sympy.PolynomialError, sympy.GeneratorsError):
+            memo[key] = None
+    constraint_polys = memo[key]
+    if not constraint_polys:
         return None
+    used = constraint_polys
     try:
-        polys, _ = sympy.parallel_poly_from_expr([divisor, *used], *own)
-    except (sympy.PolynomialError, sympy.GeneratorsError):
+        (first,), _ = sympy.parallel_poly_from_expr([divisor], *own)
+        domain = first.domain.unify(constraint_polys[0].domain)
+        polys = [first.set_domain(domain), *(c.set_domain(domain) for c in constraint_polys)]
+    except (sympy.PolynomialError, sympy.GeneratorsError, sympy.CoercionFailed, sympy.UnificationFailed):
         return None
     domain = polys[0].domain
     if not domain.is_Field and not domain.is_Ring or domain.is_EX or domain.is_EXRAW:
@@ -413,11 +536,186 @@ def nonvanishing_on(surface: Sequence[sympy.Expr], variables: Sequence[sympy.Sym
 CONSTANT_TEST_EQUATIONS = 200
 
 
+#: CPU seconds the decisions on the divisors read off trees (:func:`structural_divisors`) may take in all
+#: (CPU, not wall time: what is decided should not depend on the load of the machine)
+STRUCTURAL_BUDGET = 2.0
+#: divisors read off trees searched for a point of their locus, at most (each search compiles the divisor's gradient)
+STRUCTURAL_SEARCHES = 8
+#: ... and only those that print shorter than this (characters): the projections onto a longer one, a nested pivot
+#: of (228) of thousands of characters, cost a third of a second each and found no point there
+SEARCH_TEXT_LIMIT = 1000
+
+
+@dataclass(frozen=True)
+class Undecided:
+    """A divisor read off an expression too long to factor that is neither proven nonzero on the surface nor
+    found to vanish there (:func:`singular_loci`): the report says so, with the ``reason``."""
+
+    divisor: sympy.Expr
+    stage: int
+    what: str
+    reason: str
+
+    def __str__(self) -> str:
+        return (f"not ruled out at stage {self.stage}: whether {self.what} where the divisor {shown(self.divisor, DIVISOR_SHOWN)} vanishes "
+                f"(a base of a negative power of an expression too long to factor): {self.reason}")
+
+
+#: characters of a divisor shown in the report (a longer one is described, not printed)
+DIVISOR_SHOWN = 400
+
+
+def shown(expr: sympy.Expr, limit: int = DIVISOR_TEXT_LIMIT) -> str:
+    """``str(expr)`` when shorter than ``limit`` characters, else a description (a divisor read off the tree of
+    a long expression can print to millions of characters)."""
+    if prints_shorter(expr, limit):
+        return printed(expr)
+    return f"(an expression of {limit} characters or more, not printed)"
+
+#: why a divisor read off a tree stays undecided when no point of the locus is found
+NOT_FOUND = (f"no point of the surface where it vanishes was found in {LOCUS_ATTEMPTS} projections, which "
+             "is no proof that there is none")
+#: ... when it is too long to search
+TOO_LONG_TO_SEARCH = (f"not searched: it prints to {SEARCH_TEXT_LIMIT} characters or more (the projections onto "
+                      "its zeros would cost more than the analysis)")
+#: ... and when the time budget ran out before it was searched
+OUT_OF_TIME = (f"not searched: the budget for divisors read off long expressions ({STRUCTURAL_SEARCHES} searches, "
+               f"{STRUCTURAL_BUDGET:g} s of CPU time) ran out")
+
+
+def value_on_surface(
+    expr: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict, cache: dict,
+) -> sympy.Expr | None:
+    """The constant ``c`` (a number or a function of the parameters) that ``expr`` equals at every point of the
+    surface, proven node by node; else None.
+
+    By induction on the tree: a node free of the ``variables`` is its own value; a
+    polynomial node short enough has the value of :func:`constant_on_surface` (an
+    identity ``node = c + sum a_i phi_i``); a sum, product or integer power of nodes with
+    values has the value of the same operation on them, a negative power only when the
+    base's value is not 0 (then the base vanishes nowhere on the surface and the node is
+    defined there). The pivots of an elimination whose entries are constant on the surface
+    (the multiplier solution of four point masses at fixed distances, (19)) are proven
+    nonzero so, where their expanded forms are far too long for a polynomial identity.
+    ``cache`` keeps the value of each node between calls (shared sub-trees are decided once).
+    """
+    names = set(variables)
+
+    def value(node: sympy.Expr) -> sympy.Expr | None:
+        if node in cache:
+            return cache[node]
+        out: sympy.Expr | None = None
+        if not (free_symbols_of([node], memo) & names):
+            out = node
+        elif node.is_Add:
+            polynomial = [a for a in node.args if not _divides(a)]  # the terms without division, decided together
+            parts = []
+            if polynomial:
+                whole = sympy.Add(*polynomial)
+                parts.append(_ring_constant(whole, surface, variables, memo)
+                             if prints_shorter(whole, DIVISOR_TEXT_LIMIT) else None)
+            for arg in node.args:
+                if parts and parts[-1] is None:
+                    break
+                if _divides(arg):
+                    parts.append(value(arg))
+            if parts and all(part is not None for part in parts):
+                out = _exact_value(sympy.Add(*parts))
+        elif node.is_Mul:  # factor by factor (a product's expanded form is longer, and no constant combination)
+            parts = []
+            for arg in node.args:
+                part = value(arg)
+                if part is None:
+                    break
+                parts.append(part)
+            else:
+                out = _exact_value(sympy.Mul(*parts))
+        elif node.is_Pow and node.exp.is_Integer:
+            base = value(node.base)
+            if base is not None and (node.exp > 0 or base != 0):
+                out = _exact_value(base**node.exp)
+        cache[node] = out  # a variable alone, or any other function, is no proven constant
+        return out
+
+    def _divides(node: sympy.Expr) -> bool:
+        key = ("divides", node)
+        if key not in cache:
+            cache[key] = bool(node.is_Pow and not (node.exp.is_Integer and node.exp > 0)) or any(_divides(a) for a in node.args)
+        return cache[key]
+
+    return value(expr)
+
+
+def _ring_constant(
+    expr: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict
+) -> sympy.Expr | None:
+    """:func:`constant_on_surface` of a polynomial ``expr``, with the polynomials built by ring arithmetic.
+
+    The same identity ``expr = c + sum_i a_i phi_i`` (numbers or parameters ``a_i``, the
+    polynomial constraints in ``expr``'s variables), decided by the same linear system;
+    ``expr`` and the constraints become elements of ``QQ(parameters)[variables]`` by one walk
+    of their trees (:func:`~dirac.analysis.core.algebra.ring_value`) instead of ``expand``
+    and ``Poly`` (a tenth of the time on the pivots of (19)). ``None`` says nothing.
+    """
+    from sympy.polys.rings import ring as polynomial_ring
+
+    from dirac.analysis.core.algebra import NotInRing, ring_value
+
+    names = set(variables)
+    own = tuple(sorted(free_symbols_of([expr], memo) & names, key=lambda v: v.name))
+    if not own:
+        return None
+    key = ("ring constraints", own)
+    if key not in memo:
+        params = sorted(set().union(*(free_symbols_of([c], memo) for c in surface)) - names, key=lambda v: v.name)
+        domain = sympy.QQ.frac_field(*params) if params else sympy.QQ
+        R, *gens = polynomial_ring(list(own), domain)
+        mapping: dict = dict(zip(own, gens))
+        mapping.update({p: R(domain.from_sympy(p)) for p in params})
+        used = []
+        for c in surface:
+            inside = free_symbols_of([c], memo) & names
+            if inside and inside <= set(own):
+                try:
+                    used.append(ring_value(c, mapping, R))
+                except NotInRing:
+                    continue
+        memo[key] = (R, mapping, used)
+    R, mapping, used = memo[key]
+    if not used:
+        return None
+    try:
+        value = ring_value(expr, mapping, R)
+    except (NotInRing, sympy.CoercionFailed):
+        return None
+    if set(free_symbols_of([expr], memo)) - names - set(mapping):
+        return None  # a symbol outside the ring's parameters
+    polys = [value, *used]
+    field = R.domain
+    monomials = sorted({m for p in polys for m in p.keys()})
+    if len(monomials) > CONSTANT_TEST_EQUATIONS:
+        return None
+    constant = (0,) * len(own)
+    rows = [[field.one if m == constant else field.zero, *(p.get(m, field.zero) for p in used), value.get(m, field.zero)]
+            for m in monomials]
+    reduced, pivots = DomainMatrix(rows, (len(rows), len(used) + 2), field).rref()
+    if len(used) + 1 in pivots or 0 not in pivots:
+        return None
+    row = reduced.to_Matrix().row(pivots.index(0))
+    if any(row[j] != 0 for j in range(1, len(used) + 1) if j not in pivots):
+        return None
+    return _exact_value(row[len(used) + 1])
+
+
 def singular_loci(
     found: Sequence[Division],
     surface: Sequence[sympy.Expr],
     numerics,
     variables: Sequence[sympy.Symbol],
+    *,
+    undecided: list[Undecided] | None = None,
+    regular_at: Callable[[np.ndarray], bool] | None = None,
+    budget: float = STRUCTURAL_BUDGET,
 ) -> tuple[SingularLocus, ...]:
     """The divisions whose divisor vanishes somewhere on the surface ``surface = 0``, as :class:`SingularLocus`.
 
@@ -425,6 +723,16 @@ def singular_loci(
     ``LOCUS_ATTEMPTS`` random starts, points near an assumed-nonzero expression excluded)
     decides whether the locus meets the surface. A divisor met twice is reported once, at
     its earliest stage.
+
+    A divisor read off a tree (``Division.structural``, :func:`structural_divisors`) is
+    first put to the proofs (:func:`constant_on_surface`, :func:`square_on_surface` when
+    short, :func:`value_on_surface`); then searched. A point found is a locus: for the
+    multiplier solution, ``regular_at`` (when given) says whether the matrix it inverts is
+    regular at that point, and if so the locus is one of the solved form only
+    (:data:`PIVOT_SINGULAR`); otherwise its ``what`` says that a numerator may cancel
+    (:data:`AS_WRITTEN`). No point found is no proof: such a divisor goes to
+    ``undecided`` (:class:`Undecided`), as do those left when ``budget`` CPU seconds of these
+    decisions, or ``STRUCTURAL_SEARCHES`` searches, have run out.
     """
     fixed = fixed_values(list(surface), variables)
     seen: dict[sympy.Expr, Division] = {}
@@ -432,16 +740,47 @@ def singular_loci(
         seen.setdefault(d.divisor, d)
     out = []
     memo: dict = {}  # free symbols of the constraints, walked once for all the divisors
-    for d in seen.values():
-        value = constant_on_surface(d.divisor, surface, variables, memo)
+    cache: dict = {}  # values on the surface of the nodes of the divisors read off trees (value_on_surface)
+    deadline: float | None = None
+    searched = 0  # divisors read off trees searched for a point so far (at most STRUCTURAL_SEARCHES)
+    plain = {d.divisor: not d.structural or (not _nested(d.divisor) and prints_shorter(d.divisor, DIVISOR_TEXT_LIMIT))
+             for d in seen.values()}
+    # the divisors read off trees after the others, short polynomials first: the budget goes to the cheap ones
+    for d in sorted(seen.values(), key=lambda d: (d.structural, not plain[d.divisor])):
+        short = plain[d.divisor]
+        if d.structural:
+            deadline = time.process_time() + budget if deadline is None else deadline
+            if time.process_time() > deadline or searched >= STRUCTURAL_SEARCHES:
+                if undecided is not None:
+                    undecided.append(Undecided(d.divisor, d.stage, d.what, OUT_OF_TIME))
+                continue
+        value = constant_on_surface(d.divisor, surface, variables, memo) if short else None
         if value is not None and value != 0:
             continue  # a constant on the whole surface (nonzero at generic parameter values, as the search samples): no locus
-        square = square_on_surface(d.divisor, surface, variables, memo) if value is None else None
+        square = square_on_surface(d.divisor, surface, variables, memo) if value is None and short else None
         if square is not None and square != 0:
             continue  # divisor^2 is a nonzero constant on the whole surface (det R = +-1 on R^T R = 1): no locus
+        if d.structural:
+            proven = value_on_surface(d.divisor, surface, variables, memo, cache)
+            if proven is not None and proven != 0:
+                continue  # built from parts constant on the surface, into a nonzero constant: no locus
+        if d.structural and not prints_shorter(d.divisor, SEARCH_TEXT_LIMIT):
+            if undecided is not None:
+                undecided.append(Undecided(d.divisor, d.stage, d.what, TOO_LONG_TO_SEARCH))
+            continue
+        searched += d.structural
         try:
-            numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
+            points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:
+            if d.structural and undecided is not None:
+                undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND))
             continue  # the divisor does not vanish on the surface (or only where an assumption excludes)
-        out.append(SingularLocus(d.divisor, locus_equation(d.divisor, fixed), d.stage, d.what))
+        what = d.what
+        if d.structural:
+            if d.what == MULTIPLIERS_SINGULAR and regular_at is not None:
+                what = PIVOT_SINGULAR if regular_at(points[0]) else d.what  # singular there: the multipliers' own locus
+            else:
+                what = d.what + AS_WRITTEN
+        where = locus_equation(d.divisor, fixed) if short else f"{shown(d.divisor)} = 0"
+        out.append(SingularLocus(d.divisor, where, d.stage, what))
     return tuple(out)

@@ -133,16 +133,37 @@ def test_a_regular_system_has_no_singular_locus():
     assert a.to_json()["singular_loci"] == []
 
 
-def test_expressions_too_long_to_factor_are_said_not_searched(monkeypatch):
+def test_expressions_too_long_to_factor_are_searched_through_their_trees(monkeypatch):
     """An expression longer than ``DIVISOR_TEXT_LIMIT`` characters is not factored (a gcd of a
-    large one costs more than the analysis). It used to give no division and no word: the
-    null vector of ``L = x y y' + x y z'`` (test above: it divides by ``x`` or ``y``, by hand)
-    would then have shown no singular locus at all. With the limit set below the length of
-    its components, the locus is not found, and the analysis says so in its result, its text
-    and its JSON."""
+    large one costs more than the analysis); its divisors are read off its tree instead (the
+    bases of its negative powers). The null vector of ``L = x y y' + x y z'`` divides by ``x`` or
+    ``y`` (test above, by hand: the multiples of ``(x, -y, y)`` with one component set to 1).
+    With the limit set below the length of its components, the same locus is found, and,
+    since the consistency matrix ``F`` solved for the fixed multipliers is singular there (its
+    block ``[[y, y], [0, x]]``-like minor has determinant ``x y``, by hand), it is the
+    multiplier solution's own singular locus, not a pivot of its elimination: nothing of the
+    multiplier solution is left unsearched (the chain's elimination of multipliers is still
+    factored or said not searched, as before)."""
     from dirac.analysis.core import divisors
 
     monkeypatch.setattr(divisors, "DIVISOR_TEXT_LIMIT", 2)
+    L = dirac.Lagrangian.from_strings("null_vector", ["x", "y", "z"], "x*y*y_dot + x*y*z_dot", [])
+    a = dirac.analyze(L)
+    loci = {locus.where for locus in a.singular_loci if locus.what == MULTIPLIERS_SINGULAR}
+    assert loci and loci <= {"x = 0", "y = 0"}
+    assert not [u for u in a.singular_loci_unsearched if u.what == MULTIPLIERS_SINGULAR]
+    assert "singular locus: " in a.to_text()
+
+
+def test_expressions_whose_trees_are_too_large_are_said_not_searched(monkeypatch):
+    """When even the tree of an expression is too large to walk (more than ``STRUCTURAL_NODES``
+    distinct nodes; here the limits are set to 0 and 2 so that the null vector of the test
+    above is one), the locus ``x = 0`` or ``y = 0`` known by hand is not found, and the
+    analysis says so in its result, its text and its JSON instead of passing over it."""
+    from dirac.analysis.core import divisors
+
+    monkeypatch.setattr(divisors, "DIVISOR_TEXT_LIMIT", 2)
+    monkeypatch.setattr(divisors, "STRUCTURAL_NODES", 0)
     L = dirac.Lagrangian.from_strings("null_vector", ["x", "y", "z"], "x*y*y_dot + x*y*z_dot", [])
     a = dirac.analyze(L)
     assert not [locus for locus in a.singular_loci if locus.what == MULTIPLIERS_SINGULAR]
