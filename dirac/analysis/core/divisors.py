@@ -78,9 +78,10 @@ MULTIPLIERS_SINGULAR = "the multiplier solution divides by zero"
 #: what happens on the locus of a pivot of the multiplier solution's elimination where the solved matrix is regular
 PIVOT_SINGULAR = (
     "the multiplier solution as written divides by zero (a pivot of the elimination that solved it); the block "
-    "A_PQ of the consistency conditions it inverts is regular at a point of the locus, so the multipliers are "
-    "finite there: the division is one of the solved form, not of the multipliers (evaluate them near the locus "
-    "by another pivot order, or numerically)"
+    "A_PQ of the consistency conditions it inverts is regular at the point of the locus where it was checked, so "
+    "the multipliers are finite at that point: there the division is one of the solved form, not of the "
+    "multipliers (elsewhere on the locus A_PQ is not checked; evaluate the multipliers near the locus by another "
+    "pivot order, or numerically)"
 )
 #: added to what happens on the locus of a divisor read off a tree (no cancellation tried) when nothing else decides
 AS_WRITTEN = " (as written: read off an expression too long to cancel, so a numerator may cancel the division)"
