@@ -22,7 +22,7 @@ from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError
 
-__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "step_grid"]
+__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_results", "step_grid"]
 
 #: Members whose initial states are checked at once by :func:`check_initial_states`.
 _CHECK_BLOCK = 65536
@@ -218,19 +218,30 @@ def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                     compiled.module.ens_member(i, *arguments)
                 except ZeroDivisionError:
                     STATUS[i] = 3.0
+    return member_results(scene, values, compiled.layout, CROSS, EXT, {"t": PT, "q": PQ, "p": PP},
+                          {"final_q": Q, "final_p": P}, EERR, CERR, STATUS, STEPS)
+
+
+def member_results(scene: GeneralEnsembleScene, values: np.ndarray, layout: dict, CROSS: np.ndarray, EXT: np.ndarray,
+                   sections: dict[str, np.ndarray], final: dict[str, np.ndarray], EERR: np.ndarray, CERR: np.ndarray,
+                   STATUS: np.ndarray, STEPS: np.ndarray) -> dict[str, np.ndarray]:
+    """A chunk's arrays by name from a member loop's outputs (general systems and the heavy top).
+
+    ``values`` are the members' ensemble variables; ``sections`` the Poincaré arrays by
+    suffix (``{"t": PT, "q": PQ, "p": PP}``: ``<name>_t`` ...), ``final`` the final state's
+    arrays by name. A failed member's reductions are NaN.
+    """
     results: dict[str, np.ndarray] = {name: values[:, k].copy() for k, name in enumerate(scene.source.names)}
-    layout = compiled.layout
     for index, (name, _group) in enumerate(layout["cross"]):
         results[name] = CROSS[:, index]
     for index, (name, _kind, _e) in enumerate(layout["ext"]):
         results[name] = EXT[:, index]
     for index, (name, _e, k) in enumerate(layout["poincare"]):
-        results[f"{name}_t"] = PT[:, index, :k]
-        results[f"{name}_q"] = PQ[:, index, :k]
-        results[f"{name}_p"] = PP[:, index, :k]
+        for suffix, array in sections.items():
+            results[f"{name}_{suffix}"] = array[:, index, :k]
     kinds = {r.kind for r in scene.reductions}
     if "final" in kinds:
-        results["final_q"], results["final_p"] = Q, P
+        results.update(final)
     if "energy_error" in kinds:
         results["energy_error"] = EERR
     if "constraint_error" in kinds:

@@ -30,6 +30,7 @@ from typing import Any, cast
 
 import numpy as np
 
+from dirac.ensemble.crossing_source import locate_source
 from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian, split_condition
 from dirac.errors import InputError
 
@@ -248,44 +249,17 @@ def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, 
 def ens_velocity(q, p, t, c, v, work, piv):
     """v = M^-1 p when an expression uses velocities."""
 {velocity_body}
-
-
-@numba.njit(cache=True)
-def ens_locate(e, qa, pa, q, p, ta, dt, c, qs, ps, vs, fs, flo, fhi, vw, vpiv):
-    """Zero of expression e on the line between (qa, pa) at ta and (q, p) at ta + dt
-    (Illinois regula falsi); leaves the state there in qs, ps, vs, fs and returns its fraction."""
-    lo = 0.0
-    hi = 1.0
-    side = 0
-    size = abs(flo) + abs(fhi)
-    s = flo / (flo - fhi)
-    for _it in range(200):
-        for x in range({n}):
-            qs[x] = qa[x] + s * (q[x] - qa[x])
-            ps[x] = pa[x] + s * (p[x] - pa[x])
-        ts = ta + s * dt
-        ens_velocity(qs, ps, ts, c, vs, vw, vpiv)
-        ens_values(qs, ps, vs, ts, c, fs)
-        fm = fs[e]
-        if fm == 0.0 or abs(fm) <= 1e-16 * size or hi - lo <= 1e-16:
-            break
-        if (fm < 0.0) == (flo < 0.0):
-            lo = s
-            flo = fm
-            if side == 1:
-                fhi *= 0.5
-            side = 1
-        else:
-            hi = s
-            fhi = fm
-            if side == -1:
-                flo *= 0.5
-            side = -1
-        s = (lo * fhi - hi * flo) / (fhi - flo)
-        if not (lo <= s <= hi):
-            s = 0.5 * (lo + hi)
-    return s
 ''')
+    out.append(locate_source(
+        "ens_locate", "qa, pa, q, p, ta, dt, c, qs, ps, vs, fs",
+        "Zero of expression e on the line between (qa, pa) at ta and (q, p) at ta + dt\n"
+        "    (Illinois regula falsi); leaves the state there in qs, ps, vs, fs and returns its fraction.",
+        f"        for x in range({n}):\n"
+        "            qs[x] = qa[x] + s * (q[x] - qa[x])\n"
+        "            ps[x] = pa[x] + s * (p[x] - pa[x])\n"
+        "        ts = ta + s * dt\n",
+        "        ens_velocity(qs, ps, ts, c, vs, vw, vpiv)\n"
+        "        ens_values(qs, ps, vs, ts, c, fs)\n", trailing=", vw, vpiv"))
     n_cross = len(layout["cross"])
     n_ext = len(layout["ext"])
     n_poin = len(layout["poincare"])

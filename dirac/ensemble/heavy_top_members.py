@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from dirac.ensemble.general_chunk import _evaluate, step_grid
+from dirac.ensemble.crossing_source import locate_source
+from dirac.ensemble.general_chunk import _evaluate, member_results, step_grid
 from dirac.ensemble.general_scene import HeavyTopEnsembleScene, heavy_top_names, split_condition
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError, warn
@@ -174,44 +175,15 @@ def ht_orthogonality(R):
             if abs(acc) > worst:
                 worst = abs(acc)
     return worst
-
-
-@numba.njit(cache=True)
-def ht_locate(e, Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs, flo, fhi):
-    """Zero of expression e on the line between (Ma, Ra) at ta and (M, R) at ta + dt
-    (Illinois regula falsi); leaves the state there in Ms, Rs, fs and returns its fraction."""
-    lo = 0.0
-    hi = 1.0
-    side = 0
-    size = abs(flo) + abs(fhi)
-    s = flo / (flo - fhi)
-    for _it in range(200):
-        for x in range(3):
-            Ms[x] = Ma[x] + s * (M[x] - Ma[x])
-            for y in range(3):
-                Rs[x, y] = Ra[x, y] + s * (R[x, y] - Ra[x, y])
-        ht_values(Ms, Rs, ta + s * dt, c, fs)
-        fm = fs[e]
-        if fm == 0.0 or abs(fm) <= 1e-16 * size or hi - lo <= 1e-16:
-            break
-        if (fm < 0.0) == (flo < 0.0):
-            lo = s
-            flo = fm
-            if side == 1:
-                fhi *= 0.5
-            side = 1
-        else:
-            hi = s
-            fhi = fm
-            if side == -1:
-                flo *= 0.5
-            side = -1
-        s = (lo * fhi - hi * flo) / (fhi - flo)
-        if not (lo <= s <= hi):
-            s = 0.5 * (lo + hi)
-    return s
-
-''']
+''' + locate_source(
+        "ht_locate", "Ma, Ra, M, R, ta, dt, c, Ms, Rs, fs",
+        "Zero of expression e on the line between (Ma, Ra) at ta and (M, R) at ta + dt\n"
+        "    (Illinois regula falsi); leaves the state there in Ms, Rs, fs and returns its fraction.",
+        "        for x in range(3):\n"
+        "            Ms[x] = Ma[x] + s * (M[x] - Ma[x])\n"
+        "            for y in range(3):\n"
+        "                Rs[x, y] = Ra[x, y] + s * (R[x, y] - Ra[x, y])\n",
+        "        ht_values(Ms, Rs, ta + s * dt, c, fs)\n") + "\n"]
 
     def w(depth: int, text: str) -> None:
         lines.append("    " * depth + text)
@@ -505,28 +477,5 @@ def compute_heavy_top_chunk(scene: HeavyTopEnsembleScene, start: int, stop: int,
         compiled.module.ht_run(0, count, M, R, C, W, axes, rates, fractions, casimir, inverse, compiled.gammas, dt, starts,
                                ends, per_interval, single_run_call_steps(), scene.early_stop,
                                CROSS, EXT, EERR, CERR, PT, PM, PR, STATUS, STEPS)
-    results: dict[str, np.ndarray] = {name: values[:, k].copy() for k, name in enumerate(scene.source.names)}
-    for index, (name, _group) in enumerate(compiled.layout["cross"]):
-        results[name] = CROSS[:, index]
-    for index, (name, _kind, _e) in enumerate(compiled.layout["ext"]):
-        results[name] = EXT[:, index]
-    for index, (name, _e, k) in enumerate(compiled.layout["poincare"]):
-        results[f"{name}_t"] = PT[:, index, :k]
-        results[f"{name}_M"] = PM[:, index, :k]
-        results[f"{name}_R"] = PR[:, index, :k]
-    kinds = {r.kind for r in scene.reductions}
-    if "final" in kinds:
-        results["final_M"], results["final_R"] = M, R
-    if "energy_error" in kinds:
-        results["energy_error"] = EERR
-    if "constraint_error" in kinds:
-        results["constraint_error"] = CERR
-    failed = STATUS != 0.0
-    if np.any(failed):
-        for name in list(results):
-            if name not in scene.source.names:
-                results[name] = np.array(results[name], dtype=float)
-                results[name][failed] = np.nan
-    results["failures"] = STATUS
-    results["steps"] = STEPS
-    return results
+    return member_results(scene, values, compiled.layout, CROSS, EXT, {"t": PT, "M": PM, "R": PR},
+                          {"final_M": M, "final_R": R}, EERR, CERR, STATUS, STEPS)
