@@ -32,7 +32,9 @@ from dirac.analysis.core.divisors import (
     Unsearched,
     divisions,
     nonvanishing_on,
+    pfaffian,
     singular_loci,
+    sum_of_squares_on_surface,
 )
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
@@ -343,6 +345,8 @@ class ConstraintAnalysis:
                                structural=True)
         if 0 < len(self.second_class) <= SMALL_DETERMINANT:
             C = bracket_matrix(self._space, self.second_class)
+        # det C = Pf(C)^2: a Pfaffian proven nonzero on the surface leaves no division by zero
+        if 0 < len(self.second_class) <= SMALL_DETERMINANT and not self._pfaffian_settled(C, surface, settled):
             found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
                                "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
                                "constraints drops rank)", variables, unsearched=skipped, structural=True)
@@ -358,6 +362,16 @@ class ConstraintAnalysis:
                              regular_at=self._solved_block_regular(numerics))
         self._unsearched = (*unsearched, *undecided)
         return loci
+
+    def _pfaffian_settled(self, C: sympy.Matrix, surface: list, settled: Callable[[sympy.Expr], bool]) -> bool:
+        """Whether ``det C = Pf(C)^2`` is proven nonzero on the surface: ``Pf(C)`` a nonzero
+        constant there, or, factored, a product of such constants and sums of squares
+        (:func:`~dirac.analysis.core.divisors.sum_of_squares_on_surface`; a pendulum's
+        ``Pf(C) = -16 (x^2 + y^2)^2 / m^2``)."""
+        if C.shape[0] % 2:
+            return False
+        pf = pfaffian(C)
+        return settled(pf) or sum_of_squares_on_surface(sympy.factor(pf), surface, self._space.variables)
 
     def _solved_block_regular(self, numerics: Numerics) -> Callable[[np.ndarray], bool] | None:
         """``z -> bool``: whether the block ``A_PQ`` the exact multiplier solution inverts has full rank at the
