@@ -375,15 +375,26 @@ class ConstraintAnalysis:
 
     def _solved_block_regular(self, numerics: Numerics) -> Callable[[np.ndarray], bool] | None:
         """``z -> bool``: whether the block ``A_PQ`` the exact multiplier solution inverts has full rank at the
-        point ``z`` (finite values, rank by SVD); ``None`` when there is no such block."""
+        point ``z`` (finite values, rank by SVD); ``None`` when there is no such block.
+
+        The rank is cut relative to the block's size at the analysis' generic points of the
+        surface (its largest singular value there), not to its size at ``z``: on a locus where
+        the block vanishes, ``z`` is found to rounding (``[[0, y], [-y, 0]]`` at ``y = 1e-18``),
+        and singular values of pure rounding, compared with each other, would count as full rank.
+        """
         chain_solution = self._chain.multiplier_solution
         block = getattr(chain_solution, "matrix", None)
         if block is None or block.shape[0] == 0:
             return None
+        scale: float | None = None
+        if self._points:
+            generic = numerics.evaluate(list(block), list(self._points)).reshape(len(self._points), *block.shape)
+            sizes = [float(np.linalg.norm(values, 2)) for values in generic if np.all(np.isfinite(values))]
+            scale = max(sizes) if sizes else None
 
         def regular(z: np.ndarray) -> bool:
             values = numerics.evaluate(list(block), [z]).reshape(block.shape)
-            return bool(np.all(np.isfinite(values))) and numeric_rank(values) == block.shape[0]
+            return bool(np.all(np.isfinite(values))) and numeric_rank(values, scale=scale) == block.shape[0]
 
         return regular
 
