@@ -32,7 +32,9 @@ from dirac.analysis.core.divisors import (
     Unsearched,
     divisions,
     nonvanishing_on,
+    pfaffian,
     singular_loci,
+    sum_of_squares_on_surface,
 )
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
@@ -343,6 +345,8 @@ class ConstraintAnalysis:
                                structural=True)
         if 0 < len(self.second_class) <= SMALL_DETERMINANT:
             C = bracket_matrix(self._space, self.second_class)
+        # det C = Pf(C)^2: a Pfaffian proven nonzero on the surface leaves no division by zero
+        if 0 < len(self.second_class) <= SMALL_DETERMINANT and not self._pfaffian_settled(C, surface, settled):
             found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
                                "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
                                "constraints drops rank)", variables, unsearched=skipped, structural=True)
@@ -359,17 +363,38 @@ class ConstraintAnalysis:
         self._unsearched = (*unsearched, *undecided)
         return loci
 
+    def _pfaffian_settled(self, C: sympy.Matrix, surface: list, settled: Callable[[sympy.Expr], bool]) -> bool:
+        """Whether ``det C = Pf(C)^2`` is proven nonzero on the surface: ``Pf(C)`` a nonzero
+        constant there, or, factored, a product of such constants and sums of squares
+        (:func:`~dirac.analysis.core.divisors.sum_of_squares_on_surface`; a pendulum's
+        ``Pf(C) = -16 (x^2 + y^2)^2 / m^2``)."""
+        if C.shape[0] % 2:
+            return False
+        pf = pfaffian(C)
+        return settled(pf) or sum_of_squares_on_surface(sympy.factor(pf), surface, self._space.variables)
+
     def _solved_block_regular(self, numerics: Numerics) -> Callable[[np.ndarray], bool] | None:
         """``z -> bool``: whether the block ``A_PQ`` the exact multiplier solution inverts has full rank at the
-        point ``z`` (finite values, rank by SVD); ``None`` when there is no such block."""
+        point ``z`` (finite values, rank by SVD); ``None`` when there is no such block.
+
+        The rank is cut relative to the block's size at the analysis' generic points of the
+        surface (its largest singular value there), not to its size at ``z``: on a locus where
+        the block vanishes, ``z`` is found to rounding (``[[0, y], [-y, 0]]`` at ``y = 1e-18``),
+        and singular values of pure rounding, compared with each other, would count as full rank.
+        """
         chain_solution = self._chain.multiplier_solution
         block = getattr(chain_solution, "matrix", None)
         if block is None or block.shape[0] == 0:
             return None
+        scale: float | None = None
+        if self._points:
+            generic = numerics.evaluate(list(block), list(self._points)).reshape(len(self._points), *block.shape)
+            sizes = [float(np.linalg.norm(values, 2)) for values in generic if np.all(np.isfinite(values))]
+            scale = max(sizes) if sizes else None
 
         def regular(z: np.ndarray) -> bool:
             values = numerics.evaluate(list(block), [z]).reshape(block.shape)
-            return bool(np.all(np.isfinite(values))) and numeric_rank(values) == block.shape[0]
+            return bool(np.all(np.isfinite(values))) and numeric_rank(values, scale=scale) == block.shape[0]
 
         return regular
 

@@ -54,7 +54,8 @@ from dirac.errors import AnalysisError
 
 __all__ = [
     "Division", "SingularLocus", "Unsearched", "Undecided", "too_long_to_search", "structural_divisors", "value_on_surface", "denominator_factors", "singular_loci",
-    "constant_on_surface", "square_on_surface", "determinant_grid", "nonvanishing_on", "LEGENDRE_SINGULAR",
+    "constant_on_surface", "square_on_surface", "determinant_grid", "nonvanishing_on", "pfaffian",
+    "sum_of_squares_on_surface", "LEGENDRE_SINGULAR",
     "MULTIPLIERS_SINGULAR",
 ]
 
@@ -512,6 +513,86 @@ def _constant_matrix(
     return K
 
 
+def pfaffian(A: sympy.Matrix) -> sympy.Expr:
+    """The Pfaffian of an antisymmetric matrix of even size, ``det A = Pf(A)^2``.
+
+    Expansion along the first row, ``Pf(A) = sum_{j > 1} (-1)^j a_1j Pf(A without rows and
+    columns 1, j)`` (Cayley 1852; e.g. Lang, *Algebra*, XV.9); for the small bracket
+    matrices of the Dirac bracket (``(2n - 1)!!`` terms: 105 at size 8). The bracket matrix
+    of a pendulum's four second-class constraints has ``Pf(C) = C_14 C_23`` (``C_12 =
+    C_13 = 0``), a constant on the surface where ``det C`` itself is no constant
+    combination of the constraints.
+    """
+    size = A.shape[0]
+    if size == 0:
+        return sympy.Integer(1)
+    total = sympy.Integer(0)
+    for j in range(1, size):
+        entry = A[0, j]
+        if entry == 0:
+            continue
+        keep = [k for k in range(1, size) if k != j]
+        total += (-1) ** (j + 1) * entry * pfaffian(A.extract(keep, keep))
+    return total
+
+
+def sum_of_squares_on_surface(
+    divisor: sympy.Expr, surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], memo: dict | None = None
+) -> bool:
+    """Whether ``divisor`` is proven nonzero on the surface as a product of sums of squares.
+
+    A factor (of a product, to any integer power) is settled when it is a nonzero number
+    or expression of the parameters (at generic parameter values, as :func:`singular_loci`
+    reads them), a nonzero constant on the surface (:func:`constant_on_surface`), or a sum
+    ``sum_k c_k b_k^(2 j_k)`` of even powers of real expressions with positive numbers
+    ``c_k`` in which one term is positive on the whole surface: a positive number, or an
+    even power of a base that is a nonzero constant there. Then the sum is at least that
+    term (the phase-space variables are real). The bracket matrix of a pendulum in
+    Cartesian coordinates gives ``(4 (x^2 + y^2)/m)^2 ((4 (x^2 + y^2)/m)^2 + (...)^2 + ...)``:
+    both factors are settled on ``x^2 + y^2 = l^2``. ``False`` says only that there is no
+    proof.
+    """
+
+    phase_space = set(variables)
+
+    def constant(expr: sympy.Expr) -> bool:
+        """A nonzero number or expression of the parameters, or a nonzero constant on the surface."""
+        if not expr.free_symbols & phase_space:
+            return bool(expr != 0)
+        value = constant_on_surface(expr, surface, variables, memo)
+        return value is not None and value != 0
+
+    def nonnegative_term(term: sympy.Expr) -> tuple[bool, bool]:
+        """(term >= 0 proven, term > 0 on the whole surface proven): ``c prod b_i^(2 j_i)``,
+        ``c > 0``, is >= 0, and > 0 when every ``b_i`` is a nonzero constant on the surface."""
+        coefficient, rest = term.as_coeff_Mul()
+        if not (coefficient.is_Number and coefficient > 0):
+            return False, False
+        bases = []
+        for factor in sympy.Mul.make_args(rest):
+            if factor == 1:
+                continue
+            base, exponent = factor.as_base_exp()
+            if not (exponent.is_Integer and exponent % 2 == 0):
+                return False, False
+            bases.append(base)
+        return True, all(constant(base) for base in bases)
+
+    def settled(factor: sympy.Expr) -> bool:
+        if constant(factor):
+            return True
+        if factor.is_Add:
+            signs = [nonnegative_term(term) for term in factor.args]
+            return all(nonnegative for nonnegative, _ in signs) and any(positive for _, positive in signs)
+        return False
+
+    for factor in sympy.Mul.make_args(divisor):
+        base, exponent = factor.as_base_exp()
+        if not exponent.is_Integer or not settled(base):
+            return False
+    return True
+
+
 def nonvanishing_on(surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol]) -> Callable[[sympy.Expr], bool]:
     """``f -> bool``: whether ``f`` is proven nonzero on the whole surface ``surface = 0``.
 
@@ -549,17 +630,19 @@ SEARCH_TEXT_LIMIT = 1000
 
 @dataclass(frozen=True)
 class Undecided:
-    """A divisor read off an expression too long to factor that is neither proven nonzero on the surface nor
-    found to vanish there (:func:`singular_loci`): the report says so, with the ``reason``."""
+    """A divisor that is neither proven nonzero on the surface nor found to vanish there
+    (:func:`singular_loci`): the report says so, with the ``reason`` and the divisor's
+    ``origin`` (read off the tree of a long expression, or a factor of a denominator)."""
 
     divisor: sympy.Expr
     stage: int
     what: str
     reason: str
+    origin: str = "a base of a negative power of an expression too long to factor"
 
     def __str__(self) -> str:
         return (f"not ruled out at stage {self.stage}: whether {self.what} where the divisor {shown(self.divisor, DIVISOR_SHOWN)} vanishes "
-                f"(a base of a negative power of an expression too long to factor): {self.reason}")
+                f"({self.origin}): {self.reason}")
 
 
 #: characters of a divisor shown in the report (a longer one is described, not printed)
@@ -576,6 +659,8 @@ def shown(expr: sympy.Expr, limit: int = DIVISOR_TEXT_LIMIT) -> str:
 #: why a divisor read off a tree stays undecided when no point of the locus is found
 NOT_FOUND = (f"no point of the surface where it vanishes was found in {LOCUS_ATTEMPTS} projections, which "
              "is no proof that there is none")
+#: where a short divisor comes from (a factor of a denominator, factored)
+FACTOR_ORIGIN = "a factor of a denominator"
 #: ... when it is too long to search
 TOO_LONG_TO_SEARCH = (f"not searched: it prints to {SEARCH_TEXT_LIMIT} characters or more (the projections onto "
                       "its zeros would cost more than the analysis)")
@@ -732,8 +817,10 @@ def singular_loci(
     regular at that point, and if so the locus is one of the solved form only
     (:data:`PIVOT_SINGULAR`); otherwise its ``what`` says that a numerator may cancel
     (:data:`AS_WRITTEN`). No point found is no proof: such a divisor goes to
-    ``undecided`` (:class:`Undecided`), as do those left when ``budget`` CPU seconds of these
-    decisions, or ``STRUCTURAL_SEARCHES`` searches, have run out.
+    ``undecided`` (:class:`Undecided`), unless it is a short divisor that
+    :func:`sum_of_squares_on_surface` proves nonzero; so do the divisors read off trees left
+    when ``budget`` CPU seconds of these decisions, or ``STRUCTURAL_SEARCHES`` searches, have
+    run out.
     """
     fixed = fixed_values(list(surface), variables)
     seen: dict[sympy.Expr, Division] = {}
@@ -773,9 +860,12 @@ def singular_loci(
         try:
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:
-            if d.structural and undecided is not None:
-                undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND))
-            continue  # the divisor does not vanish on the surface (or only where an assumption excludes)
+            if undecided is not None:
+                if d.structural:
+                    undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND))
+                elif not sum_of_squares_on_surface(d.divisor, surface, variables, memo):
+                    undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND, FACTOR_ORIGIN))
+            continue  # no point found: proven nonzero, or said not ruled out
         what = d.what
         if d.structural:
             if d.what == MULTIPLIERS_SINGULAR and regular_at is not None:
