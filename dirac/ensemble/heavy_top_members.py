@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from dirac.ensemble.crossing_source import locate_source
-from dirac.ensemble.general_chunk import _evaluate, member_results, step_grid
+from dirac.ensemble.general_chunk import member_column, member_results, step_grid
 from dirac.ensemble.general_scene import HeavyTopEnsembleScene, heavy_top_names, split_condition
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError, warn
@@ -352,18 +352,11 @@ def heavy_top_initial_states(scene: HeavyTopEnsembleScene, values: np.ndarray
     """``(M, R, C)`` of members with the ensemble variables ``values`` (rows): body angular
     momenta (``M = I omega`` for ``omega``, ``M = R^T m`` for ``m``, as a single scene), attitudes and
     the parameter rows ``(I_1, I_2, I_3, mass_gravity, chi_1, chi_2, chi_3)``."""
-    import sympy
-
-    from dirac.model.expressions import parse_expression
-
     count = values.shape[0]
     names = scene.source.names
-    symbols = {name: sympy.Symbol(name, real=True) for name in names}
 
     def column(value: float | str, where: str) -> np.ndarray:
-        if isinstance(value, str):
-            return _evaluate(parse_expression(value, symbols, what=where), names, values)
-        return np.full(count, float(value))
+        return member_column(value, where, names, values)
 
     C = np.empty((count, len(scene.parameter_names)))
     for k, key in enumerate(scene.parameter_names):
