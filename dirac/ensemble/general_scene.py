@@ -498,7 +498,7 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
 
 _TOP_SYSTEM_KEYS = {"name", "inertia", "mass_gravity", "center_of_mass", "description"}
 _TOP_INITIAL_KEYS = {"M", "omega", "m", "R"}
-_TOP_RUN_KEYS = {"t_end", "method", "dt", "samples", "outputs"}
+_TOP_RUN_KEYS = {"t_end", "method", "dt", "samples", "outputs", "newton_tolerance", "max_newton_iterations"}
 
 #: The parameters of a heavy top, in the order of a member's parameter row.
 TOP_PARAMETERS = ("I_1", "I_2", "I_3", "mass_gravity", "chi_1", "chi_2", "chi_3")
@@ -549,6 +549,7 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
 
     initial_momentum: tuple[float | str, ...] = ()
     initial_R: tuple[tuple[float | str, ...], ...] = ()
+    torque: tuple[str, ...] | None = None
 
     heavy_top = True
 
@@ -566,6 +567,8 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
         described = super().describe()
         described["initial"] = {self.rate_kind: list(self.initial_momentum), "R": [list(row) for row in self.initial_R]}
         described["heavy_top"] = True  # its Poincaré sections are stored as <name>_M and <name>_R
+        if self.torque is not None:  # (absent for an undriven top: the fingerprints of earlier stores hold)
+            described["torque"] = list(self.torque)
         return described
 
 
@@ -609,11 +612,12 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
     from dirac.model.expressions import parse_expression
     from dirac.rigidbody.schemes import SCHEMES
 
-    if "impulses" in data or "forces" in data:
-        raise InputError("[forces] and [[impulses]] are not available in heavy-top ensembles; run a driven top "
-                         "with dirac run")
-    reject_unknown_keys(data, {"system", "initial", "run", "ensemble"}, "the scene", kind="section")
+    if "impulses" in data:
+        raise InputError("[[impulses]] are not available in heavy-top ensembles (a member's steps would be cut at "
+                         "each impulse time); run a top with impulses with dirac run")
+    reject_unknown_keys(data, {"system", "initial", "run", "ensemble", "forces"}, "the scene", kind="section")
     system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
+    torque = _top_torque(data.get("forces"))
     reject_unknown_keys(system, _TOP_SYSTEM_KEYS, "[system]")
     reject_unknown_keys(initial, _TOP_INITIAL_KEYS, "[initial]")
     reject_unknown_keys(run, _TOP_RUN_KEYS, "[run]")
@@ -666,6 +670,10 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
                          "(final, max, min, poincare, ...) under [ensemble] reductions")
     spacing = t_end / (samples - 1)
     steps_per_sample = max(1, math.ceil(spacing / dt * (1.0 - 1e-12)))
+    tolerance = scene_number(run.get("newton_tolerance", 1e-12), "[run] newton_tolerance", positive=True)
+    iterations = run.get("max_newton_iterations", 50)
+    if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
+        raise InputError(f"[run] max_newton_iterations = {iterations!r} must be an integer >= 1")
 
     listed = ensemble.get("reductions", [])
     tables = ensemble.get("reduction", [])
@@ -700,5 +708,22 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
         rate_kind=given[0], parameters=parameters, project=False, method=str(method),
         order=int(get_method(str(method)).order), dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end,
         samples=samples, steps_per_sample=steps_per_sample, reductions=reductions, chunk_size=chunk_size, path=path,
-        initial_momentum=momentum, initial_R=attitude,
+        initial_momentum=momentum, initial_R=attitude, torque=torque, newton_tolerance=tolerance,
+        max_newton_iterations=int(iterations),
     )
+
+
+def _top_torque(forces: object) -> tuple[str, ...] | None:
+    """``[forces] torque = [N1, N2, N3]`` of a heavy-top ensemble scene, validated as a single
+    scene validates it (:class:`dirac.flows.torques.Torque`: expressions in ``M_i``,
+    ``Omega_i``, ``R_ij`` and ``t``), or None without ``[forces]``."""
+    if forces is None:
+        return None
+    if not isinstance(forces, dict):
+        raise InputError('[forces] must be a table, e.g. torque = ["0", "0", "-0.1*Omega_3"]')
+    reject_unknown_keys(forces, {"torque"}, "[forces]")
+    if "torque" not in forces:
+        raise InputError('[forces] lacks torque = [N1, N2, N3] (the body-frame torque), e.g. ["0", "0", "-0.1*Omega_3"]')
+    from dirac.flows.torques import Torque
+
+    return Torque(forces["torque"], "the scene").texts

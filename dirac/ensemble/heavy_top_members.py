@@ -22,6 +22,11 @@ ending there gives, to rounding) and updates the reductions' expressions
 :func:`dirac.codegen.kernel_source.emit_function`; ``ht_run`` is the ``numba.prange`` loop
 over the members of a chunk. Crossings are located as in a general ensemble (regula falsi
 on the straight line between the two states bracketing them).
+
+A top driven by a torque (``[forces] torque``) runs a single driven run's step instead
+(:class:`dirac.flows.methods.torqued.TorquedStepper`): the torque kick of
+:mod:`dirac.flows.torque_kernels` (gravity and torque, the work accumulated) around each
+free step, the kicks not merged, imported from the torque's own generated module.
 """
 
 from __future__ import annotations
@@ -42,6 +47,8 @@ __all__ = ["CompiledTop", "compiled_heavy_top", "check_heavy_top_states", "heavy
 
 #: The ``failures`` code of a member whose state stopped being finite (as in a general ensemble).
 NON_FINITE = 2.0
+#: The ``failures`` code of a member whose torque kick's Newton iteration did not converge.
+NEWTON_FAILED = 1.0
 
 _CACHE: dict[str, CompiledTop] = {}
 
@@ -142,8 +149,15 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
               emit_function("ht_energy", "H = sum M_i^2 / (2 I_i) + m g <chi, gamma>", arrays, [("t", None)],
                             [names["energy"]], None, parameters)]
     exact = scene.method.startswith("exact-kick-")
+    driven = None
+    if scene.torque is not None:  # the single run's torque kick (dirac.flows.torque_kernels), by its module's name
+        from dirac.flows.torques import Torque
+
+        kernels = Torque(scene.torque).kernels
+        source[0] += f"from {kernels.__name__} import kick as torque_kick\n"
+        driven = (scene.newton_tolerance, scene.max_newton_iterations)
     source.append(_loop_source(layout, conditions, len(exprs), "energy_error" in kinds, "constraint_error" in kinds,
-                               exact))
+                               exact, driven))
     module = import_source("\n\n".join(source))
     if exact:
         from dirac.flows.methods.registry import get_method
@@ -154,10 +168,18 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
 
 
 def _loop_source(layout: dict, conditions: list, n_exprs: int, energy: bool, constraint: bool,
-                 exact: bool = False) -> str:
+                 exact: bool = False, driven: tuple[float, int] | None = None) -> str:
     """``ht_locate``, ``ht_member`` and ``ht_run`` (module docstring); the free step is
     ``advance_sequence`` (``lie-poisson-*``) or, with ``exact``, ``free_flow_step``
-    (``exact-kick-*``: :func:`dirac.rigidbody.exact_step.exact_kick_advance`'s loop)."""
+    (``exact-kick-*``: :func:`dirac.rigidbody.exact_step.exact_kick_advance`'s loop).
+
+    ``driven`` (the Newton tolerance and iterations of the kick) makes the step that of a
+    single driven run, :func:`dirac.flows.torque_kernels` ``split_advance`` or
+    ``exact_advance``: every stage ``K(g_j dt/2) F(g_j dt) K(g_j dt/2)`` with the torque
+    kick ``torque_kick`` (gravity and torque, the work ``W`` accumulated), kicks not merged,
+    the time of a call's steps ``t0 + step dt`` with ``t0`` the sum of the earlier calls'
+    ``n dt`` (as :class:`dirac.flows.methods.torqued.TorquedStepper` keeps it); the energy
+    error is that of ``E - W``."""
     from dirac.rigidbody.exact_step import _LEVELS
 
     n_cross, n_ext, n_poin = len(layout["cross"]), len(layout["ext"]), len(layout["poincare"])
@@ -201,8 +223,14 @@ def ht_orthogonality(R):
     w(1, "fractions = FRACS[i]")
     w(1, "casimir_rate = CAS[i]")
     w(1, "s = gammas.shape[0]")
-    if exact:
+    if driven is not None:
         w(1, "a = A[i]")
+        w(1, "N = np.empty(3)")
+        w(1, "work = np.zeros(1)")
+        w(1, "t_call = 0.0")
+    if exact:
+        if driven is None:
+            w(1, "a = A[i]")
         w(1, "p = np.zeros(21)")
         w(1, f"em = np.zeros({_LEVELS})")
         w(1, f"en = np.zeros({_LEVELS})")
@@ -237,29 +265,12 @@ def ht_orthogonality(R):
     w(2, "done = 0")
     w(2, "while done < per_interval and not stop:")
     w(3, "n = min(call, per_interval - done)")
-    if exact:
-        w(3, "# exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en), observed after each step")
+    if driven is not None:
+        _driven_steps(w, exact, driven)
     else:
-        w(3, "# heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n), observed after each step")
-    w(3, "kick(M, R, w, 0.5 * gammas[0] * dt)")
-    w(3, "for step in range(n):")
-    w(4, "for j in range(s):")
-    if exact:
-        w(5, "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
-    else:
-        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)")
-    w(5, "if j < s - 1:")
-    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[j + 1]) * dt)")
-    w(5, "elif step < n - 1:")
-    w(6, "for x in range(3):")
-    w(7, "Mo[x] = M[x]")
-    w(6, "kick(Mo, R, w, 0.5 * gammas[j] * dt)")
-    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[0]) * dt)")
-    w(5, "else:")
-    w(6, "kick(M, R, w, 0.5 * gammas[j] * dt)")
-    w(6, "for x in range(3):")
-    w(7, "Mo[x] = M[x]")
+        _undriven_steps(w, exact)
     w(4, "steps += 1")
+
     w(4, "ta = t_k + (done + step) * dt")
     w(4, "tb = t_k + (done + step + 1) * dt")
     w(4, "bad = False")
@@ -313,11 +324,14 @@ def ht_orthogonality(R):
         w(4, f"if early and {' and '.join(decided)}:")
         w(5, "stop = True")
         w(5, "break")
+    if driven is not None:
+        w(3, "t_call = t0 + n * dt")
     w(3, "done += n")
     w(2, "if stop:")
     w(3, "break")
     if energy:
-        w(2, "err = abs(ht_energy(M, R, 0.0, c) - e0)")
+        w(2, "err = abs(ht_energy(M, R, 0.0, c) - e0)" if driven is None else
+          "err = abs(ht_energy(M, R, 0.0, c) - work[0] - e0)")
         w(2, "if not (err <= EERR[i]):")
         w(3, "EERR[i] = err")
     if constraint:
@@ -346,6 +360,61 @@ HT_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
 def _where(names: tuple[str, ...], row: np.ndarray) -> str:
     return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
 
+
+def _undriven_steps(w: Any, exact: bool) -> None:
+    """The steps of one call of a single undriven run, its half kicks merged (module docstring)."""
+    if exact:
+        w(3, "# exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en), observed after each step")
+    else:
+        w(3, "# heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n), observed after each step")
+    w(3, "kick(M, R, w, 0.5 * gammas[0] * dt)")
+    w(3, "for step in range(n):")
+    w(4, "for j in range(s):")
+    if exact:
+        w(5, "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
+    else:
+        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)")
+    w(5, "if j < s - 1:")
+    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[j + 1]) * dt)")
+    w(5, "elif step < n - 1:")
+    w(6, "for x in range(3):")
+    w(7, "Mo[x] = M[x]")
+    w(6, "kick(Mo, R, w, 0.5 * gammas[j] * dt)")
+    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[0]) * dt)")
+    w(5, "else:")
+    w(6, "kick(M, R, w, 0.5 * gammas[j] * dt)")
+    w(6, "for x in range(3):")
+    w(7, "Mo[x] = M[x]")
+
+
+def _driven_steps(w: Any, exact: bool, driven: tuple[float, int]) -> None:
+    """The steps of one call of a single driven run (``split_advance`` / ``exact_advance`` of
+    :mod:`dirac.flows.torque_kernels`); a kick whose Newton iteration fails fails the member."""
+    tolerance, iterations = driven
+    kick = f"torque_kick(M, R, a, w, t, 0.5 * h, N, work, {tolerance!r}, {int(iterations)}) < 0"
+    w(3, "t0 = t_call")
+    w(3, "for step in range(n):")
+    w(4, "t = t0 + step * dt")
+    w(4, "failed = False")
+    w(4, "for j in range(s):")
+    w(5, "h = gammas[j] * dt")
+    w(5, f"if {kick}:")
+    w(6, "failed = True")
+    w(6, "break")
+    if exact:
+        w(5, "free_flow_step(M, R, a, h, p, em, en)")
+    else:
+        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, h, 1, True)")
+    w(5, "t += h")
+    w(5, f"if {kick}:")
+    w(6, "failed = True")
+    w(6, "break")
+    w(4, "if failed:")
+    w(5, f"status = {NEWTON_FAILED!r}")
+    w(5, "stop = True")
+    w(5, "break")
+    w(4, "for x in range(3):")
+    w(5, "Mo[x] = M[x]")
 
 def heavy_top_initial_states(scene: HeavyTopEnsembleScene, values: np.ndarray
                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
