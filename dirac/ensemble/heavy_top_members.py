@@ -363,17 +363,15 @@ def _where(names: tuple[str, ...], row: np.ndarray) -> str:
 
 def _undriven_steps(w: Any, exact: bool) -> None:
     """The steps of one call of a single undriven run, its half kicks merged (module docstring)."""
-    if exact:
-        w(3, "# exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en), observed after each step")
-    else:
-        w(3, "# heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n), observed after each step")
+    call, free = (("exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en)", "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
+                  if exact else
+                  ("heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n)",
+                   "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)"))
+    w(3, f"# {call}, observed after each step")
     w(3, "kick(M, R, w, 0.5 * gammas[0] * dt)")
     w(3, "for step in range(n):")
     w(4, "for j in range(s):")
-    if exact:
-        w(5, "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
-    else:
-        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)")
+    w(5, free)
     w(5, "if j < s - 1:")
     w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[j + 1]) * dt)")
     w(5, "elif step < n - 1:")
@@ -398,17 +396,15 @@ def _driven_steps(w: Any, exact: bool, driven: tuple[float, int]) -> None:
     w(4, "failed = False")
     w(4, "for j in range(s):")
     w(5, "h = gammas[j] * dt")
-    w(5, f"if {kick}:")
-    w(6, "failed = True")
-    w(6, "break")
-    if exact:
-        w(5, "free_flow_step(M, R, a, h, p, em, en)")
-    else:
-        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, h, 1, True)")
-    w(5, "t += h")
-    w(5, f"if {kick}:")
-    w(6, "failed = True")
-    w(6, "break")
+    free = "free_flow_step(M, R, a, h, p, em, en)" if exact else \
+        "advance_sequence(M, R, axes, rates, fractions, casimir_rate, h, 1, True)"
+    for statement in (None, free, "t += h", None):
+        if statement is not None:
+            w(5, statement)
+            continue
+        w(5, f"if {kick}:")
+        w(6, "failed = True")
+        w(6, "break")
     w(4, "if failed:")
     w(5, f"status = {NEWTON_FAILED!r}")
     w(5, "stop = True")
