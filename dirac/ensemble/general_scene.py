@@ -478,6 +478,10 @@ def _state_names(lagrangian: Any) -> dict[str, Any]:
 
 
 def _method(run: dict, forced: bool) -> tuple[str, int]:
+    """The step method of a member and its order. On a forced system the ordinary names
+    ``rattle-2`` and ``rattle-4`` run as ``forced-rattle-2`` and ``forced-rattle-4``, as
+    :func:`dirac.flows.integrate` runs them on a forced problem (the same stepper)."""
+    from dirac.flows.methods.forced_ordinary import FORCED_VERSIONS
     from dirac.flows.methods.registry import get_method
 
     usable = ["forced-rattle-2", "forced-rattle-4", "conformal-2", "conformal-4"] if forced else \
@@ -485,9 +489,12 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
     name = run.get("method", "auto")
     if name == "auto":
         name = usable[0]
+    if forced and name in FORCED_VERSIONS:
+        name = FORCED_VERSIONS[name]
     if name not in usable:
         kind = "a forced system" if forced else "an ensemble of this system"
-        raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {usable}")
+        names = [*FORCED_VERSIONS, *usable] if forced else usable
+        raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {names}")
     return str(name), int(get_method(name).order)
 
 
