@@ -557,8 +557,14 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
     initial_momentum: tuple[float | str, ...] = ()
     initial_R: tuple[tuple[float | str, ...], ...] = ()
     torque: tuple[str, ...] | None = None
+    impulses: tuple[tuple[float, tuple[float, ...]], ...] = ()
 
     heavy_top = True
+
+    @property
+    def driven(self) -> bool:
+        """Whether a torque or angular impulses act (the single run's driven step)."""
+        return self.torque is not None or bool(self.impulses)
 
     def array_layout(self) -> dict[str, tuple[int, ...]]:
         """Array name -> shape of one member's entry: ``final`` gives ``final_M`` (3,) and
@@ -576,6 +582,8 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
         described["heavy_top"] = True  # its Poincaré sections are stored as <name>_M and <name>_R
         if self.torque is not None:  # (absent for an undriven top: the fingerprints of earlier stores hold)
             described["torque"] = list(self.torque)
+        if self.impulses:
+            described["impulses"] = [[t, list(vector)] for t, vector in self.impulses]
         return described
 
 
@@ -619,12 +627,8 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
     from dirac.model.expressions import parse_expression
     from dirac.rigidbody.schemes import SCHEMES
 
-    if "impulses" in data:
-        raise InputError("[[impulses]] are not available in heavy-top ensembles (a member's steps would be cut at "
-                         "each impulse time); run a top with impulses with dirac run")
-    reject_unknown_keys(data, {"system", "initial", "run", "ensemble", "forces"}, "the scene", kind="section")
+    reject_unknown_keys(data, {"system", "initial", "run", "ensemble", "forces", "impulses"}, "the scene", kind="section")
     system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
-    torque = _top_torque(data.get("forces"))
     reject_unknown_keys(system, _TOP_SYSTEM_KEYS, "[system]")
     reject_unknown_keys(initial, _TOP_INITIAL_KEYS, "[initial]")
     reject_unknown_keys(run, _TOP_RUN_KEYS, "[run]")
@@ -677,6 +681,9 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
                          "(final, max, min, poincare, ...) under [ensemble] reductions")
     spacing = t_end / (samples - 1)
     steps_per_sample = max(1, math.ceil(spacing / dt * (1.0 - 1e-12)))
+    from dirac.io.scene import rigid_drive
+
+    torque, impulses = rigid_drive(data, t_end, "the scene")  # as a single scene reads them (expressions of the state)
     tolerance = scene_number(run.get("newton_tolerance", 1e-12), "[run] newton_tolerance", positive=True)
     iterations = run.get("max_newton_iterations", 50)
     if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
@@ -715,22 +722,7 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
         rate_kind=given[0], parameters=parameters, project=False, method=str(method),
         order=int(get_method(str(method)).order), dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end,
         samples=samples, steps_per_sample=steps_per_sample, reductions=reductions, chunk_size=chunk_size, path=path,
-        initial_momentum=momentum, initial_R=attitude, torque=torque, newton_tolerance=tolerance,
-        max_newton_iterations=int(iterations),
+        initial_momentum=momentum, initial_R=attitude, torque=None if torque is None else torque.texts,
+        impulses=tuple((float(impulse.t), tuple(float(x) for x in impulse.vector)) for impulse in impulses),
+        newton_tolerance=tolerance, max_newton_iterations=int(iterations),
     )
-
-
-def _top_torque(forces: object) -> tuple[str, ...] | None:
-    """``[forces] torque = [N1, N2, N3]`` of a heavy-top ensemble scene, validated as a single
-    scene validates it (:class:`dirac.flows.torques.Torque`: expressions in ``M_i``,
-    ``Omega_i``, ``R_ij`` and ``t``), or None without ``[forces]``."""
-    if forces is None:
-        return None
-    if not isinstance(forces, dict):
-        raise InputError('[forces] must be a table, e.g. torque = ["0", "0", "-0.1*Omega_3"]')
-    reject_unknown_keys(forces, {"torque"}, "[forces]")
-    if "torque" not in forces:
-        raise InputError('[forces] lacks torque = [N1, N2, N3] (the body-frame torque), e.g. ["0", "0", "-0.1*Omega_3"]')
-    from dirac.flows.torques import Torque
-
-    return Torque(forces["torque"], "the scene").texts

@@ -32,7 +32,7 @@ free step, the kicks not merged, imported from the torque's own generated module
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -150,12 +150,12 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
                             [names["energy"]], None, parameters)]
     exact = scene.method.startswith("exact-kick-")
     driven = None
-    if scene.torque is not None:  # the single run's torque kick (dirac.flows.torque_kernels), by its module's name
+    if scene.driven:  # the single run's torque kick (dirac.flows.torque_kernels), by its module's name
         from dirac.flows.torques import Torque
 
-        kernels = Torque(scene.torque).kernels
+        kernels = Torque(scene.torque or ("0", "0", "0")).kernels  # impulses alone: a zero torque, as a single run
         source[0] += f"from {kernels.__name__} import kick as torque_kick\n"
-        driven = (scene.newton_tolerance, scene.max_newton_iterations)
+        driven = _Drive(scene.newton_tolerance, scene.max_newton_iterations, scene.impulses)
     source.append(_loop_source(layout, conditions, len(exprs), "energy_error" in kinds, "constraint_error" in kinds,
                                exact, driven))
     module = import_source("\n\n".join(source))
@@ -168,18 +168,14 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
 
 
 def _loop_source(layout: dict, conditions: list, n_exprs: int, energy: bool, constraint: bool,
-                 exact: bool = False, driven: tuple[float, int] | None = None) -> str:
+                 exact: bool = False, driven: _Drive | None = None) -> str:
     """``ht_locate``, ``ht_member`` and ``ht_run`` (module docstring); the free step is
     ``advance_sequence`` (``lie-poisson-*``) or, with ``exact``, ``free_flow_step``
     (``exact-kick-*``: :func:`dirac.rigidbody.exact_step.exact_kick_advance`'s loop).
 
-    ``driven`` (the Newton tolerance and iterations of the kick) makes the step that of a
-    single driven run, :func:`dirac.flows.torque_kernels` ``split_advance`` or
-    ``exact_advance``: every stage ``K(g_j dt/2) F(g_j dt) K(g_j dt/2)`` with the torque
-    kick ``torque_kick`` (gravity and torque, the work ``W`` accumulated), kicks not merged,
-    the time of a call's steps ``t0 + step dt`` with ``t0`` the sum of the earlier calls'
-    ``n dt`` (as :class:`dirac.flows.methods.torqued.TorquedStepper` keeps it); the energy
-    error is that of ``E - W``."""
+    ``driven`` makes the step that of a single driven run
+    (:class:`dirac.flows.methods.torqued.TorquedStepper`; :func:`_driven_steps`); the energy
+    error is then that of ``E - W``."""
     from dirac.rigidbody.exact_step import _LEVELS
 
     n_cross, n_ext, n_poin = len(layout["cross"]), len(layout["ext"]), len(layout["poincare"])
@@ -206,6 +202,8 @@ def ht_orthogonality(R):
         "            for y in range(3):\n"
         "                Rs[x, y] = Ra[x, y] + s * (R[x, y] - Ra[x, y])\n",
         "        ht_values(Ms, Rs, ta + s * dt, c, fs)\n") + "\n"]
+    if driven is not None:
+        lines.append(_driven_source(exact, driven))
 
     def w(depth: int, text: str) -> None:
         lines.append("    " * depth + text)
@@ -228,6 +226,7 @@ def ht_orthogonality(R):
         w(1, "N = np.empty(3)")
         w(1, "work = np.zeros(1)")
         w(1, "t_call = 0.0")
+        w(1, "q = ht_impulses(M, a, work, 0, 0.0)  # those at t = 0 act on the initial state")
     if exact:
         if driven is None:
             w(1, "a = A[i]")
@@ -249,7 +248,7 @@ def ht_orthogonality(R):
     for x, (_, _, e) in enumerate(layout["ext"]):
         w(1, f"EXT[i, {x}] = f[{e}]")
     if energy:
-        w(1, "e0 = ht_energy(M, R, 0.0, c)")
+        w(1, "e0 = ht_energy(M, R, 0.0, c)" + (" - work[0]" if driven is not None else ""))
         w(1, "EERR[i] = 0.0")
     if constraint:
         w(1, "CERR[i] = ht_orthogonality(R)")
@@ -266,7 +265,7 @@ def ht_orthogonality(R):
     w(2, "while done < per_interval and not stop:")
     w(3, "n = min(call, per_interval - done)")
     if driven is not None:
-        _driven_steps(w, exact, driven)
+        _driven_steps(w, exact)
     else:
         _undriven_steps(w, exact)
     w(4, "steps += 1")
@@ -325,7 +324,9 @@ def ht_orthogonality(R):
         w(5, "stop = True")
         w(5, "break")
     if driven is not None:
-        w(3, "t_call = t0 + n * dt")
+        w(3, "while q < IMP_T.shape[0] and IMP_T[q] <= target + slack:  # at the end of the call")
+        w(4, "q = ht_impulses(M, a, work, q, IMP_T[q])")
+        w(3, "t_call = target")
     w(3, "done += n")
     w(2, "if stop:")
     w(3, "break")
@@ -385,32 +386,105 @@ def _undriven_steps(w: Any, exact: bool) -> None:
     w(7, "Mo[x] = M[x]")
 
 
-def _driven_steps(w: Any, exact: bool, driven: tuple[float, int]) -> None:
-    """The steps of one call of a single driven run (``split_advance`` / ``exact_advance`` of
-    :mod:`dirac.flows.torque_kernels`); a kick whose Newton iteration fails fails the member."""
-    tolerance, iterations = driven
-    kick = f"torque_kick(M, R, a, w, t, 0.5 * h, N, work, {tolerance!r}, {int(iterations)}) < 0"
+class _Drive(NamedTuple):
+    """What a driven member loop needs besides the torque: the Newton tolerance and
+    iterations of the kick, and the impulses ``(t, (a, b, c))`` sorted by time."""
+
+    tolerance: float
+    iterations: int
+    impulses: tuple[tuple[float, tuple[float, ...]], ...]
+
+
+def _driven_source(exact: bool, driven: _Drive) -> str:
+    """The impulses as constants, ``ht_impulses`` (:meth:`TorquedStepper._apply_impulses_at`)
+    and ``ht_step`` (one step of ``split_advance`` / ``exact_advance`` of
+    :mod:`dirac.flows.torque_kernels` from time ``t``, step ``dt``: 0, or -1 when a kick's
+    Newton iteration fails)."""
+    times = ", ".join(repr(float(t)) for t, _ in driven.impulses)
+    vectors = ", ".join(repr(float(x)) for _, vector in driven.impulses for x in vector)
+    free, args = (("free_flow_step(M, R, a, h, p, em, en)", "p, em, en") if exact else
+                  ("advance_sequence(M, R, axes, rates, fractions, casimir_rate, h, 1, True)",
+                   "axes, rates, fractions, casimir_rate"))
+    kick = f"torque_kick(M, R, a, w, t, 0.5 * h, N, work, {driven.tolerance!r}, {int(driven.iterations)}) < 0"
+    return f'''
+IMP_T = np.array([{times}], dtype=np.float64)
+IMP_J = np.array([{vectors}], dtype=np.float64).reshape(-1, 3)
+
+
+@numba.njit(cache=True)
+def ht_impulses(M, a, work, q, t):
+    """Apply the impulses from index q whose time is t (within round-off); the next index."""
+    while q < IMP_T.shape[0] and IMP_T[q] <= t + 1e-12 * max(1.0, abs(t)):
+        before = 0.5 * (M[0] * M[0] * a[0] + M[1] * M[1] * a[1] + M[2] * M[2] * a[2])
+        for x in range(3):
+            M[x] = M[x] + IMP_J[q, x]
+        work[0] += 0.5 * (M[0] * M[0] * a[0] + M[1] * M[1] * a[1] + M[2] * M[2] * a[2]) - before
+        q += 1
+    return q
+
+
+@numba.njit(cache=True)
+def ht_step(M, R, a, w, gammas, t, dt, N, work, {args}):
+    """One step prod_j K(g_j dt/2) F(g_j dt) K(g_j dt/2) from time t; -1 if a kick failed."""
+    for j in range(gammas.shape[0]):
+        h = gammas[j] * dt
+        if {kick}:
+            return -1
+        {free}
+        t += h
+        if {kick}:
+            return -1
+    return 0
+'''
+
+
+def _driven_steps(w: Any, exact: bool) -> None:
+    """The steps of one call ``stepper.step(n, dt)`` of a single driven run
+    (:class:`dirac.flows.methods.torqued.TorquedStepper`), observed after each step.
+
+    The call's time starts at ``t0``, the sum of the earlier calls' ``n dt``. Steps run in
+    segments from ``t0 + k dt`` (``k`` the first step of the segment), with the step times
+    ``t0 + k dt + j dt`` of the single run's kernel calls; a segment ends at an impulse. An
+    impulse inside a step cuts it in two (``rest`` to the impulse, ``dt - rest`` after); one
+    on a step boundary (within ``1e-9 dt``) acts between two steps, or after the call's last.
+    A kick whose Newton iteration fails fails the member."""
+    step_args = "p, em, en" if exact else "axes, rates, fractions, casimir_rate"
     w(3, "t0 = t_call")
+    w(3, "target = t0 + n * dt")
+    w(3, "slack = 1e-9 * dt")
+    w(3, "first = 0")
+    w(3, "start = t0 + 0 * dt")
     w(3, "for step in range(n):")
-    w(4, "t = t0 + step * dt")
-    w(4, "failed = False")
-    w(4, "for j in range(s):")
-    w(5, "h = gammas[j] * dt")
-    free = "free_flow_step(M, R, a, h, p, em, en)" if exact else \
-        "advance_sequence(M, R, axes, rates, fractions, casimir_rate, h, 1, True)"
-    for statement in (None, free, "t += h", None):
-        if statement is not None:
-            w(5, statement)
-            continue
-        w(5, f"if {kick}:")
-        w(6, "failed = True")
-        w(6, "break")
+    w(4, "cut = False")
+    w(4, "t_imp = 0.0")
+    w(4, "while q < IMP_T.shape[0] and IMP_T[q] <= target + slack:")
+    w(5, "if min(n, int(math.floor((IMP_T[q] - t0 + slack) / dt))) > step:")
+    w(6, "break  # it comes in a later step")
+    w(5, "t_imp = IMP_T[q]")
+    w(5, "if t_imp - (t0 + step * dt) > slack:")
+    w(6, "cut = True")
+    w(6, "break")
+    w(5, "q = ht_impulses(M, a, work, q, t_imp)")
+    w(5, "first = step")
+    w(5, "start = t0 + step * dt")
+    w(4, "if cut:")
+    w(5, "t_here = t0 + step * dt")
+    w(5, "rest = t_imp - t_here")
+    w(5, f"failed = ht_step(M, R, a, w, gammas, t_here, rest, N, work, {step_args}) < 0")
+    w(5, "if not failed:")
+    w(6, "q = ht_impulses(M, a, work, q, t_imp)")
+    w(6, f"failed = ht_step(M, R, a, w, gammas, t_imp, dt - rest, N, work, {step_args}) < 0")
+    w(5, "first = step + 1")
+    w(5, "start = t0 + (step + 1) * dt")
+    w(4, "else:")
+    w(5, f"failed = ht_step(M, R, a, w, gammas, start + (step - first) * dt, dt, N, work, {step_args}) < 0")
     w(4, "if failed:")
     w(5, f"status = {NEWTON_FAILED!r}")
     w(5, "stop = True")
     w(5, "break")
     w(4, "for x in range(3):")
     w(5, "Mo[x] = M[x]")
+
 
 def heavy_top_initial_states(scene: HeavyTopEnsembleScene, values: np.ndarray
                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -329,13 +329,14 @@ reductions = ["final", "energy_error", "constraint_error"]
 
 
 
-def _single(method: str, b: float, w: float, torque: list[str], t_end: float = 2.0, samples: int = 5):
+def _single(method: str, b: float, w: float, torque: list[str] | None, t_end: float = 2.0, samples: int = 5,
+            impulses: list | None = None):
     from dirac.flows import integrate
     from dirac.flows.problems import HeavyTopProblem
 
     inertia = np.array([1.0, b, 0.6])
     problem = HeavyTopProblem(inertia, inertia * np.array([0.3, w, 2.0]), _tilted(0.4), mass_gravity=1.5,
-                              center_of_mass=[0.3, 0.0, 1.0], torque=torque)
+                              center_of_mass=[0.3, 0.0, 1.0], torque=torque, impulses=impulses or ())
     return integrate(problem, method, t_end=t_end, dt=0.007, samples=samples, outputs=["M", "R", "energy", "work"])
 
 
@@ -456,10 +457,41 @@ def test_bad_torques_are_refused_before_anything_is_written(tmp_path, change, me
     _refused(path, tmp_path / "out", message)
 
 
-def test_impulses_are_still_refused_with_the_way_out(tmp_path):
+#: impulses at t = 0, inside a step (cut in two), on a step boundary (0.5 = 72 steps of 0.5/72),
+#: two inside one step, and at t_end (after the last step of the last call)
+IMPULSES = [(0.0, [0.0, 0.0, 0.3]), (0.3001, [0.2, -0.1, 0.0]), (0.5, [0.0, 0.4, 0.0]),
+            (1.20001, [0.1, 0.0, 0.0]), (1.20003, [0.0, 0.0, -0.2]), (2.0, [0.5, 0.5, 0.5])]
+
+
+@pytest.mark.parametrize("method, torque", [("lie-poisson-4", True), ("exact-kick-4", False)])
+def test_members_with_impulses_equal_single_runs(tmp_path, method, torque, monkeypatch):
+    """Angular impulses cut a single run's steps at their times (TorquedStepper.step): a member
+    with the same impulses equals dirac.integrate of the driven HeavyTopProblem to the last bit,
+    with a torque and with impulses alone (a zero torque, as a single run), in calls of 37 steps;
+    its energy error is the single run's max |E - W - (E - W)(0)|, W counting each impulse's jump
+    of the kinetic energy. An impulse at t = 0 acts on the initial state."""
+    import dirac.flows.integration as integration
+
+    monkeypatch.setattr(integration, "CHUNK_STEPS", 37)
+    monkeypatch.setattr(integration, "MIN_CHUNK_STEPS", 10)
+    scene = DRIVEN.replace('"lie-poisson-4"', f'"{method}"').replace("reductions = [", "reductions = [{ kind = \"max\", name = \"spin\", expr = \"M_3\" }, ")
+    if not torque:
+        scene = scene.replace(f"[forces]\ntorque = {TORQUE_TEXT}\n", "")
+    scene += "".join(f"\n[[impulses]]\nt = {t}\nangular_impulse = {vector}\n" for t, vector in IMPULSES)
     path = tmp_path / "kicked.toml"
-    path.write_text(DRIVEN + '\n[[impulses]]\nt = 1.0\nM = [0.0, 0.0, 1.0]\n')
-    _refused(path, tmp_path / "out", "[[impulses]] are not available in heavy-top ensembles")
+    path.write_text(scene)
+    assert run_ensemble(path, tmp_path / "out").complete
+    stored = _arrays(tmp_path / "out")
+    assert np.all(stored["failures"] == 0)
+    for i in range(6):
+        single = _single(method, float(stored["b"][i]), float(stored["w"][i]), TORQUE if torque else None,
+                         impulses=IMPULSES)
+        assert np.array_equal(single.outputs["M"][-1], stored["final_M"][i])
+        assert np.array_equal(single.outputs["R"][-1], stored["final_R"][i])
+        balance = single.outputs["energy"] - single.outputs["work"]
+        assert stored["energy_error"][i] == pytest.approx(np.max(np.abs(balance - balance[0])), rel=1e-9, abs=1e-15)
+        assert single.outputs["M"][0][2] == pytest.approx(0.6 * 2.0 + 0.3)  # M_3 = I_3 omega_3, then the jump at t = 0
+        assert stored["spin"][i] >= single.outputs["M"][0][2]
 
 
 def _refused(path, out, message):
