@@ -22,7 +22,7 @@ from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError
 
-__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_results", "step_grid"]
+__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_column", "member_results", "step_grid"]
 
 #: Members whose initial states are checked at once by :func:`check_initial_states`.
 _CHECK_BLOCK = 65536
@@ -58,6 +58,20 @@ def _evaluate(expression: object, variables: tuple[str, ...], values: np.ndarray
     return np.broadcast_to(np.asarray(result, dtype=float), (values.shape[0],)).copy()
 
 
+def member_column(value: float | str, where: str, names: tuple[str, ...], values: np.ndarray) -> np.ndarray:
+    """A scene entry for every member: a number repeated, or an expression (a string, read by
+    the safe expression parser; ``where`` names the entry in its errors) of the ensemble
+    variables ``names`` at each member's ``values`` (rows)."""
+    import sympy
+
+    from dirac.model.expressions import parse_expression
+
+    if isinstance(value, str):
+        symbols = {name: sympy.Symbol(name, real=True) for name in names}
+        return _evaluate(parse_expression(value, symbols, what=where), names, values)
+    return np.full(values.shape[0], float(value))
+
+
 @functools.lru_cache(maxsize=256)
 def _numpy_function(expression: Any, variables: tuple[str, ...]) -> Any:
     """``expression`` of the ensemble variables as a numpy function (made once per process:
@@ -75,18 +89,11 @@ def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, valu
     the constraints when the scene says ``project = true`` (``projected``: these members'
     projected ``(Q, P)``, computed before by this function, which are then taken as they are:
     the projection is a Python loop over members, about 0.15 ms each)."""
-    import sympy
-
-    from dirac.model.expressions import parse_expression
-
     count = values.shape[0]
     names = scene.source.names
-    symbols = {name: sympy.Symbol(name, real=True) for name in names}
 
     def column(value: float | str, where: str) -> np.ndarray:
-        if isinstance(value, str):
-            return _evaluate(parse_expression(value, symbols, what=where), names, values)
-        return np.full(count, float(value))
+        return member_column(value, where, names, values)
 
     mechanics = compiled.mechanics
     C = np.tile(np.asarray(mechanics.params, dtype=float), (count, 1))

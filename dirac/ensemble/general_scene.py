@@ -478,6 +478,10 @@ def _state_names(lagrangian: Any) -> dict[str, Any]:
 
 
 def _method(run: dict, forced: bool) -> tuple[str, int]:
+    """The step method of a member and its order. On a forced system the ordinary names
+    ``rattle-2`` and ``rattle-4`` run as ``forced-rattle-2`` and ``forced-rattle-4``, as
+    :func:`dirac.flows.integrate` runs them on a forced problem (the same stepper)."""
+    from dirac.flows.methods.forced_ordinary import FORCED_VERSIONS
     from dirac.flows.methods.registry import get_method
 
     usable = ["forced-rattle-2", "forced-rattle-4", "conformal-2", "conformal-4"] if forced else \
@@ -485,9 +489,12 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
     name = run.get("method", "auto")
     if name == "auto":
         name = usable[0]
+    if forced and name in FORCED_VERSIONS:
+        name = FORCED_VERSIONS[name]
     if name not in usable:
         kind = "a forced system" if forced else "an ensemble of this system"
-        raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {usable}")
+        names = [*FORCED_VERSIONS, *usable] if forced else usable
+        raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {names}")
     return str(name), int(get_method(name).order)
 
 
@@ -498,7 +505,7 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
 
 _TOP_SYSTEM_KEYS = {"name", "inertia", "mass_gravity", "center_of_mass", "description"}
 _TOP_INITIAL_KEYS = {"M", "omega", "m", "R"}
-_TOP_RUN_KEYS = {"t_end", "method", "dt", "samples", "outputs"}
+_TOP_RUN_KEYS = {"t_end", "method", "dt", "samples", "outputs", "newton_tolerance", "max_newton_iterations"}
 
 #: The parameters of a heavy top, in the order of a member's parameter row.
 TOP_PARAMETERS = ("I_1", "I_2", "I_3", "mass_gravity", "chi_1", "chi_2", "chi_3")
@@ -549,8 +556,15 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
 
     initial_momentum: tuple[float | str, ...] = ()
     initial_R: tuple[tuple[float | str, ...], ...] = ()
+    torque: tuple[str, ...] | None = None
+    impulses: tuple[tuple[float, tuple[float, ...]], ...] = ()
 
     heavy_top = True
+
+    @property
+    def driven(self) -> bool:
+        """Whether a torque or angular impulses act (the single run's driven step)."""
+        return self.torque is not None or bool(self.impulses)
 
     def array_layout(self) -> dict[str, tuple[int, ...]]:
         """Array name -> shape of one member's entry: ``final`` gives ``final_M`` (3,) and
@@ -566,6 +580,10 @@ class HeavyTopEnsembleScene(GeneralEnsembleScene):
         described = super().describe()
         described["initial"] = {self.rate_kind: list(self.initial_momentum), "R": [list(row) for row in self.initial_R]}
         described["heavy_top"] = True  # its Poincaré sections are stored as <name>_M and <name>_R
+        if self.torque is not None:  # (absent for an undriven top: the fingerprints of earlier stores hold)
+            described["torque"] = list(self.torque)
+        if self.impulses:
+            described["impulses"] = [[t, list(vector)] for t, vector in self.impulses]
         return described
 
 
@@ -609,10 +627,7 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
     from dirac.model.expressions import parse_expression
     from dirac.rigidbody.schemes import SCHEMES
 
-    if "impulses" in data or "forces" in data:
-        raise InputError("[forces] and [[impulses]] are not available in heavy-top ensembles; run a driven top "
-                         "with dirac run")
-    reject_unknown_keys(data, {"system", "initial", "run", "ensemble"}, "the scene", kind="section")
+    reject_unknown_keys(data, {"system", "initial", "run", "ensemble", "forces", "impulses"}, "the scene", kind="section")
     system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
     reject_unknown_keys(system, _TOP_SYSTEM_KEYS, "[system]")
     reject_unknown_keys(initial, _TOP_INITIAL_KEYS, "[initial]")
@@ -666,6 +681,13 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
                          "(final, max, min, poincare, ...) under [ensemble] reductions")
     spacing = t_end / (samples - 1)
     steps_per_sample = max(1, math.ceil(spacing / dt * (1.0 - 1e-12)))
+    from dirac.io.scene import rigid_drive
+
+    torque, impulses = rigid_drive(data, t_end, "the scene")  # as a single scene reads them (expressions of the state)
+    tolerance = scene_number(run.get("newton_tolerance", 1e-12), "[run] newton_tolerance", positive=True)
+    iterations = run.get("max_newton_iterations", 50)
+    if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
+        raise InputError(f"[run] max_newton_iterations = {iterations!r} must be an integer >= 1")
 
     listed = ensemble.get("reductions", [])
     tables = ensemble.get("reduction", [])
@@ -700,5 +722,7 @@ def parse_heavy_top_scene(data: dict, base_dir: str | Path = ".", path: str | No
         rate_kind=given[0], parameters=parameters, project=False, method=str(method),
         order=int(get_method(str(method)).order), dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end,
         samples=samples, steps_per_sample=steps_per_sample, reductions=reductions, chunk_size=chunk_size, path=path,
-        initial_momentum=momentum, initial_R=attitude,
+        initial_momentum=momentum, initial_R=attitude, torque=None if torque is None else torque.texts,
+        impulses=tuple((float(impulse.t), tuple(float(x) for x in impulse.vector)) for impulse in impulses),
+        newton_tolerance=tolerance, max_newton_iterations=int(iterations),
     )

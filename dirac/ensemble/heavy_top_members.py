@@ -22,17 +22,22 @@ ending there gives, to rounding) and updates the reductions' expressions
 :func:`dirac.codegen.kernel_source.emit_function`; ``ht_run`` is the ``numba.prange`` loop
 over the members of a chunk. Crossings are located as in a general ensemble (regula falsi
 on the straight line between the two states bracketing them).
+
+A top driven by a torque (``[forces] torque``) runs a single driven run's step instead
+(:class:`dirac.flows.methods.torqued.TorquedStepper`): the torque kick of
+:mod:`dirac.flows.torque_kernels` (gravity and torque, the work accumulated) around each
+free step, the kicks not merged, imported from the torque's own generated module.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from dirac.ensemble.crossing_source import locate_source
-from dirac.ensemble.general_chunk import _evaluate, member_results, step_grid
+from dirac.ensemble.general_chunk import member_column, member_results, step_grid
 from dirac.ensemble.general_scene import HeavyTopEnsembleScene, heavy_top_names, split_condition
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.errors import InputError, warn
@@ -42,6 +47,8 @@ __all__ = ["CompiledTop", "compiled_heavy_top", "check_heavy_top_states", "heavy
 
 #: The ``failures`` code of a member whose state stopped being finite (as in a general ensemble).
 NON_FINITE = 2.0
+#: The ``failures`` code of a member whose torque kick's Newton iteration did not converge.
+NEWTON_FAILED = 1.0
 
 _CACHE: dict[str, CompiledTop] = {}
 
@@ -142,8 +149,15 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
               emit_function("ht_energy", "H = sum M_i^2 / (2 I_i) + m g <chi, gamma>", arrays, [("t", None)],
                             [names["energy"]], None, parameters)]
     exact = scene.method.startswith("exact-kick-")
+    driven = None
+    if scene.driven:  # the single run's torque kick (dirac.flows.torque_kernels), by its module's name
+        from dirac.flows.torques import Torque
+
+        kernels = Torque(scene.torque or ("0", "0", "0")).kernels  # impulses alone: a zero torque, as a single run
+        source[0] += f"from {kernels.__name__} import kick as torque_kick\n"
+        driven = _Drive(scene.newton_tolerance, scene.max_newton_iterations, scene.impulses)
     source.append(_loop_source(layout, conditions, len(exprs), "energy_error" in kinds, "constraint_error" in kinds,
-                               exact))
+                               exact, driven))
     module = import_source("\n\n".join(source))
     if exact:
         from dirac.flows.methods.registry import get_method
@@ -154,10 +168,14 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
 
 
 def _loop_source(layout: dict, conditions: list, n_exprs: int, energy: bool, constraint: bool,
-                 exact: bool = False) -> str:
+                 exact: bool = False, driven: _Drive | None = None) -> str:
     """``ht_locate``, ``ht_member`` and ``ht_run`` (module docstring); the free step is
     ``advance_sequence`` (``lie-poisson-*``) or, with ``exact``, ``free_flow_step``
-    (``exact-kick-*``: :func:`dirac.rigidbody.exact_step.exact_kick_advance`'s loop)."""
+    (``exact-kick-*``: :func:`dirac.rigidbody.exact_step.exact_kick_advance`'s loop).
+
+    ``driven`` makes the step that of a single driven run
+    (:class:`dirac.flows.methods.torqued.TorquedStepper`; :func:`_driven_steps`); the energy
+    error is then that of ``E - W``."""
     from dirac.rigidbody.exact_step import _LEVELS
 
     n_cross, n_ext, n_poin = len(layout["cross"]), len(layout["ext"]), len(layout["poincare"])
@@ -184,6 +202,8 @@ def ht_orthogonality(R):
         "            for y in range(3):\n"
         "                Rs[x, y] = Ra[x, y] + s * (R[x, y] - Ra[x, y])\n",
         "        ht_values(Ms, Rs, ta + s * dt, c, fs)\n") + "\n"]
+    if driven is not None:
+        lines.append(_driven_source(exact, driven))
 
     def w(depth: int, text: str) -> None:
         lines.append("    " * depth + text)
@@ -201,8 +221,15 @@ def ht_orthogonality(R):
     w(1, "fractions = FRACS[i]")
     w(1, "casimir_rate = CAS[i]")
     w(1, "s = gammas.shape[0]")
-    if exact:
+    if driven is not None:
         w(1, "a = A[i]")
+        w(1, "N = np.empty(3)")
+        w(1, "work = np.zeros(1)")
+        w(1, "t_call = 0.0")
+        w(1, "q = ht_impulses(M, a, work, 0, 0.0)  # those at t = 0 act on the initial state")
+    if exact:
+        if driven is None:
+            w(1, "a = A[i]")
         w(1, "p = np.zeros(21)")
         w(1, f"em = np.zeros({_LEVELS})")
         w(1, f"en = np.zeros({_LEVELS})")
@@ -221,7 +248,7 @@ def ht_orthogonality(R):
     for x, (_, _, e) in enumerate(layout["ext"]):
         w(1, f"EXT[i, {x}] = f[{e}]")
     if energy:
-        w(1, "e0 = ht_energy(M, R, 0.0, c)")
+        w(1, "e0 = ht_energy(M, R, 0.0, c)" + (" - work[0]" if driven is not None else ""))
         w(1, "EERR[i] = 0.0")
     if constraint:
         w(1, "CERR[i] = ht_orthogonality(R)")
@@ -237,29 +264,12 @@ def ht_orthogonality(R):
     w(2, "done = 0")
     w(2, "while done < per_interval and not stop:")
     w(3, "n = min(call, per_interval - done)")
-    if exact:
-        w(3, "# exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en), observed after each step")
+    if driven is not None:
+        _driven_steps(w, exact)
     else:
-        w(3, "# heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n), observed after each step")
-    w(3, "kick(M, R, w, 0.5 * gammas[0] * dt)")
-    w(3, "for step in range(n):")
-    w(4, "for j in range(s):")
-    if exact:
-        w(5, "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
-    else:
-        w(5, "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)")
-    w(5, "if j < s - 1:")
-    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[j + 1]) * dt)")
-    w(5, "elif step < n - 1:")
-    w(6, "for x in range(3):")
-    w(7, "Mo[x] = M[x]")
-    w(6, "kick(Mo, R, w, 0.5 * gammas[j] * dt)")
-    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[0]) * dt)")
-    w(5, "else:")
-    w(6, "kick(M, R, w, 0.5 * gammas[j] * dt)")
-    w(6, "for x in range(3):")
-    w(7, "Mo[x] = M[x]")
+        _undriven_steps(w, exact)
     w(4, "steps += 1")
+
     w(4, "ta = t_k + (done + step) * dt")
     w(4, "tb = t_k + (done + step + 1) * dt")
     w(4, "bad = False")
@@ -313,11 +323,16 @@ def ht_orthogonality(R):
         w(4, f"if early and {' and '.join(decided)}:")
         w(5, "stop = True")
         w(5, "break")
+    if driven is not None:
+        w(3, "while q < IMP_T.shape[0] and IMP_T[q] <= target + slack:  # at the end of the call")
+        w(4, "q = ht_impulses(M, a, work, q, IMP_T[q])")
+        w(3, "t_call = target")
     w(3, "done += n")
     w(2, "if stop:")
     w(3, "break")
     if energy:
-        w(2, "err = abs(ht_energy(M, R, 0.0, c) - e0)")
+        w(2, "err = abs(ht_energy(M, R, 0.0, c) - e0)" if driven is None else
+          "err = abs(ht_energy(M, R, 0.0, c) - work[0] - e0)")
         w(2, "if not (err <= EERR[i]):")
         w(3, "EERR[i] = err")
     if constraint:
@@ -347,23 +362,140 @@ def _where(names: tuple[str, ...], row: np.ndarray) -> str:
     return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
 
 
+def _undriven_steps(w: Any, exact: bool) -> None:
+    """The steps of one call of a single undriven run, its half kicks merged (module docstring)."""
+    call, free = (("exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en)", "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
+                  if exact else
+                  ("heavy_top_advance(M, R, w, gammas, axes, rates, fractions, casimir_rate, dt, n)",
+                   "advance_sequence(M, R, axes, rates, fractions, casimir_rate, gammas[j] * dt, 1, True)"))
+    w(3, f"# {call}, observed after each step")
+    w(3, "kick(M, R, w, 0.5 * gammas[0] * dt)")
+    w(3, "for step in range(n):")
+    w(4, "for j in range(s):")
+    w(5, free)
+    w(5, "if j < s - 1:")
+    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[j + 1]) * dt)")
+    w(5, "elif step < n - 1:")
+    w(6, "for x in range(3):")
+    w(7, "Mo[x] = M[x]")
+    w(6, "kick(Mo, R, w, 0.5 * gammas[j] * dt)")
+    w(6, "kick(M, R, w, 0.5 * (gammas[j] + gammas[0]) * dt)")
+    w(5, "else:")
+    w(6, "kick(M, R, w, 0.5 * gammas[j] * dt)")
+    w(6, "for x in range(3):")
+    w(7, "Mo[x] = M[x]")
+
+
+class _Drive(NamedTuple):
+    """What a driven member loop needs besides the torque: the Newton tolerance and
+    iterations of the kick, and the impulses ``(t, (a, b, c))`` sorted by time."""
+
+    tolerance: float
+    iterations: int
+    impulses: tuple[tuple[float, tuple[float, ...]], ...]
+
+
+def _driven_source(exact: bool, driven: _Drive) -> str:
+    """The impulses as constants, ``ht_impulses`` (:meth:`TorquedStepper._apply_impulses_at`)
+    and ``ht_step`` (one step of ``split_advance`` / ``exact_advance`` of
+    :mod:`dirac.flows.torque_kernels` from time ``t``, step ``dt``: 0, or -1 when a kick's
+    Newton iteration fails)."""
+    times = ", ".join(repr(float(t)) for t, _ in driven.impulses)
+    vectors = ", ".join(repr(float(x)) for _, vector in driven.impulses for x in vector)
+    free, args = (("free_flow_step(M, R, a, h, p, em, en)", "p, em, en") if exact else
+                  ("advance_sequence(M, R, axes, rates, fractions, casimir_rate, h, 1, True)",
+                   "axes, rates, fractions, casimir_rate"))
+    kick = f"torque_kick(M, R, a, w, t, 0.5 * h, N, work, {driven.tolerance!r}, {int(driven.iterations)}) < 0"
+    return f'''
+IMP_T = np.array([{times}], dtype=np.float64)
+IMP_J = np.array([{vectors}], dtype=np.float64).reshape(-1, 3)
+
+
+@numba.njit(cache=True)
+def ht_impulses(M, a, work, q, t):
+    """Apply the impulses from index q whose time is t (within round-off); the next index."""
+    while q < IMP_T.shape[0] and IMP_T[q] <= t + 1e-12 * max(1.0, abs(t)):
+        before = 0.5 * (M[0] * M[0] * a[0] + M[1] * M[1] * a[1] + M[2] * M[2] * a[2])
+        for x in range(3):
+            M[x] = M[x] + IMP_J[q, x]
+        work[0] += 0.5 * (M[0] * M[0] * a[0] + M[1] * M[1] * a[1] + M[2] * M[2] * a[2]) - before
+        q += 1
+    return q
+
+
+@numba.njit(cache=True)
+def ht_step(M, R, a, w, gammas, t, dt, N, work, {args}):
+    """One step prod_j K(g_j dt/2) F(g_j dt) K(g_j dt/2) from time t; -1 if a kick failed."""
+    for j in range(gammas.shape[0]):
+        h = gammas[j] * dt
+        if {kick}:
+            return -1
+        {free}
+        t += h
+        if {kick}:
+            return -1
+    return 0
+'''
+
+
+def _driven_steps(w: Any, exact: bool) -> None:
+    """The steps of one call ``stepper.step(n, dt)`` of a single driven run
+    (:class:`dirac.flows.methods.torqued.TorquedStepper`), observed after each step.
+
+    The call's time starts at ``t0``, the sum of the earlier calls' ``n dt``. Steps run in
+    segments from ``t0 + k dt`` (``k`` the first step of the segment), with the step times
+    ``t0 + k dt + j dt`` of the single run's kernel calls; a segment ends at an impulse. An
+    impulse inside a step cuts it in two (``rest`` to the impulse, ``dt - rest`` after); one
+    on a step boundary (within ``1e-9 dt``) acts between two steps, or after the call's last.
+    A kick whose Newton iteration fails fails the member."""
+    step_args = "p, em, en" if exact else "axes, rates, fractions, casimir_rate"
+    w(3, "t0 = t_call")
+    w(3, "target = t0 + n * dt")
+    w(3, "slack = 1e-9 * dt")
+    w(3, "first = 0")
+    w(3, "start = t0 + 0 * dt")
+    w(3, "for step in range(n):")
+    w(4, "cut = False")
+    w(4, "t_imp = 0.0")
+    w(4, "while q < IMP_T.shape[0] and IMP_T[q] <= target + slack:")
+    w(5, "if min(n, int(math.floor((IMP_T[q] - t0 + slack) / dt))) > step:")
+    w(6, "break  # it comes in a later step")
+    w(5, "t_imp = IMP_T[q]")
+    w(5, "if t_imp - (t0 + step * dt) > slack:")
+    w(6, "cut = True")
+    w(6, "break")
+    w(5, "q = ht_impulses(M, a, work, q, t_imp)")
+    w(5, "first = step")
+    w(5, "start = t0 + step * dt")
+    w(4, "if cut:")
+    w(5, "t_here = t0 + step * dt")
+    w(5, "rest = t_imp - t_here")
+    w(5, f"failed = ht_step(M, R, a, w, gammas, t_here, rest, N, work, {step_args}) < 0")
+    w(5, "if not failed:")
+    w(6, "q = ht_impulses(M, a, work, q, t_imp)")
+    w(6, f"failed = ht_step(M, R, a, w, gammas, t_imp, dt - rest, N, work, {step_args}) < 0")
+    w(5, "first = step + 1")
+    w(5, "start = t0 + (step + 1) * dt")
+    w(4, "else:")
+    w(5, f"failed = ht_step(M, R, a, w, gammas, start + (step - first) * dt, dt, N, work, {step_args}) < 0")
+    w(4, "if failed:")
+    w(5, f"status = {NEWTON_FAILED!r}")
+    w(5, "stop = True")
+    w(5, "break")
+    w(4, "for x in range(3):")
+    w(5, "Mo[x] = M[x]")
+
+
 def heavy_top_initial_states(scene: HeavyTopEnsembleScene, values: np.ndarray
                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(M, R, C)`` of members with the ensemble variables ``values`` (rows): body angular
     momenta (``M = I omega`` for ``omega``, ``M = R^T m`` for ``m``, as a single scene), attitudes and
     the parameter rows ``(I_1, I_2, I_3, mass_gravity, chi_1, chi_2, chi_3)``."""
-    import sympy
-
-    from dirac.model.expressions import parse_expression
-
     count = values.shape[0]
     names = scene.source.names
-    symbols = {name: sympy.Symbol(name, real=True) for name in names}
 
     def column(value: float | str, where: str) -> np.ndarray:
-        if isinstance(value, str):
-            return _evaluate(parse_expression(value, symbols, what=where), names, values)
-        return np.full(count, float(value))
+        return member_column(value, where, names, values)
 
     C = np.empty((count, len(scene.parameter_names)))
     for k, key in enumerate(scene.parameter_names):

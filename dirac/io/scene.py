@@ -52,7 +52,7 @@ from __future__ import annotations
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -341,20 +341,37 @@ _RIGID_IMPULSE_KEYS = {"t", "angular_impulse"}
 
 def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> None:
     """``[forces] torque = [...]`` and ``[[impulses]]`` of a rigid-body or heavy-top scene,
-    set on ``problem`` (validated there: :class:`dirac.flows.torques.Torque`,
-    :class:`dirac.flows.torques.AngularImpulse`)."""
+    set on ``problem`` (:func:`rigid_drive`)."""
+    torque, impulses = rigid_drive(data, t_end, source)
+    if torque is not None:
+        problem.torque = torque
+    if impulses:
+        problem.impulses = impulses
+
+
+def rigid_drive(data: dict, t_end: float, source: str) -> tuple[Any, tuple[Any, ...]]:
+    """The torque (:class:`dirac.flows.torques.Torque` or None) and the angular impulses
+    (sorted, those at one time added: :func:`dirac.flows.impulses.validate_impulses`) of a
+    rigid-body or heavy-top scene's ``[forces] torque = [...]`` and ``[[impulses]]``.
+
+    Raises
+    ------
+    InputError
+        A key, expression or number that is not valid, named with the fix.
+    """
     from dirac.errors import warn
     from dirac.flows.impulses import AngularImpulse, validate_impulses
 
+    torque = None
     forces = scene_table(data, "forces", source, required=False)
     reject_unknown_keys(forces, _RIGID_FORCE_KEYS, "[forces]", source)
     if "torque" in forces:
-        torque = forces["torque"]
-        if not isinstance(torque, list):
+        components = forces["torque"]
+        if not isinstance(components, list):
             raise InputError(f'{source}: [forces] torque must be a list of three expressions, e.g. ["0", "0", "-0.1*Omega_3"]')
         from dirac.flows.torques import Torque
 
-        problem.torque = Torque(torque, source)
+        torque = Torque(components, source)
     tables = data.get("impulses", [])
     if not isinstance(tables, list) or not all(isinstance(table, dict) for table in tables):
         raise InputError(f"{source}: impulses must be [[impulses]] tables, each with t and angular_impulse = [a, b, c]")
@@ -373,8 +390,7 @@ def _drive(problem: RigidBodyProblem, data: dict, t_end: float, source: str) -> 
             warn(f"{source}: {where} at t = {t:g} is after [run] t_end = {t_end:g}: it never acts")
         impulses.append(AngularImpulse(t, scene_vector(table["angular_impulse"], f"{where} angular_impulse", source,
                                                        (3,))))
-    if impulses:
-        problem.impulses = validate_impulses(impulses)
+    return torque, validate_impulses(impulses) if impulses else ()
 
 
 def _impulse_tables(tables: object, source: str) -> list[tuple[float, dict[str, float]]]:

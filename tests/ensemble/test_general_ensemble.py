@@ -84,20 +84,24 @@ def test_members_equal_single_runs(tmp_path):
             assert np.array_equal(single.outputs["p"][-1], stored["final_p"][i])
             energy = single.outputs["energy"]
             assert stored["energy_error"][i] == pytest.approx(np.max(np.abs(energy - energy[0])), rel=1e-12, abs=1e-15)
-    # a forced, time-dependent system: forced RATTLE's state is the single run's too
+    # a forced, time-dependent system: forced RATTLE's state is the single run's too, under its
+    # own name and under the ordinary name rattle-4 (forced-rattle-4 on a forced system, as
+    # dirac.integrate of a ConstrainedProblem of the forced system runs it)
     (tmp_path / "damped.toml").write_text(DAMPED)
-    path = _scene(tmp_path, '[system]\nfile = "damped.toml"\nparameters = { F = 1.2, w = "1 + s" }\n',
-                  'q = { th = 0.3 }\nq_dot = { th = "s" }', 'method = "forced-rattle-2"\ndt = 0.01\nt_end = 1.0',
-                  'grid = { s = [0.0, 1.0, 3] }\nreductions = ["final"]', name="forced.toml")
-    assert run_ensemble(path, tmp_path / "forced").complete
-    stored = _arrays(tmp_path / "forced")
-    for i, s in enumerate(stored["s"]):
-        mechanics = MechanicalSystem.from_lagrangian(load_system(tmp_path / "damped.toml"), {"F": 1.2, "w": 1 + s},
-                                                     with_forces=True)
-        single = integrate(ForcedProblem(mechanics, np.array([0.3]), np.array([s])), "forced-rattle-2", t_end=1.0,
-                           dt=0.01, outputs=["q", "p"])
-        assert np.array_equal(single.outputs["q"][-1], stored["final_q"][i])
-        assert np.array_equal(single.outputs["p"][-1], stored["final_p"][i])
+    for method, single_method, problem_class in (("forced-rattle-2", "forced-rattle-2", ForcedProblem),
+                                                  ("rattle-4", "rattle-4", ConstrainedProblem)):
+        path = _scene(tmp_path, '[system]\nfile = "damped.toml"\nparameters = { F = 1.2, w = "1 + s" }\n',
+                      'q = { th = 0.3 }\nq_dot = { th = "s" }', f'method = "{method}"\ndt = 0.01\nt_end = 1.0',
+                      'grid = { s = [0.0, 1.0, 3] }\nreductions = ["final"]', name="forced.toml")
+        assert run_ensemble(path, tmp_path / method).complete
+        stored = _arrays(tmp_path / method)
+        for i, s in enumerate(stored["s"]):
+            mechanics = MechanicalSystem.from_lagrangian(load_system(tmp_path / "damped.toml"), {"F": 1.2, "w": 1 + s},
+                                                         with_forces=True)
+            single = integrate(problem_class(mechanics, np.array([0.3]), np.array([s])), single_method, t_end=1.0,
+                               dt=0.01, outputs=["q", "p"])
+            assert np.array_equal(single.outputs["q"][-1], stored["final_q"][i])
+            assert np.array_equal(single.outputs["p"][-1], stored["final_p"][i])
 
 
 def test_flip_time_and_early_stop(tmp_path):
@@ -211,6 +215,19 @@ def test_bad_input_is_refused_before_anything_is_written(tmp_path, initial, ense
     result = _cli(path, tmp_path / "out")
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith("error: ") and message in result.stderr and len(result.stderr.splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_forced_system_refuses_a_method_without_forces_naming_those_with(tmp_path):
+    """rattle-6 has no forced version: the refusal names the ordinary names that take forces
+    (rattle-2, rattle-4) besides the forced methods."""
+    (tmp_path / "damped.toml").write_text(DAMPED)
+    path = _scene(tmp_path, '[system]\nfile = "damped.toml"\n', 'q = { th = 0.3 }', 'method = "rattle-6"\ndt = 0.01\nt_end = 0.1',
+                  'grid = { s = [0.0, 1.0, 2] }\nreductions = ["final"]')
+    result = _cli(path, tmp_path / "out")
+    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1, result.stderr
+    assert result.stderr.startswith("error: [run] method = 'rattle-6' is not available for a forced system")
+    assert "'rattle-2', 'rattle-4', 'forced-rattle-2'" in result.stderr
     assert not (tmp_path / "out").exists()
 
 
