@@ -367,6 +367,11 @@ def parse_ensemble_scene(data: dict, base_dir: Path | str = ".", path: str | Non
     )
 
     source = path or ""
+    if "forces" in data or "impulses" in data:
+        raise InputError(f"{source + ': ' if source else ''}a rigid-body ensemble runs the free body; a body driven by a "
+                         "torque or angular impulses runs as a heavy top without weight: write [system] name = "
+                         "\"heavy_top\" with mass_gravity = 0 and the heavy-top ensemble keys (see "
+                         "docs/ensembles_general.md, \"A driven top\")")
     reject_unknown_keys(data, set(_SECTION_KEYS), "the ensemble scene", source, kind="section")
     system = _section(data, "system", required=True, source=source)
     initial = _section(data, "initial", required=False, source=source)

@@ -499,3 +499,28 @@ def _refused(path, out, message):
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith("error: ") and message in result.stderr and len(result.stderr.splitlines()) == 1
     assert not out.exists()
+
+
+def test_a_driven_free_body_runs_as_a_heavy_top_without_weight(tmp_path):
+    """A rigid-body ensemble scene with [forces] is refused with the way out: a heavy top with
+    mass_gravity = 0. That scene's members equal single driven RigidBodyProblem runs in M to
+    the last bit (the same torque kick with a zero weight vector, around the same free step)."""
+    from dirac.flows import integrate
+    from dirac.flows.problems import RigidBodyProblem
+
+    rigid = tmp_path / "rigid.toml"
+    rigid.write_text('[system]\nname = "rigid_body"\ninertia = [1.0, 2.0, 3.0]\n\n[forces]\n'
+                     'torque = ["0", "0", "-0.1*Omega_3"]\n\n[initial]\nM = [0.1, 1.0, 0.1]\n\n[run]\n'
+                     'method = "lie-poisson-4"\ndt = 0.01\nt_end = 1.0\n\n[ensemble]\ncount = 4\nreductions = ["flip_time"]\n')
+    _refused(rigid, tmp_path / "out", 'write [system] name = "heavy_top" with mass_gravity = 0')
+    top = tmp_path / "top.toml"
+    top.write_text('[system]\nname = "heavy_top"\ninertia = [1.0, 2.0, 3.0]\nmass_gravity = 0.0\n\n[forces]\n'
+                   'torque = ["0", "0", "-0.1*Omega_3"]\n\n[initial]\nM = [0.1, "m2", 0.1]\n\n[run]\n'
+                   'method = "lie-poisson-4"\ndt = 0.01\nt_end = 1.0\nsamples = 3\n\n[ensemble]\n'
+                   'grid = { m2 = [0.5, 1.5, 3] }\nreductions = ["final"]\n')
+    assert run_ensemble(top, tmp_path / "top").complete
+    stored = _arrays(tmp_path / "top")
+    for i, m2 in enumerate(stored["m2"]):
+        problem = RigidBodyProblem([1.0, 2.0, 3.0], [0.1, float(m2), 0.1], torque=["0", "0", "-0.1*Omega_3"])
+        single = integrate(problem, "lie-poisson-4", t_end=1.0, dt=0.01, samples=3, outputs=["M"])
+        assert np.array_equal(single.outputs["M"][-1], stored["final_M"][i])
