@@ -42,6 +42,7 @@ from sympy.polys.matrices.sdm import SDM
 from sympy.polys.rings import PolyRing
 
 from dirac.analysis.core.numeric import Numerics
+from dirac.analysis.legendre.basis_pursuit import least_l1
 from dirac.errors import AnalysisError
 
 __all__ = ["PolynomialKernel", "polynomial_kernel"]
@@ -286,12 +287,11 @@ def _unit_denominator(
     tangent to ``chi = 0`` (``J_chi B = 0`` there), which removes multiples of the null
     vectors that would otherwise hide in ``H_c`` (for (228) it gives the paper's
     ``M = -eps (R^{-1} p)`` (233) and ``d(R^T R)/dt = 0`` without multipliers). Found by
-    basis pursuit (least ``l1`` norm, which favours sparse combinations) on the values at
+    basis pursuit (least ``l1`` norm, which favours sparse combinations;
+    :func:`~dirac.analysis.legendre.basis_pursuit.least_l1`) on the values at
     ``points``; the coefficients are made rational and the constancy is checked again at
     the fresh points ``check``. ``None`` when there is no such combination.
     """
-    from scipy.optimize import linprog  # scipy.optimize costs ~0.3 s to import: only when needed
-
     m = len(solutions)
     if not m:
         return None
@@ -322,10 +322,9 @@ def _unit_denominator(
     A_eq, b_eq = U[:, :r].T @ D, U[:, :r].T @ target
     if np.max(np.abs(target - U[:, :r] @ b_eq)) > 1e-9:
         return None  # target not in the range of D: no combination is constant on chi = 0
-    lp = linprog(np.ones(2 * m), A_eq=np.hstack([A_eq, -A_eq]), b_eq=b_eq, bounds=(0, None), method="highs")
-    if lp.status != 0:
+    full = least_l1(A_eq, b_eq)
+    if full is None:
         return None
-    full = lp.x[:m] - lp.x[m:]
     support = [int(i) for i in np.nonzero(np.abs(full) > 1e-9 * max(1.0, np.max(np.abs(full))))[0]]
     coeff = np.linalg.lstsq(D[:, support], target, rcond=None)[0]
     big = np.max(np.abs(coeff))
