@@ -276,6 +276,31 @@ def _tidy_by_term(work: sympy.Expr, variables: Sequence[sympy.Symbol], others: S
     return sympy.Add(*terms)
 
 
+def _reduced_product(work: sympy.Expr, gens: Mapping, ring: PolyRing) -> tuple[Any, Any] | None:
+    """``(p, q)``, the reduced fraction ``work = p / q`` of a product of polynomials and negative powers of polynomials.
+
+    The same pair as the fraction field gives (``FracField`` reduces after every
+    operation; its elements are the unique representatives ``p / q`` with ``p, q`` of
+    integer coefficients without a common factor, content included, and the leading
+    coefficient of ``q`` positive, which :meth:`PolyElement.cancel` also returns), with one
+    ``gcd`` at the end instead of one per operation: a multiplier of (78), a long sum over
+    one polynomial denominator, is reduced in a fraction of the time. ``None`` for any
+    other shape (a sum of fractions), left to the field.
+    """
+    numer, denom = ring.one, ring.one
+    try:
+        for factor in sympy.Mul.make_args(work):
+            if factor.is_Pow and factor.exp.is_Integer and factor.exp < 0:
+                denom *= ring_value(factor.base, gens, ring) ** int(-factor.exp)
+            else:
+                numer *= ring_value(factor, gens, ring)
+    except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+        return None
+    if not denom:
+        return None  # a division by zero: the field raises it
+    return numer.cancel(denom)
+
+
 #: sums of more terms than this are expanded term by term (:func:`_tidy_by_term`)
 PIECEWISE_TERMS = 64
 
@@ -312,15 +337,18 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
     except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
         if not rational:  # rational normal forms need gcds: too slow for large expressions
             return expr
-        field = FracField(gens_all, sympy.QQ)
-        fgens = dict(zip(gens_all, field.gens))
-        try:
-            value = ring_value(work, fgens, field, invert=lambda base: field(1) / base)
-        except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
-            out = sympy.cancel(expr)
-            return -out if sign and out.could_extract_minus_sign() else out
-        num = _poly_to_expr(value.numer, variables, others, back)
-        den = _poly_to_expr(value.denom, variables, others, back)
+        reduced = _reduced_product(work, gens, ring)
+        if reduced is None:
+            field = FracField(gens_all, sympy.QQ)
+            fgens = dict(zip(gens_all, field.gens))
+            try:
+                value = ring_value(work, fgens, field, invert=lambda base: field(1) / base)
+            except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+                out = sympy.cancel(expr)
+                return -out if sign and out.could_extract_minus_sign() else out
+            reduced = value.numer, value.denom
+        num = _poly_to_expr(reduced[0], variables, others, back)
+        den = _poly_to_expr(reduced[1], variables, others, back)
         if den.could_extract_minus_sign():
             num, den = -num, -den
         out = num / sympy.factor(den) if den != 1 else num

@@ -42,6 +42,7 @@ from sympy.polys.matrices.sdm import SDM
 from sympy.polys.rings import PolyRing
 
 from dirac.analysis.core.numeric import Numerics
+from dirac.analysis.legendre.basis_pursuit import least_l1
 from dirac.errors import AnalysisError
 
 __all__ = ["PolynomialKernel", "polynomial_kernel"]
@@ -135,13 +136,21 @@ def _ansatz(entries, q, domain, degree: int, columns: int, scaled_identity: bool
                                 add(("diagonal", i2, shifted), u, -value)
     rows = {r: {u: v for u, v in row.items() if v} for r, row in rows.items()}
     null = DomainMatrix.from_rep(SDM(rows, (len(equations), nunk), domain)).nullspace().to_sdm()
+    powers: dict[int, sympy.Expr] = {}  # the monomials met, built once
     out = []
     for s in range(null.shape[0]):
-        X = sympy.zeros(n, columns)
+        # the terms of each entry gathered, then summed once: the same canonical sums as
+        # adding them one by one (their monomials differ), without re-flattening a growing sum
+        terms: dict[tuple[int, int], list[sympy.Expr]] = {}
         for u, value in null.get(s, {}).items():
             jc, mi = divmod(u, len(monos))
-            j, c = divmod(jc, columns)
-            X[j, c] += domain.to_sympy(value) * sympy.Mul(*[v**e for v, e in zip(q, monos[mi])])
+            power = powers.get(mi)
+            if power is None:
+                power = powers[mi] = sympy.Mul(*[v**e for v, e in zip(q, monos[mi])])
+            terms.setdefault(divmod(jc, columns), []).append(domain.to_sympy(value) * power)
+        X = sympy.zeros(n, columns)
+        for (j, c), parts in terms.items():
+            X[j, c] = sympy.Add(*parts)
         out.append(X)
     return out
 
@@ -206,7 +215,7 @@ def polynomial_kernel(
         matrices = _ansatz(entries, q, domain, degree, k, scaled_identity=True)
         if matrices is None:
             return None
-        solutions = [(B, sympy.expand((A[0, :] * B[:, 0])[0, 0])) for B in matrices]
+        solutions = [(B, _first_diagonal(A, B, entries, ring)) for B in matrices]
         if lowest is None and any(d != 0 for _, d in solutions):
             lowest = (degree, [(B, d) for B, d in solutions if d != 0])
         if lowest is not None and holonomic:
@@ -224,6 +233,23 @@ def polynomial_kernel(
     if lowest is None:
         return None
     return PolynomialKernel(null_basis, lowest[1], (null_degree, lowest[0]))
+
+
+def _first_diagonal(A: sympy.Matrix, B: sympy.Matrix, entries, ring: PolyRing) -> sympy.Expr:
+    """``d = (A B)_00``, expanded: the scale of ``A B = d 1``.
+
+    Over ``QQ`` (no parameters in ``A``) the product is taken in the polynomial ring and
+    turned back into the expanded sum, the same expression as ``sympy.expand`` of the
+    symbolic product (an expanded polynomial is canonical) at a fraction of the cost, for
+    the hundreds of candidates of (228); with parameters, by ``sympy.expand``.
+    """
+    if ring.domain != sympy.QQ:
+        return sympy.expand((A[0, :] * B[:, 0])[0, 0])
+    total = ring.zero
+    for j, a in enumerate(entries[0]):
+        if a and B[j, 0] != 0:
+            total += a * ring(B[j, 0])
+    return total.as_expr()
 
 
 def _independent_vectors(vectors: list[list[sympy.Expr]], q, numerics: Numerics, wanted: int) -> list[list[sympy.Expr]] | None:
@@ -286,12 +312,11 @@ def _unit_denominator(
     tangent to ``chi = 0`` (``J_chi B = 0`` there), which removes multiples of the null
     vectors that would otherwise hide in ``H_c`` (for (228) it gives the paper's
     ``M = -eps (R^{-1} p)`` (233) and ``d(R^T R)/dt = 0`` without multipliers). Found by
-    basis pursuit (least ``l1`` norm, which favours sparse combinations) on the values at
+    basis pursuit (least ``l1`` norm, which favours sparse combinations;
+    :func:`~dirac.analysis.legendre.basis_pursuit.least_l1`) on the values at
     ``points``; the coefficients are made rational and the constancy is checked again at
     the fresh points ``check``. ``None`` when there is no such combination.
     """
-    from scipy.optimize import linprog  # scipy.optimize costs ~0.3 s to import: only when needed
-
     m = len(solutions)
     if not m:
         return None
@@ -322,10 +347,9 @@ def _unit_denominator(
     A_eq, b_eq = U[:, :r].T @ D, U[:, :r].T @ target
     if np.max(np.abs(target - U[:, :r] @ b_eq)) > 1e-9:
         return None  # target not in the range of D: no combination is constant on chi = 0
-    lp = linprog(np.ones(2 * m), A_eq=np.hstack([A_eq, -A_eq]), b_eq=b_eq, bounds=(0, None), method="highs")
-    if lp.status != 0:
+    full = least_l1(A_eq, b_eq)
+    if full is None:
         return None
-    full = lp.x[:m] - lp.x[m:]
     support = [int(i) for i in np.nonzero(np.abs(full) > 1e-9 * max(1.0, np.max(np.abs(full))))[0]]
     coeff = np.linalg.lstsq(D[:, support], target, rcond=None)[0]
     big = np.max(np.abs(coeff))

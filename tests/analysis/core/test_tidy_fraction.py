@@ -1,0 +1,69 @@
+"""``tidy`` of a product over polynomial denominators: one reduction at the end, the field's fraction.
+
+Hand derivations:
+
+* ``(x**2 - y**2) / (x - y) = x + y`` (the difference of squares), a polynomial again.
+* ``(2 x) / (4 y) = x / (2 y)``: integer contents cancel too, the denominator keeps the
+  positive leading coefficient.
+* ``3 x / (2 y / 3) = 9 x / (2 y)``: a rational coefficient in the denominator moves up.
+* ``(x + 1) / (-(x + 1) * y) = -1 / y``: the sign goes to the numerator.
+* ``a x / ((b - a) (x**2 + y**2))`` with parameters ``a, b``: nothing cancels; the
+  parameter factor ``1 / (b - a)`` stays a coefficient, as the field road gives it.
+
+Each is also compared with the fraction-field road (``FracField``, which reduces after
+every operation; its elements are the unique reduced fractions).
+"""
+
+from __future__ import annotations
+
+import sympy
+from sympy.polys.fields import FracField
+
+from dirac.analysis.core.algebra import _reduced_product, ring_value, tidy
+
+x, y, a, b = sympy.symbols("x y a b")
+
+
+def _field_pair(expr: sympy.Expr, gens: list[sympy.Symbol]):
+    field = FracField(gens, sympy.QQ)
+    value = ring_value(expr, dict(zip(gens, field.gens)), field, invert=lambda base: field(1) / base)
+    return value.numer, value.denom
+
+
+def test_reduced_product_is_the_fields_fraction() -> None:
+    from sympy.polys.rings import PolyRing
+
+    gens = [x, y]
+    ring = PolyRing(gens, sympy.QQ)
+    cases = [
+        (x**2 - y**2) / (x - y),
+        2 * x / (4 * y),
+        3 * x / (sympy.Rational(2, 3) * y),
+        (x + 1) / (-(x + 1) * y),
+        (x**3 + 2 * x * y) / (x**2 * (y + 1) ** 2),
+    ]
+    for expr in cases:
+        mine = _reduced_product(expr, dict(zip(gens, ring.gens)), ring)
+        assert mine is not None
+        assert mine == _field_pair(expr, gens)
+
+
+def test_tidy_by_hand() -> None:
+    assert tidy((x**2 - y**2) / (x - y), [x, y]) == x + y
+    assert tidy(2 * x / (4 * y), [x, y]) == x / (2 * y)
+    assert tidy(3 * x / (sympy.Rational(2, 3) * y), [x, y]) == 9 * x / (2 * y)
+    assert tidy((x + 1) / (-(x + 1) * y), [x, y]) == -1 / y
+    expr = a * x / ((b - a) * (x**2 + y**2))
+    out = tidy(expr, [x, y])
+    assert sympy.simplify(out - expr) == 0
+    assert str(out) == "a*x/((-a + b)*(x**2 + y**2))"
+
+
+def test_a_sum_of_fractions_is_left_to_the_field() -> None:
+    from sympy.polys.rings import PolyRing
+
+    gens = [x, y]
+    ring = PolyRing(gens, sympy.QQ)
+    expr = x / y + y / x
+    assert _reduced_product(expr, dict(zip(gens, ring.gens)), ring) is None
+    assert tidy(expr, [x, y]) == (x**2 + y**2) / (x * y)
