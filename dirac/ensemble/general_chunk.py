@@ -142,6 +142,11 @@ def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = N
     InputError
         Naming the first offending member, its ensemble variables and the fix.
     """
+    if scene.analysed:  # the Dirac flow of the system's analysis: its own initial states
+        from dirac.ensemble.analysed_members import check_analysed_states
+
+        check_analysed_states(scene)
+        return
     compiled = compiled_ensemble(scene)
     m = compiled.mechanics.n_constraints
     keep = scene.project and m > 0 and chunk_size is not None and (
@@ -184,11 +189,17 @@ def forget_projected(scene: GeneralEnsembleScene) -> None:
 def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                           values: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Integrate members ``start .. stop-1`` and return their arrays (:meth:`GeneralEnsembleScene.array_layout`)."""
-    compiled = compiled_ensemble(scene)
     if values is None:
         values = scene.source.members(start, stop)
-    projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
-    Q, P, C = initial_states(scene, compiled, values, projected)
+    if scene.analysed:  # the Dirac flow of the system's analysis (dirac.ensemble.analysed_members)
+        from dirac.ensemble.analysed_members import analysed_initial_states, compiled_analysed
+
+        compiled = compiled_analysed(scene)
+        Q, P, C = analysed_initial_states(scene, compiled, values, start)
+    else:
+        compiled = compiled_ensemble(scene)
+        projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
+        Q, P, C = initial_states(scene, compiled, values, projected)
     count, n = Q.shape
     starts, ends, per_interval, dt = step_grid(scene)
     n_cross, n_ext, n_poin, k_max = compiled.module.ENS_SHAPES
@@ -218,8 +229,9 @@ def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                     compiled.module.ens_member(i, *arguments)
                 except ZeroDivisionError:
                     STATUS[i] = 3.0
-    return member_results(scene, values, compiled.layout, CROSS, EXT, {"t": PT, "q": PQ, "p": PP},
-                          {"final_q": Q, "final_p": P}, EERR, CERR, STATUS, STEPS)
+    k = len(scene.coordinate_names)  # an analysed system's state also holds its multipliers: not stored
+    return member_results(scene, values, compiled.layout, CROSS, EXT, {"t": PT, "q": PQ[..., :k], "p": PP[..., :k]},
+                          {"final_q": Q[:, :k], "final_p": P[:, :k]}, EERR, CERR, STATUS, STEPS)
 
 
 def member_results(scene: GeneralEnsembleScene, values: np.ndarray, layout: dict, CROSS: np.ndarray, EXT: np.ndarray,
