@@ -42,9 +42,10 @@ from dirac.ensemble.general_kernel import CompiledEnsemble
 from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian
 from dirac.errors import InputError
 
-__all__ = ["needs_analysis", "compiled_analysed", "analysed_initial_states", "check_analysed_states"]
+__all__ = ["needs_analysis", "analysed_system", "compiled_analysed", "analysed_initial_states", "check_analysed_states"]
 
 _CACHE: dict[str, CompiledEnsemble] = {}
+_SYSTEMS: dict[str, Any] = {}
 
 
 def needs_analysis(lagrangian: Any) -> bool:
@@ -77,16 +78,28 @@ def compiled_analysed(scene: GeneralEnsembleScene) -> CompiledEnsemble:
     return _CACHE[key]
 
 
+def analysed_system(scene: GeneralEnsembleScene) -> Any:
+    """The :class:`~dirac.flows.analysed.AnalysedSystem` of ``scene``, made as a single run
+    makes it (:meth:`AnalysedSystem.from_lagrangian` with the scene's parameter values; once
+    per process)."""
+    from dirac.flows.analysed import AnalysedSystem
+
+    key = scene.fingerprint()
+    if key not in _SYSTEMS:
+        lagrangian = load_lagrangian(scene.system, scene.base_dir)
+        _SYSTEMS[key] = AnalysedSystem.from_lagrangian(lagrangian, {k: float(v) for k, v in scene.parameters.items()})
+    return _SYSTEMS[key]
+
+
 def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
     import sympy
 
     from dirac.codegen.numba_backend import import_source
     from dirac.ensemble.general_kernel import _ensemble_source, _paste_step
     from dirac.ensemble.reduction_layout import reduction_layout
-    from dirac.flows.analysed import AnalysedSystem
 
     lagrangian = load_lagrangian(scene.system, scene.base_dir)
-    analysed = AnalysedSystem.from_lagrangian(lagrangian, {k: float(v) for k, v in scene.parameters.items()})
+    analysed = analysed_system(scene)
     analysis = analysed.analysis
     z = list(analysis.phase_space)
     half = len(z) // 2
@@ -170,13 +183,14 @@ def velocity(q, p, t, c, v, work, piv):
 '''
 
 
-def analysed_initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray,
+def analysed_initial_states(scene: GeneralEnsembleScene, analysed: Any, values: np.ndarray,
                             first: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(Q, P, C)`` of members with the ensemble variables ``values`` (rows): the two halves
     of each member's ``z``, completed on the constraint surface by
     :meth:`AnalysedSystem.initial_state` from its ``q`` and ``q_dot`` (or ``p``), as a single
     scene does, and checked there as :class:`~dirac.flows.analysed.AnalysedProblem` checks
-    it (``max |Phi| <= 1e-8 (1 + |z|^2)``); ``C`` the module's parameter rows. ``first`` is
+    it (``max |Phi| <= 1e-8 (1 + |z|^2)``); ``C`` the module's parameter rows. ``analysed``
+    is the scene's :func:`analysed_system`. ``first`` is
     the number of the first of these members (for messages).
 
     Raises
@@ -191,7 +205,6 @@ def analysed_initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsem
     from dirac.flows.analysed import AnalysedProblem
     from dirac.model.expressions import parse_expression
 
-    analysed = compiled.mechanics
     count = values.shape[0]
     names = scene.source.names
     symbols = {name: sympy.Symbol(name, real=True) for name in names}
@@ -228,8 +241,8 @@ def analysed_initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsem
 def check_analysed_states(scene: GeneralEnsembleScene) -> None:
     """Refuse, before anything is written, a member whose initial state a single scene
     refuses (:func:`analysed_initial_states`)."""
-    compiled = compiled_analysed(scene)
+    analysed = analysed_system(scene)  # nothing compiled yet: a refusal is quick
     block = 65536
     for start in range(0, scene.count, block):
         stop = min(scene.count, start + block)
-        analysed_initial_states(scene, compiled, scene.source.members(start, stop), start)
+        analysed_initial_states(scene, analysed, scene.source.members(start, stop), start)

@@ -195,7 +195,7 @@ def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
         from dirac.ensemble.analysed_members import analysed_initial_states, compiled_analysed
 
         compiled = compiled_analysed(scene)
-        Q, P, C = analysed_initial_states(scene, compiled, values, start)
+        Q, P, C = analysed_initial_states(scene, compiled.mechanics, values, start)
     else:
         compiled = compiled_ensemble(scene)
         projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
