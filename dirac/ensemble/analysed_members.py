@@ -40,32 +40,13 @@ import numpy as np
 
 from dirac.ensemble.general_kernel import CompiledEnsemble
 from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian
+from dirac.ensemble.member_values import evaluate, member_label
 from dirac.errors import InputError
 
-__all__ = ["needs_analysis", "analysed_system", "compiled_analysed", "analysed_initial_states", "check_analysed_states"]
+__all__ = ["analysed_system", "compiled_analysed", "analysed_initial_states", "check_analysed_states"]
 
 _CACHE: dict[str, CompiledEnsemble] = {}
 _SYSTEMS: dict[str, Any] = {}
-
-
-def needs_analysis(lagrangian: Any) -> bool:
-    """Whether a single run integrates ``lagrangian`` on the Dirac flow of its analysis:
-    the form ``1/2 q_dot^T M(q) q_dot - V(q)`` that :class:`dirac.flows.mechanics.MechanicalSystem`
-    takes fails (a kinetic term not quadratic in the velocities, or terms linear in them).
-
-    The same two tests as :meth:`MechanicalSystem.from_lagrangian` makes before it refuses
-    with :class:`~dirac.flows.mechanics.NotMechanicalError`, without generating its kernels.
-    """
-    import sympy
-
-    from dirac.flows.mechanics import _split_by_velocities
-
-    velocities = list(lagrangian.velocities)
-    hessian, gradient_at_rest, _ = _split_by_velocities(sympy.expand(lagrangian.expression), velocities)
-    if any(entry.free_symbols & set(velocities) for entry in hessian):
-        return True
-    at_rest = {s: 0 for s in velocities}
-    return any(term != 0 and sympy.simplify(term.subs(at_rest)) != 0 for term in gradient_at_rest)
 
 
 def compiled_analysed(scene: GeneralEnsembleScene) -> CompiledEnsemble:
@@ -201,7 +182,6 @@ def analysed_initial_states(scene: GeneralEnsembleScene, analysed: Any, values: 
     """
     import sympy
 
-    from dirac.ensemble.general_chunk import _evaluate, _where
     from dirac.flows.analysed import AnalysedProblem
     from dirac.model.expressions import parse_expression
 
@@ -211,7 +191,7 @@ def analysed_initial_states(scene: GeneralEnsembleScene, analysed: Any, values: 
 
     def column(value: float | str, where: str) -> np.ndarray:
         if isinstance(value, str):
-            return _evaluate(parse_expression(value, symbols, what=where), names, values)
+            return evaluate(parse_expression(value, symbols, what=where), names, values)
         return np.full(count, float(value))
 
     coordinates = scene.coordinate_names
@@ -220,7 +200,7 @@ def analysed_initial_states(scene: GeneralEnsembleScene, analysed: Any, values: 
                              for n in coordinates])
     Z = np.empty((count, analysed.dimension))
     for i in range(count):
-        where = f"member {first + i} ({_where(names, values[i])})"
+        where = f"member {first + i} ({member_label(names, values[i])})"
         if not (np.all(np.isfinite(q[i])) and np.all(np.isfinite(rates[i]))):
             raise InputError(f"the initial state of {where} is not finite; check the expressions in [initial]")
         given = dict(zip(coordinates, q[i].tolist()))

@@ -11,15 +11,15 @@ reductions are NaN; the others complete.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
-from typing import Any
 
 import numpy as np
 
 from dirac.ensemble.general_kernel import CompiledEnsemble, compiled_ensemble
 from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
+from dirac.ensemble.member_values import evaluate as _evaluate
+from dirac.ensemble.member_values import member_label as _where
 from dirac.errors import InputError
 
 __all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_results", "step_grid"]
@@ -45,26 +45,6 @@ def step_grid(scene: GeneralEnsembleScene) -> tuple[np.ndarray, np.ndarray, int,
     spacing = float(times[1] - times[0])
     per_interval = max(1, int(math.ceil(spacing / scene.dt_requested * (1.0 - 1e-12))))
     return np.ascontiguousarray(times[:-1]), np.ascontiguousarray(times[1:]), per_interval, spacing / per_interval
-
-
-def _evaluate(expression: object, variables: tuple[str, ...], values: np.ndarray) -> np.ndarray:
-    """An expression (sympy, or a number) of the ensemble variables at each member's values."""
-    import sympy
-
-    if not isinstance(expression, sympy.Basic):
-        return np.full(values.shape[0], float(expression))  # type: ignore[arg-type]
-    function = _numpy_function(expression, variables)
-    result = function(*(values[:, k] for k in range(len(variables))))
-    return np.broadcast_to(np.asarray(result, dtype=float), (values.shape[0],)).copy()
-
-
-@functools.lru_cache(maxsize=256)
-def _numpy_function(expression: Any, variables: tuple[str, ...]) -> Any:
-    """``expression`` of the ensemble variables as a numpy function (made once per process:
-    ``sympy.lambdify`` takes milliseconds, and every chunk evaluates the same expressions)."""
-    import sympy
-
-    return sympy.lambdify([sympy.Symbol(name, real=True) for name in variables], expression, "numpy")
 
 
 def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray,
@@ -121,10 +101,6 @@ def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, valu
     return np.ascontiguousarray(Q), np.ascontiguousarray(P), np.ascontiguousarray(C)
 
 
-def _where(names: tuple[str, ...], row: np.ndarray) -> str:
-    return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
-
-
 def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = None) -> None:
     """Refuse, before anything is written, members whose initial state is off the constraint
     surface (with ``project = false``), or not finite, or cannot be projected (``project = true``).
@@ -156,6 +132,11 @@ def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = N
         stop = min(scene.count, start + block)
         values = scene.source.members(start, stop)
         Q, P, C = initial_states(scene, compiled, values)
+        if start == 0 and stop > 0:  # a mass matrix a single run refuses (singular, as an einbein's): refused too
+            try:
+                dataclasses.replace(compiled.mechanics, params=C[0].copy(), constant_mass=None).mass_matrix(Q[0])
+            except InputError as exc:
+                raise InputError(f"member 0 ({_where(scene.source.names, values[0])}): {exc}") from None
         if keep:
             _PROJECTED[(scene.fingerprint(), start, stop)] = (Q, P)
         if scene.project or m == 0:

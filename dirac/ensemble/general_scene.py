@@ -70,7 +70,7 @@ from dirac.io.scene import reject_unknown_keys, scene_number
 from dirac.validate import unknown_name_error
 
 __all__ = ["GeneralEnsembleScene", "HeavyTopEnsembleScene", "ReductionSpec", "parse_general_scene", "is_general_scene",
-           "REDUCTION_KINDS", "heavy_top_names"]
+           "REDUCTION_KINDS", "heavy_top_names", "needs_analysis"]
 
 #: Reduction kinds and the keys each takes besides ``kind`` and ``name``.
 REDUCTION_KINDS: dict[str, set[str]] = {
@@ -482,13 +482,31 @@ def _state_names(lagrangian: Any) -> dict[str, Any]:
     return names
 
 
+def needs_analysis(lagrangian: Any) -> bool:
+    """Whether a single run integrates ``lagrangian`` on the Dirac flow of its analysis:
+    the form ``1/2 q_dot^T M(q) q_dot - V(q)`` that :class:`dirac.flows.mechanics.MechanicalSystem`
+    takes fails (a kinetic term not quadratic in the velocities, or terms linear in them).
+
+    The same two tests as :meth:`MechanicalSystem.from_lagrangian` makes before it refuses
+    with :class:`~dirac.flows.mechanics.NotMechanicalError`, without generating its kernels.
+    """
+    import sympy
+
+    from dirac.flows.mechanics import _split_by_velocities
+
+    velocities = list(lagrangian.velocities)
+    hessian, gradient_at_rest, _ = _split_by_velocities(sympy.expand(lagrangian.expression), velocities)
+    if any(entry.free_symbols & set(velocities) for entry in hessian):
+        return True
+    at_rest = {s: 0 for s in velocities}
+    return any(term != 0 and sympy.simplify(term.subs(at_rest)) != 0 for term in gradient_at_rest)
+
+
 def _analysed_system(lagrangian: Any, forced: bool, parameters: dict, project: bool) -> bool:
     """Whether the members run on the Dirac flow of the system's analysis, as a single run of
     it does (a Lagrangian not of the form ``1/2 q_dot^T M(q) q_dot - V(q)``:
-    :func:`dirac.ensemble.analysed_members.needs_analysis`); refuses what such an ensemble
+    :func:`needs_analysis`); refuses what such an ensemble
     cannot take, with the message of a single scene where it refuses the same."""
-    from dirac.ensemble.analysed_members import needs_analysis
-
     if not needs_analysis(lagrangian):
         return False
     if forced:  # the words of a single scene (dirac.io.scene)

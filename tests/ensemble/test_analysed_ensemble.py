@@ -174,7 +174,7 @@ def test_parameters_varying_over_an_analysed_ensemble_are_refused(tmp_path):
 
 def test_needs_analysis_agrees_with_the_mechanical_form():
     """The scene's test is the one that makes MechanicalSystem refuse a Lagrangian."""
-    from dirac.ensemble.analysed_members import needs_analysis
+    from dirac.ensemble.general_scene import needs_analysis
     from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
     from dirac.model.system_file import lagrangian_from_table
     from dirac.model.systems import load_system
@@ -193,3 +193,17 @@ def test_needs_analysis_agrees_with_the_mechanical_form():
             refused = True
         assert needs_analysis(lagrangian) == refused, lagrangian.name
     assert needs_analysis(velocity_linear) and needs_analysis(load_system("gauge_system"))
+
+
+def test_a_system_a_single_run_refuses_is_refused_with_its_message(tmp_path):
+    """The einbein form of the relativistic particle, L = x_dot^2/(2e) - e m^2/2, is quadratic in
+    the velocities without e_dot: its mass matrix diag(-1/e, 1/e, 1/e, 1/e, 0) is singular, and a
+    single run refuses it (the mass matrix is singular or not positive); so does the ensemble,
+    before anything is written, instead of failing every member."""
+    path = _scene(tmp_path, '[system]\nname = "relativistic_particle"\n',
+                  'q = { t = 0.0, x = 0.0, y = 0.0, z = 0.0, e = 1.0 }\nq_dot = { t = 1.2, x = "a" }',
+                  "dt = 0.01\nt_end = 0.1", 'grid = { a = [0.1, 0.5, 2] }\nreductions = ["final"]')
+    result = _cli(path, tmp_path / "out")
+    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
+    assert "the mass matrix of 'relativistic_particle' is singular or not positive" in result.stderr
+    assert not (tmp_path / "out").exists()
