@@ -28,7 +28,7 @@ adapters give it what it asks of a mechanical system:
 A member's state equals a single run's of the same initial state to the last bit (the
 same compiled arithmetic, at the same times ``t_k + j dt``). Initial states are completed
 on the constraint surface member by member by :meth:`AnalysedSystem.initial_state`, as a
-single scene completes its one.
+single scene completes its one (from a fixed start of its solve).
 """
 
 from __future__ import annotations
@@ -170,7 +170,9 @@ def analysed_initial_states(scene: GeneralEnsembleScene, analysed: Any, values: 
     of each member's ``z``, completed on the constraint surface by
     :meth:`AnalysedSystem.initial_state` from its ``q`` and ``q_dot`` (or ``p``), as a single
     scene does, and checked there as :class:`~dirac.flows.analysed.AnalysedProblem` checks
-    it (``max |Phi| <= 1e-8 (1 + |z|^2)``); ``C`` the module's parameter rows. ``analysed``
+    it (``max |Phi| <= 1e-8 (1 + |z|^2)``); the values it solves for (multipliers) from the
+    same start for every member and in every process (``seed = 0``), so that they do not
+    depend on where a chunk runs. ``C`` is the module's parameter rows, ``analysed``
     is the scene's :func:`analysed_system`. ``first`` is
     the number of the first of these members (for messages).
 
@@ -207,9 +209,9 @@ def analysed_initial_states(scene: GeneralEnsembleScene, analysed: Any, values: 
         other = dict(zip(coordinates, rates[i].tolist()))
         try:
             if scene.rate_kind == "p":
-                Z[i] = analysed.initial_state(given, p=other)
+                Z[i] = analysed.initial_state(given, p=other, seed=0)
             else:
-                Z[i] = analysed.initial_state(given, q_dot=other)
+                Z[i] = analysed.initial_state(given, q_dot=other, seed=0)
             AnalysedProblem(analysed, Z[i])
         except InputError as exc:
             raise InputError(f"[initial] of {where}: {exc}") from None

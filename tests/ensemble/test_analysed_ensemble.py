@@ -207,3 +207,48 @@ def test_a_system_a_single_run_refuses_is_refused_with_its_message(tmp_path):
     assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
     assert "the mass matrix of 'relativistic_particle' is singular or not positive" in result.stderr
     assert not (tmp_path / "out").exists()
+
+
+#: A velocity-linear pair (x, y) and a particle on the unit circle z^2 + w^2 = 1 in the potential
+#: z^2/2: the analysis adds the multiplier lambda_1 (and p_lambda_1) to the phase space.
+RING = """[system]
+name = "ring"
+coordinates = ["x", "y", "z", "w"]
+lagrangian = "x*y_dot - (x**2 + y**2)/2 + z_dot**2/2 + w_dot**2/2 - z**2/2"
+constraints = ["z**2 + w**2 - 1"]
+"""
+
+
+def test_multipliers_are_completed_the_same_everywhere_and_members_equal_single_runs(tmp_path):
+    """The multiplier lambda_1 is solved from a random start by surface_point: without a fixed
+    start its last bits differ from call to call (and so between a local and a dask run). The
+    ensemble completes every member from the same start (seed 0): two completions are equal to
+    the bit, a member equals the single run from that state, and the stored final state holds
+    the Lagrangian's coordinates x, y, z, w and their momenta only."""
+    from dirac.ensemble.analysed_members import analysed_initial_states, analysed_system
+    from dirac.ensemble.scene import load_ensemble_scene
+    from dirac.flows import AnalysedProblem, integrate
+    from dirac.model.systems import load_system
+
+    (tmp_path / "ring.toml").write_text(RING)
+    path = _scene(tmp_path, '[system]\nfile = "ring.toml"\n',
+                  'q = { x = 1.0, y = 0.0, z = "cos(a)", w = "sin(a)" }\nq_dot = { z = "-sin(a)", w = "cos(a)" }',
+                  "dt = 0.01\nt_end = 0.5\nsamples = 6",
+                  'grid = { a = [0.3, 1.2, 3] }\nreductions = ["final", "constraint_error"]')
+    scene = load_ensemble_scene(path)
+    analysed = analysed_system(scene)
+    assert analysed.variable_names[4] == "lambda_1" and analysed.dimension == 10
+    values = scene.source.members(0, 3)
+    first, second = analysed_initial_states(scene, analysed, values), analysed_initial_states(scene, analysed, values)
+    assert all(np.array_equal(u, v) for u, v in zip(first, second))
+    assert run_ensemble(path, tmp_path / "out").complete
+    stored = _arrays(tmp_path / "out")
+    assert stored["final_q"].shape == (3, 4) and stored["final_p"].shape == (3, 4)
+    assert np.all(stored["constraint_error"] <= 1e-10) and np.all(stored["failures"] == 0)
+    single_system = type(analysed).from_lagrangian(load_system(tmp_path / "ring.toml"))
+    for i, a in enumerate(stored["a"]):
+        z0 = single_system.initial_state({"x": 1.0, "y": 0.0, "z": np.cos(a), "w": np.sin(a)},
+                                         q_dot={"x": 0.0, "y": 0.0, "z": -np.sin(a), "w": np.cos(a)}, seed=0)
+        single = integrate(AnalysedProblem(single_system, z0), "midpoint", t_end=0.5, dt=0.01, samples=6, outputs=["z"])
+        assert np.array_equal(single.outputs["z"][-1][:4], stored["final_q"][i])
+        assert np.array_equal(single.outputs["z"][-1][5:9], stored["final_p"][i])
