@@ -46,6 +46,12 @@ Expressions of reductions use the coordinates, their velocities ``<q>_dot``, mom
 crossings found) stops early when the scene asks for nothing that needs the rest of the
 run (``max``, ``min``, ``final``, ``energy_error``, ``constraint_error``).
 
+A Lagrangian that is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (:func:`needs_analysis`: terms
+linear in the velocities, gauge systems) runs, as in a single run, on the Dirac flow of its
+analysis with ``midpoint`` (``analysed = True``; :mod:`dirac.ensemble.analysed_members`);
+its parameters are fixed numbers and its initial state is completed on the surface, not
+projected.
+
 ``[system] name = "heavy_top"`` is read by :func:`parse_heavy_top_scene` into a
 :class:`HeavyTopEnsembleScene` (the keys of a single heavy-top scene, each entry a number or
 an expression of the ensemble variables; reductions in the names of :func:`heavy_top_names`),
