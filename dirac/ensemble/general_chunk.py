@@ -118,10 +118,10 @@ def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = N
     InputError
         Naming the first offending member, its ensemble variables and the fix.
     """
-    if scene.analysed:  # the Dirac flow of the system's analysis: its own initial states
+    if scene.analysed:  # the Dirac flow of the system's analysis: its own initial states (kept as projected ones)
         from dirac.ensemble.analysed_members import check_analysed_states
 
-        check_analysed_states(scene)
+        check_analysed_states(scene, chunk_size, _PROJECTED if chunk_size is not None else None, _PROJECTED_LIMIT)
         return
     compiled = compiled_ensemble(scene)
     m = compiled.mechanics.n_constraints
@@ -176,7 +176,8 @@ def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
         from dirac.ensemble.analysed_members import analysed_initial_states, compiled_analysed
 
         compiled = compiled_analysed(scene)
-        Q, P, C = analysed_initial_states(scene, compiled.mechanics, values, start)
+        completed = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
+        Q, P, C = analysed_initial_states(scene, compiled.mechanics, values, start, completed)
     else:
         compiled = compiled_ensemble(scene)
         projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)

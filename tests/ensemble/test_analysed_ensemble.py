@@ -275,3 +275,32 @@ def test_ring_identical_local_dask_and_resumed(tmp_path):
     report = run_ensemble(path, out)
     assert report.complete and report.chunks_computed == 1
     assert np.array_equal(_arrays(out)["final_q"], reference["final_q"])
+
+
+def test_members_are_completed_once_with_the_same_bits(tmp_path, monkeypatch):
+    """A local run completes each member's initial state once (the check before anything is
+    written keeps the states for the chunks, as projected ones are), and stores the same bits as
+    chunks that complete them again (as a dask worker or a resumed run does)."""
+    from dirac.ensemble.general_chunk import _PROJECTED, compute_general_chunk
+    from dirac.ensemble.scene import load_ensemble_scene
+    from dirac.flows.analysed import AnalysedSystem
+
+    calls = []
+    complete = AnalysedSystem.initial_state
+
+    def counted(self, *args, **kwargs):
+        calls.append(1)
+        return complete(self, *args, **kwargs)
+
+    monkeypatch.setattr(AnalysedSystem, "initial_state", counted)
+    path = _scene(tmp_path, VELOCITY_LINEAR, 'q = { x = "A", y = 0.0, z = "A/2" }', "dt = 0.01\nt_end = 0.3",
+                  'grid = { A = [0.5, 2.0, 5] }\nchunk_size = 2\nreductions = ["final"]')
+    assert run_ensemble(path, tmp_path / "out").complete
+    assert len(calls) == 5 and not _PROJECTED
+    stored = _arrays(tmp_path / "out")
+    scene = load_ensemble_scene(path)
+    for start, stop in ((0, 2), (2, 4), (4, 5)):
+        again = compute_general_chunk(scene, start, stop)
+        for name in ("final_q", "final_p"):
+            assert np.array_equal(again[name], stored[name][start:stop])
+    assert len(calls) == 10
