@@ -20,6 +20,9 @@ Modules, one job each:
 - :mod:`dirac.ensemble.general_scene` -- scenes of any other system, their reductions;
 - :mod:`dirac.ensemble.general_kernel` -- the system's own step batched over members (generated);
 - :mod:`dirac.ensemble.general_chunk` -- one chunk of such an ensemble;
+- :mod:`dirac.ensemble.analysed_members` -- members on the Dirac flow of an analysis (velocity-linear, gauge systems);
+- :mod:`dirac.ensemble.reduction_layout` -- the reductions' expressions and where the member loops put them;
+- :mod:`dirac.ensemble.member_values` -- expressions of the ensemble variables at the members, members' labels;
 - :mod:`dirac.ensemble.heavy_top_members` -- the heavy top's member loop (a single run's kernels, generated);
 - :mod:`dirac.ensemble.kernel_lock` -- the lock around the parallel kernels.
 

@@ -11,15 +11,16 @@ reductions are NaN; the others complete.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
-from typing import Any
 
 import numpy as np
 
 from dirac.ensemble.general_kernel import CompiledEnsemble, compiled_ensemble
 from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
+from dirac.ensemble.member_values import evaluate as _evaluate
+from dirac.ensemble.member_values import member_column
+from dirac.ensemble.member_values import member_label as _where
 from dirac.errors import InputError
 
 __all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_column", "member_results", "step_grid"]
@@ -45,40 +46,6 @@ def step_grid(scene: GeneralEnsembleScene) -> tuple[np.ndarray, np.ndarray, int,
     spacing = float(times[1] - times[0])
     per_interval = max(1, int(math.ceil(spacing / scene.dt_requested * (1.0 - 1e-12))))
     return np.ascontiguousarray(times[:-1]), np.ascontiguousarray(times[1:]), per_interval, spacing / per_interval
-
-
-def _evaluate(expression: object, variables: tuple[str, ...], values: np.ndarray) -> np.ndarray:
-    """An expression (sympy, or a number) of the ensemble variables at each member's values."""
-    import sympy
-
-    if not isinstance(expression, sympy.Basic):
-        return np.full(values.shape[0], float(expression))  # type: ignore[arg-type]
-    function = _numpy_function(expression, variables)
-    result = function(*(values[:, k] for k in range(len(variables))))
-    return np.broadcast_to(np.asarray(result, dtype=float), (values.shape[0],)).copy()
-
-
-def member_column(value: float | str, where: str, names: tuple[str, ...], values: np.ndarray) -> np.ndarray:
-    """A scene entry for every member: a number repeated, or an expression (a string, read by
-    the safe expression parser; ``where`` names the entry in its errors) of the ensemble
-    variables ``names`` at each member's ``values`` (rows)."""
-    import sympy
-
-    from dirac.model.expressions import parse_expression
-
-    if isinstance(value, str):
-        symbols = {name: sympy.Symbol(name, real=True) for name in names}
-        return _evaluate(parse_expression(value, symbols, what=where), names, values)
-    return np.full(values.shape[0], float(value))
-
-
-@functools.lru_cache(maxsize=256)
-def _numpy_function(expression: Any, variables: tuple[str, ...]) -> Any:
-    """``expression`` of the ensemble variables as a numpy function (made once per process:
-    ``sympy.lambdify`` takes milliseconds, and every chunk evaluates the same expressions)."""
-    import sympy
-
-    return sympy.lambdify([sympy.Symbol(name, real=True) for name in variables], expression, "numpy")
 
 
 def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray,
@@ -128,10 +95,6 @@ def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, valu
     return np.ascontiguousarray(Q), np.ascontiguousarray(P), np.ascontiguousarray(C)
 
 
-def _where(names: tuple[str, ...], row: np.ndarray) -> str:
-    return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
-
-
 def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = None) -> None:
     """Refuse, before anything is written, members whose initial state is off the constraint
     surface (with ``project = false``), or not finite, or cannot be projected (``project = true``).
@@ -149,6 +112,11 @@ def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = N
     InputError
         Naming the first offending member, its ensemble variables and the fix.
     """
+    if scene.analysed:  # the Dirac flow of the system's analysis: its own initial states (kept as projected ones)
+        from dirac.ensemble.analysed_members import check_analysed_states
+
+        check_analysed_states(scene, chunk_size, _PROJECTED if chunk_size is not None else None, _PROJECTED_LIMIT)
+        return
     compiled = compiled_ensemble(scene)
     m = compiled.mechanics.n_constraints
     keep = scene.project and m > 0 and chunk_size is not None and (
@@ -158,6 +126,11 @@ def check_initial_states(scene: GeneralEnsembleScene, chunk_size: int | None = N
         stop = min(scene.count, start + block)
         values = scene.source.members(start, stop)
         Q, P, C = initial_states(scene, compiled, values)
+        if start == 0 and stop > 0:  # a mass matrix a single run refuses (singular, as an einbein's): refused too
+            try:
+                dataclasses.replace(compiled.mechanics, params=C[0].copy(), constant_mass=None).mass_matrix(Q[0])
+            except InputError as exc:
+                raise InputError(f"member 0 ({_where(scene.source.names, values[0])}): {exc}") from None
         if keep:
             _PROJECTED[(scene.fingerprint(), start, stop)] = (Q, P)
         if scene.project or m == 0:
@@ -191,11 +164,18 @@ def forget_projected(scene: GeneralEnsembleScene) -> None:
 def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                           values: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Integrate members ``start .. stop-1`` and return their arrays (:meth:`GeneralEnsembleScene.array_layout`)."""
-    compiled = compiled_ensemble(scene)
     if values is None:
         values = scene.source.members(start, stop)
-    projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
-    Q, P, C = initial_states(scene, compiled, values, projected)
+    if scene.analysed:  # the Dirac flow of the system's analysis (dirac.ensemble.analysed_members)
+        from dirac.ensemble.analysed_members import analysed_initial_states, compiled_analysed
+
+        compiled = compiled_analysed(scene)
+        completed = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
+        Q, P, C = analysed_initial_states(scene, compiled.mechanics, values, start, completed)
+    else:
+        compiled = compiled_ensemble(scene)
+        projected = _PROJECTED.pop((scene.fingerprint(), start, stop), None)
+        Q, P, C = initial_states(scene, compiled, values, projected)
     count, n = Q.shape
     starts, ends, per_interval, dt = step_grid(scene)
     n_cross, n_ext, n_poin, k_max = compiled.module.ENS_SHAPES
@@ -225,8 +205,9 @@ def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
                     compiled.module.ens_member(i, *arguments)
                 except ZeroDivisionError:
                     STATUS[i] = 3.0
-    return member_results(scene, values, compiled.layout, CROSS, EXT, {"t": PT, "q": PQ, "p": PP},
-                          {"final_q": Q, "final_p": P}, EERR, CERR, STATUS, STEPS)
+    k = len(scene.coordinate_names)  # an analysed system's state also holds its multipliers: not stored
+    return member_results(scene, values, compiled.layout, CROSS, EXT, {"t": PT, "q": PQ[..., :k], "p": PP[..., :k]},
+                          {"final_q": Q[:, :k], "final_p": P[:, :k]}, EERR, CERR, STATUS, STEPS)
 
 
 def member_results(scene: GeneralEnsembleScene, values: np.ndarray, layout: dict, CROSS: np.ndarray, EXT: np.ndarray,

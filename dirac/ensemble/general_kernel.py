@@ -31,7 +31,7 @@ from typing import Any, cast
 import numpy as np
 
 from dirac.ensemble.crossing_source import locate_source
-from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian, split_condition
+from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian
 from dirac.errors import InputError
 
 __all__ = ["CompiledEnsemble", "compiled_ensemble", "FAILURES"]
@@ -89,6 +89,7 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
 
     from dirac.codegen.numba_backend import import_source
     from dirac.ensemble.general_scene import _state_names
+    from dirac.ensemble.reduction_layout import reduction_layout
     from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
     from dirac.flows.methods.registry import get_method
     from dirac.model.expressions import parse_expression
@@ -126,31 +127,7 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         step = f"{name}(q, p, ta, c, fractions, dt, 1, tol, max_iter, info)"
         gamma = 0.0
     state = _state_names(lagrangian)
-    exprs: list[Any] = []
-    conditions: list[tuple[Any, str]] = []
-    layout: dict[str, list] = {"cross": [], "ext": [], "poincare": []}
-    for reduction in scene.reductions:
-        parsed = [parse_expression(text, state, what=f"reduction {reduction.name}") for text in reduction.exprs]
-        if reduction.kind == "first_crossing":
-            group = []
-            for text, when in zip(parsed, reduction.whens):
-                exprs.append(text)
-                cond = -1
-                if when is not None:
-                    lhs, op, rhs = split_condition(when, reduction.name)
-                    left = parse_expression(lhs, state, what=f"reduction {reduction.name} when")
-                    right = parse_expression(rhs, state, what=f"reduction {reduction.name} when")
-                    value = left - right if op in (">", ">=") else right - left
-                    conditions.append((value, ">" if op in (">", "<") else ">="))
-                    cond = len(conditions) - 1
-                group.append((len(exprs) - 1, cond))
-            layout["cross"].append((reduction.name, group))
-        elif reduction.kind in ("max", "min"):
-            exprs.append(parsed[0])
-            layout["ext"].append((reduction.name, reduction.kind, len(exprs) - 1))
-        elif reduction.kind == "poincare":
-            exprs.append(parsed[0])
-            layout["poincare"].append((reduction.name, len(exprs) - 1, reduction.count))
+    exprs, conditions, layout = reduction_layout(scene, state)
     kinds = {r.kind for r in scene.reductions}
     n = len(scene.coordinate_names)
     velocities = [state[f"{q}_dot"] for q in scene.coordinate_names]

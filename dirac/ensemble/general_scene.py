@@ -46,6 +46,12 @@ Expressions of reductions use the coordinates, their velocities ``<q>_dot``, mom
 crossings found) stops early when the scene asks for nothing that needs the rest of the
 run (``max``, ``min``, ``final``, ``energy_error``, ``constraint_error``).
 
+A Lagrangian that is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (:func:`needs_analysis`: terms
+linear in the velocities, gauge systems) runs, as in a single run, on the Dirac flow of its
+analysis with ``midpoint`` (``analysed = True``; :mod:`dirac.ensemble.analysed_members`);
+its parameters are fixed numbers and its initial state is completed on the surface, not
+projected.
+
 ``[system] name = "heavy_top"`` is read by :func:`parse_heavy_top_scene` into a
 :class:`HeavyTopEnsembleScene` (the keys of a single heavy-top scene, each entry a number or
 an expression of the ensemble variables; reductions in the names of :func:`heavy_top_names`),
@@ -70,7 +76,7 @@ from dirac.io.scene import reject_unknown_keys, scene_number
 from dirac.validate import unknown_name_error
 
 __all__ = ["GeneralEnsembleScene", "HeavyTopEnsembleScene", "ReductionSpec", "parse_general_scene", "is_general_scene",
-           "REDUCTION_KINDS", "heavy_top_names"]
+           "REDUCTION_KINDS", "heavy_top_names", "needs_analysis"]
 
 #: Reduction kinds and the keys each takes besides ``kind`` and ``name``.
 REDUCTION_KINDS: dict[str, set[str]] = {
@@ -172,6 +178,7 @@ class GeneralEnsembleScene:
     path: str | None = None
     outputs: tuple[str, ...] = field(default=())
     system_digest: str = ""
+    analysed: bool = False
 
     general = True
 
@@ -223,6 +230,8 @@ class GeneralEnsembleScene:
             "newton_tolerance": self.newton_tolerance,
             "max_newton_iterations": self.max_newton_iterations,
             "reductions": [r.describe() for r in self.reductions],
+            # only when set: the fingerprints of stores written before analysed systems stay
+            **({"analysed": True} if self.analysed else {}),
         }
 
     def fingerprint(self) -> str:
@@ -400,7 +409,8 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
         raise InputError(f"[initial] project = {project!r} must be true or false")
 
     forced = bool(lagrangian.is_forced)
-    method, order = _method(run, forced)
+    analysed = _analysed_system(lagrangian, forced, parameters, project)
+    method, order = _method(run, forced, analysed)
     if "dt" not in run:
         raise InputError("[run] needs 'dt' (the fixed step)")
     dt = scene_number(run["dt"], "[run] dt", positive=True)
@@ -459,6 +469,7 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
         order=order, dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end, samples=samples,
         steps_per_sample=steps_per_sample, reductions=reductions, newton_tolerance=tolerance,
         max_newton_iterations=iterations, chunk_size=chunk_size, path=path, system_digest=digest,
+        analysed=analysed,
     )
 
 
@@ -477,7 +488,54 @@ def _state_names(lagrangian: Any) -> dict[str, Any]:
     return names
 
 
-def _method(run: dict, forced: bool) -> tuple[str, int]:
+def needs_analysis(lagrangian: Any) -> bool:
+    """Whether a single run integrates ``lagrangian`` on the Dirac flow of its analysis:
+    the form ``1/2 q_dot^T M(q) q_dot - V(q)`` that :class:`dirac.flows.mechanics.MechanicalSystem`
+    takes fails (a kinetic term not quadratic in the velocities, or terms linear in them).
+
+    The same two tests as :meth:`MechanicalSystem.from_lagrangian` makes before it refuses
+    with :class:`~dirac.flows.mechanics.NotMechanicalError`, without generating its kernels.
+    """
+    import sympy
+
+    from dirac.flows.mechanics import _split_by_velocities
+
+    velocities = list(lagrangian.velocities)
+    hessian, gradient_at_rest, _ = _split_by_velocities(sympy.expand(lagrangian.expression), velocities)
+    if any(entry.free_symbols & set(velocities) for entry in hessian):
+        return True
+    at_rest = {s: 0 for s in velocities}
+    return any(term != 0 and sympy.simplify(term.subs(at_rest)) != 0 for term in gradient_at_rest)
+
+
+def _analysed_system(lagrangian: Any, forced: bool, parameters: dict, project: bool) -> bool:
+    """Whether the members run on the Dirac flow of the system's analysis, as a single run of
+    it does (a Lagrangian not of the form ``1/2 q_dot^T M(q) q_dot - V(q)``:
+    :func:`needs_analysis`); refuses what such an ensemble
+    cannot take, with the message of a single scene where it refuses the same."""
+    if not needs_analysis(lagrangian):
+        return False
+    if forced:  # the words of a single scene (dirac.io.scene)
+        from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
+
+        try:
+            MechanicalSystem.from_lagrangian(lagrangian, {k: 1.0 for k in parameters}, with_forces=True)
+        except NotMechanicalError as exc:
+            raise InputError("forces and impulses are integrated for L = 1/2 q_dot^T M(q) q_dot - V(q) only; "
+                             f"{exc}".replace('; use method = "midpoint" on the Dirac flow instead', "")) from None
+    varying = [key for key, value in parameters.items() if isinstance(value, str)]
+    if varying:
+        raise InputError(f"[system] parameters {', '.join(varying)} of {lagrangian.name!r} vary over the ensemble, but "
+                         "this system runs on the Dirac flow of its analysis, which is made with its parameters "
+                         "fixed (as in a single run); give them numbers, and run one ensemble per value")
+    if project:
+        raise InputError(f"[initial] project = true: {lagrangian.name!r} runs on the Dirac flow of its analysis, whose "
+                         "initial state is completed on the constraint surface from q and q_dot (or p), as in a single "
+                         "run; set project = false and give values on the surface")
+    return True
+
+
+def _method(run: dict, forced: bool, analysed: bool = False) -> tuple[str, int]:
     """The step method of a member and its order. On a forced system the ordinary names
     ``rattle-2`` and ``rattle-4`` run as ``forced-rattle-2`` and ``forced-rattle-4``, as
     :func:`dirac.flows.integrate` runs them on a forced problem (the same stepper)."""
@@ -485,7 +543,7 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
     from dirac.flows.methods.registry import get_method
 
     usable = ["forced-rattle-2", "forced-rattle-4", "conformal-2", "conformal-4"] if forced else \
-        ["rattle-2", "rattle-4", "rattle-6", "rattle-8", "midpoint"]
+        ["midpoint"] if analysed else ["rattle-2", "rattle-4", "rattle-6", "rattle-8", "midpoint"]
     name = run.get("method", "auto")
     if name == "auto":
         name = usable[0]
@@ -493,6 +551,10 @@ def _method(run: dict, forced: bool) -> tuple[str, int]:
         name = FORCED_VERSIONS[name]
     if name not in usable:
         kind = "a forced system" if forced else "an ensemble of this system"
+        if analysed:
+            raise InputError(f"[run] method = {name!r} is not available for an ensemble of this system: it runs on the "
+                             "Dirac flow of its analysis (not L = 1/2 q_dot^T M(q) q_dot - V(q)), which ensembles "
+                             "integrate with 'midpoint'; choose 'auto' or 'midpoint'")
         names = [*FORCED_VERSIONS, *usable] if forced else usable
         raise InputError(f"[run] method = {name!r} is not available for {kind}; choose 'auto' or one of {names}")
     return str(name), int(get_method(name).order)

@@ -170,10 +170,11 @@ class AnalysedSystem:
         return out
 
     def initial_state(self, q: dict[str, float], q_dot: dict[str, float] | None = None,
-                      p: dict[str, float] | None = None) -> np.ndarray:
+                      p: dict[str, float] | None = None, seed: int | None = None) -> np.ndarray:
         """A point of the constraint surface with the given coordinates and velocities
         (``p = dL/dq_dot``) or momenta; the multipliers and the rest are completed by
-        :meth:`ConstraintAnalysis.surface_point`.
+        :meth:`ConstraintAnalysis.surface_point` (from a random start: ``seed`` fixes it,
+        and with it the last bits of the completed values).
 
         Raises
         ------
@@ -190,7 +191,7 @@ class AnalysedSystem:
             values.update({f"p_{n}": float(m) for n, m in zip(names, momenta)})
         elif p is not None:
             values.update({f"p_{n}": float(v) for n, v in p.items()})
-        point = self.analysis.surface_point(values)
+        point = self.analysis.surface_point(values, seed=seed)
         return np.array([point[n] for n in self.variable_names])
 
 
