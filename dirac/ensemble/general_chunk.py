@@ -18,12 +18,11 @@ import numpy as np
 from dirac.ensemble.general_kernel import CompiledEnsemble, compiled_ensemble
 from dirac.ensemble.general_scene import GeneralEnsembleScene
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
-from dirac.ensemble.member_values import evaluate as _evaluate
 from dirac.ensemble.member_values import member_column
 from dirac.ensemble.member_values import member_label as _where
 from dirac.errors import InputError
 
-__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_column", "member_results", "step_grid"]
+__all__ = ["check_initial_states", "compute_general_chunk", "forget_projected", "initial_states", "member_results", "step_grid"]
 
 #: Members whose initial states are checked at once by :func:`check_initial_states`.
 _CHECK_BLOCK = 65536

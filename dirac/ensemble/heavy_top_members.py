@@ -37,9 +37,11 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from dirac.ensemble.crossing_source import locate_source
-from dirac.ensemble.general_chunk import member_column, member_results, step_grid
+from dirac.ensemble.general_chunk import member_results, step_grid
 from dirac.ensemble.general_scene import HeavyTopEnsembleScene, heavy_top_names, split_condition
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
+from dirac.ensemble.member_values import member_column
+from dirac.ensemble.member_values import member_label as _where
 from dirac.errors import InputError, warn
 
 __all__ = ["CompiledTop", "compiled_heavy_top", "check_heavy_top_states", "heavy_top_initial_states",
@@ -357,9 +359,6 @@ HT_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
 ''')
     return "\n".join(lines) + "\n"
 
-
-def _where(names: tuple[str, ...], row: np.ndarray) -> str:
-    return ", ".join(f"{name} = {value:.17g}" for name, value in zip(names, row))
 
 
 def _undriven_steps(w: Any, exact: bool) -> None:
