@@ -360,7 +360,6 @@ HT_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
     return "\n".join(lines) + "\n"
 
 
-
 def _undriven_steps(w: Any, exact: bool) -> None:
     """The steps of one call of a single undriven run, its half kicks merged (module docstring)."""
     call, free = (("exact_kick_advance(M, R, a, w, gammas, dt, n, p, em, en)", "free_flow_step(M, R, a, gammas[j] * dt, p, em, en)")
