@@ -5,9 +5,12 @@ instead while a child process compiles the kernel into numba's on-disk cache; th
 switches to the compiled form at the next step boundary after the child is done
 (:meth:`dirac.codegen.tiers.TieredFunction.run_steps`). The child is
 
-    python -m dirac.codegen.background MODULE.py FUNCTION SIGNATURE.json CHARS
+    python -c BOOTSTRAP .../dirac/codegen/background.py MODULE.py FUNCTION SIGNATURE.json CHARS
 
-It imports the generated module file (the same file, under the same name, as the
+(this file run by its path, not as ``dirac.codegen.background``: importing the package would
+import sympy and the analysis, about 0.6 s of CPU that the child does not need before
+numba even starts; the child imports numpy, numba and the generated module alone). It
+imports the generated module file (the same file, under the same name, as the
 parent, so numba's cache index is the one the parent reads), compiles ``FUNCTION`` for
 the argument types the parent described (:func:`describe`: the parent does not import
 numba while the cache is cold), writes the compile time to the history below and the
@@ -79,9 +82,9 @@ def _history_path() -> Path:
     return cache_directory() / HISTORY_FILE
 
 
-def _read_history() -> list[dict[str, Any]]:
+def _read_history(path: Path | None = None) -> list[dict[str, Any]]:
     try:
-        entries = json.loads(_history_path().read_text(encoding="utf-8"))
+        entries = json.loads((path or _history_path()).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return []
     if not isinstance(entries, list):
@@ -90,13 +93,14 @@ def _read_history() -> list[dict[str, Any]]:
             and isinstance(e.get("seconds"), (int, float)) and e["chars"] > 0]
 
 
-def record_compile_seconds(chars: int, seconds: float, what: str) -> None:
+def record_compile_seconds(chars: int, seconds: float, what: str, history: Path | None = None) -> None:
     """Append one measured compilation (``seconds`` for ``chars`` characters of source) to
-    the history in the cache directory (the last 64 are kept; a failure to write is ignored:
+    the history in the cache directory, or to the file ``history`` (the child, which does not
+    import the engine to find the cache; the last 64 are kept; a failure to write is ignored:
     the history only informs estimates)."""
     try:
-        path = _history_path()
-        entries = _read_history()[-(_KEEP - 1):]
+        path = history or _history_path()
+        entries = _read_history(path)[-(_KEEP - 1):]
         entries.append({"chars": int(chars), "seconds": round(float(seconds), 4), "what": what[:80]})
         temporary = path.with_suffix(f".{os.getpid()}.tmp")
         temporary.write_text(json.dumps(entries), encoding="utf-8")
@@ -126,7 +130,7 @@ class BackgroundCompile:
         self.signature_file = Path(signature_file)
         self.started = time.perf_counter()
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "dirac.codegen.background", str(path), name, signature_file, str(chars)],
+            [sys.executable, "-c", _BOOTSTRAP, __file__, str(path), name, signature_file, str(chars)],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     def poll(self) -> bool | None:
@@ -184,7 +188,16 @@ def mark_ready(marker: Path) -> None:
         return
 
 
+#: the child's first line: run this file by its path as ``__main__`` with nothing of the caller's
+#: folder on ``sys.path`` (``python FILE`` would put this file's folder first, where its
+#: siblings could shadow modules numba imports)
+_BOOTSTRAP = "import runpy, sys; del sys.path[0]; runpy.run_path(sys.argv[1], run_name='__main__')"
+
+
 def _main(argv: list[str]) -> int:
+    """The child: compile function ``name`` of the generated module at ``path`` for the types
+    in ``signature_file`` into numba's cache, record its CPU seconds in the history of the
+    module's folder (the cache directory) and write its ready marker."""
     import importlib.util
 
     path, name, signature_file, chars = argv
@@ -199,10 +212,12 @@ def _main(argv: list[str]) -> int:
     spec.loader.exec_module(module)
     start = time.process_time()
     getattr(module, name).compile(signature)
-    record_compile_seconds(int(chars), time.process_time() - start, f"{name} (background)")
+    record_compile_seconds(int(chars), time.process_time() - start, f"{name} (background)",
+                           Path(path).parent / HISTORY_FILE)
     mark_ready(Path(path).with_name(f"{module_name}.{name}.ready"))
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(_main(sys.argv[1:]))
+    # run by _BOOTSTRAP: sys.argv is ["-c", this file, MODULE.py, FUNCTION, SIGNATURE.json, CHARS]
+    sys.exit(_main(sys.argv[2:]))

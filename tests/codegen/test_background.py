@@ -1,0 +1,48 @@
+"""The background compiler child: it compiles into numba's cache without importing the engine."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from dirac.codegen import background
+from dirac.codegen.numba_backend import ready_marker
+
+_SOURCE = '''"""step -- generated for a test of the background child"""
+import math
+import numpy as np
+import numba
+
+
+@numba.njit(cache=True)
+def run(x, n_steps):
+    """n_steps of x <- x + sin(x) / 8."""
+    for _ in range(n_steps):
+        x[0] = x[0] + math.sin(x[0]) / 8.0
+'''
+
+
+def test_the_child_compiles_into_the_cache_without_importing_sympy_or_the_engine(tmp_path, monkeypatch) -> None:
+    """The child is started by BackgroundCompile with a ``sympy`` on its path that fails on
+    import (the engine imports sympy, so importing ``dirac`` would fail too): it still
+    compiles the function, writes its ready marker and records its compile time in the
+    history next to the module (the cache folder). Before, it ran as
+    ``python -m dirac.codegen.background``, which imports the package and with it sympy
+    (about 0.6 s of CPU before numba even started), and failed here."""
+    poisoned = tmp_path / "poisoned"
+    poisoned.mkdir()
+    (poisoned / "sympy.py").write_text("raise ImportError('the background child imported sympy')\n")
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    module = cache / "dirac_gen_background_child_test.py"
+    module.write_text(_SOURCE)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba"))
+    monkeypatch.setenv("PYTHONPATH", str(poisoned) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    child = background.BackgroundCompile(module, "run", (np.zeros(1), 3), 123)
+    assert child.wait(timeout=600) is True
+    assert ready_marker(module, "run").exists()
+    history = json.loads((cache / background.HISTORY_FILE).read_text())
+    assert [entry["chars"] for entry in history] == [123] and "background" in history[0]["what"]
+    assert list((tmp_path / "numba").rglob("*.nbi")), "no numba cache index written"
