@@ -43,6 +43,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from math import factorial
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy
@@ -51,6 +52,9 @@ from sympy.polys.matrices import DomainMatrix
 from dirac.analysis.core.algebra import printed, prints_shorter
 from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.errors import AnalysisError
+
+if TYPE_CHECKING:
+    from dirac.analysis.core.gram_proof import GramVerdict
 
 __all__ = [
     "Division", "SingularLocus", "Unsearched", "Undecided", "too_long_to_search", "structural_divisors", "value_on_surface", "denominator_factors", "singular_loci",
@@ -802,6 +806,7 @@ def singular_loci(
     undecided: list[Undecided] | None = None,
     regular_at: Callable[[np.ndarray], bool] | None = None,
     budget: float = STRUCTURAL_BUDGET,
+    gram: Callable[[sympy.Expr], GramVerdict | None] | None = None,
 ) -> tuple[SingularLocus, ...]:
     """The divisions whose divisor vanishes somewhere on the surface ``surface = 0``, as :class:`SingularLocus`.
 
@@ -818,7 +823,10 @@ def singular_loci(
     (:data:`PIVOT_SINGULAR`); otherwise its ``what`` says that a numerator may cancel
     (:data:`AS_WRITTEN`). No point found is no proof: such a divisor goes to
     ``undecided`` (:class:`Undecided`), unless it is a short divisor that
-    :func:`sum_of_squares_on_surface` proves nonzero; so do the divisors read off trees left
+    :func:`sum_of_squares_on_surface` proves nonzero, or ``gram`` (when given: a
+    :class:`~dirac.analysis.core.gram_proof.GramProver`, whose :class:`GramVerdict` reason is added
+    when it recognised the divisor) proves a principal minor of ``J W J^T`` positive on the surface by
+    the Cauchy–Binet formula; so do the divisors read off trees left
     when ``budget`` CPU seconds of these decisions, or ``STRUCTURAL_SEARCHES`` searches, have
     run out.
     """
@@ -860,11 +868,12 @@ def singular_loci(
         try:
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:
-            if undecided is not None:
-                if d.structural:
-                    undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND))
-                elif not sum_of_squares_on_surface(d.divisor, surface, variables, memo):
-                    undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND, FACTOR_ORIGIN))
+            if undecided is not None and (d.structural or not sum_of_squares_on_surface(d.divisor, surface, variables, memo)):
+                verdict = gram(d.divisor) if gram is not None else None
+                if verdict is not None and verdict.proven:
+                    continue  # its numerator is a Gram minor, positive on the surface by Cauchy-Binet: no locus
+                reason = NOT_FOUND + (f"; {verdict.reason}" if verdict is not None and verdict.reason else "")
+                undecided.append(Undecided(d.divisor, d.stage, d.what, reason, *(() if d.structural else (FACTOR_ORIGIN,))))
             continue  # no point found: proven nonzero, or said not ruled out
         what = d.what
         if d.structural:

@@ -1,0 +1,280 @@
+"""Proofs that Gram-type divisors never vanish on the constraint surface (Cauchy–Binet).
+
+With holonomic constraints ``chi_a(q) = 0`` and a kinetic energy quadratic in the
+momenta, ``H_c = 1/2 p^T W p + V(q)`` with a constant ``W`` (the inverse mass matrix), the
+consistency conditions of the fourth stage fix the multipliers through the Gram matrix
+
+    G = J W J^T,      J_ai = d chi_a / d q_i
+
+(Sect. X, (210)-(215): ``{Phi_a, p_lambda_b} = d Phi_a/d lambda_b`` is ``G``). Eliminating
+the multipliers divides by its pivots, ratios ``D_k / D_(k-1)`` of its principal minors:
+the Cartesian double pendulum's multiplier solution divides by the Schur complement
+``G_22 - G_12^2 / G_11``, whose numerator is ``det G``. The principal minor of the rows
+``K`` is a sum of squares by the Cauchy–Binet formula (e.g. Horn & Johnson, *Matrix
+Analysis*, 2nd ed., Sect. 0.8.7; for ``k = 2`` and ``W = 1`` Lagrange's identity):
+
+    det(J_K W J_K^T) = sum_{|S| = k} det(J_KS)^2 prod_{s in S} w_s
+
+for a diagonal ``W = diag(w)``; a constant symmetric ``W = L D L^T`` is brought to that
+form with ``J L`` and ``D``. When every weight product ``prod w_S`` is positive (numbers,
+or parameters declared ``positive=True``) each term is ``>= 0``; the terms that share a
+weight product are grouped, and when one group's sum of squares is a nonzero constant on
+the surface (each factor of it an exact identity ``c + sum a_i phi_i``,
+:func:`~dirac.analysis.core.divisors.constant_on_surface`), the minor is at least that
+group times its weight: it never vanishes on the surface. The double pendulum's
+``det G = 16/m1^2 (r1 x d)^2 + 16 (x1^2 + y1^2)(dx^2 + dy^2)/(m1 m2)`` (``d = r2 - r1``) is
+at least ``16 l1^2 l2^2/(m1 m2)`` there.
+
+The rule is a proof or nothing: a divisor whose numerator is no constant multiple of such
+a minor, a weight of unknown sign (a mass not declared positive), or no group constant on
+the surface leave the divisor to the other proofs and the search, with the reason
+(:class:`GramVerdict`). It runs inside a CPU-time budget (:data:`GRAM_BUDGET`).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import sympy
+
+from dirac.analysis.core.budget import CpuBudget, OverBudget
+from dirac.analysis.core.divisors import constant_on_surface, sum_of_squares_on_surface
+
+__all__ = ["GramProver", "GramVerdict", "GRAM_BUDGET"]
+
+#: CPU seconds that the Gram proofs of one analysis may take in all (past it, divisors stay not ruled out)
+GRAM_BUDGET = 1.0
+#: largest number of rows of a principal minor tried (``k`` of ``det(J_K W J_K^T)``)
+GRAM_ROWS = 4
+#: largest number of row sets ``K`` compared with one divisor
+GRAM_SUBSETS = 64
+#: largest number of Cauchy–Binet terms (column sets ``S``) expanded for one minor
+GRAM_TERMS = 2000
+
+
+@dataclass(frozen=True)
+class GramVerdict:
+    """The answer of :class:`GramProver` about one divisor.
+
+    ``proven`` is true only with a certificate; ``reason`` says why not when the divisor
+    was recognised as a Gram minor (or the budget ran out), else is empty.
+    """
+
+    proven: bool
+    reason: str = ""
+
+
+class GramProver:
+    """``divisor -> GramVerdict``: whether the divisor's numerator is a principal minor of ``J W J^T``
+    proven nonzero on the surface by the Cauchy–Binet formula (module docstring).
+
+    Parameters
+    ----------
+    holonomic
+        The constraints of the surface that depend on the ``coordinates`` alone (the rows of ``J``).
+    coordinates
+        The coordinates conjugate to the momenta of ``W`` (the columns of ``J``).
+    weights
+        ``W`` (``n x n``, constant on phase space, symmetric): ``d^2 H_c / dp^2``.
+    surface, variables
+        All constraints of the surface, and the phase-space variables.
+    budget
+        CPU seconds for all calls together (:data:`GRAM_BUDGET`).
+    """
+
+    def __init__(
+        self, holonomic: Sequence[sympy.Expr], coordinates: Sequence[sympy.Symbol], weights: sympy.Matrix,
+        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float = GRAM_BUDGET,
+    ) -> None:
+        self.holonomic = list(holonomic)
+        self.coordinates = list(coordinates)
+        self.surface = list(surface)
+        self.variables = list(variables)
+        self.budget = CpuBudget(budget)
+        self._memo: dict = {}
+        self._jacobian: sympy.Matrix | None = None
+        self._diagonal: list[sympy.Expr] | None = None
+        self._weights = weights
+        self._answers: dict[sympy.Expr, GramVerdict | None] = {}
+
+    @classmethod
+    def from_hamiltonian(
+        cls, hamiltonian: sympy.Expr, coordinates: Sequence[sympy.Symbol], momenta: Sequence[sympy.Symbol],
+        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float = GRAM_BUDGET,
+    ) -> GramProver | None:
+        """The prover for ``H_c`` and the surface, or None when there is no Gram structure to use: no
+        constraint in the coordinates alone, or ``d^2 H_c / dp^2`` not constant on phase space."""
+        names = set(variables)
+        own = set(coordinates)
+        holonomic = [c for c in surface if (c.free_symbols & names) and (c.free_symbols & names) <= own]
+        if not holonomic or not momenta:
+            return None
+        used = [k for k, p in enumerate(momenta) if hamiltonian.has(p)]
+        if not used:
+            return None
+        ps = [momenta[k] for k in used]
+        try:
+            W = sympy.hessian(hamiltonian, ps)
+        except (TypeError, ValueError):
+            return None
+        if any(entry.free_symbols & names for entry in W) or W != W.T:
+            return None
+        return cls(holonomic, [coordinates[k] for k in used], W, surface, variables, budget)
+
+    @classmethod
+    def on_first_use(
+        cls, hamiltonian: sympy.Expr, coordinates: Sequence[sympy.Symbol], momenta: Sequence[sympy.Symbol],
+        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float = GRAM_BUDGET,
+    ) -> Callable[[sympy.Expr], GramVerdict | None]:
+        """``divisor -> verdict`` that builds the prover (:meth:`from_hamiltonian`) on its first call: an analysis
+        whose divisors are all decided otherwise never takes the Hessian of ``H_c``."""
+        built: list[GramProver | None] = []
+
+        def prove(divisor: sympy.Expr) -> GramVerdict | None:
+            if not built:
+                built.append(cls.from_hamiltonian(hamiltonian, coordinates, momenta, surface, variables, budget))
+            prover = built[0]
+            return None if prover is None else prover(divisor)
+
+        return prove
+
+    # ------------------------------------------------------------------ the structure
+    def _factors(self) -> tuple[sympy.Matrix, list[sympy.Expr]] | None:
+        """``(J L, diag D)`` with ``W = L D L^T`` (``L = 1`` for a diagonal ``W``); None when ``W`` has no such form."""
+        if self._jacobian is None:
+            W = self._weights
+            J = sympy.Matrix([[sympy.diff(c, q) for q in self.coordinates] for c in self.holonomic])
+            if W.is_diagonal():
+                self._jacobian, self._diagonal = J, [W[i, i] for i in range(W.shape[0])]
+            else:
+                try:
+                    L, D = W.LDLdecomposition(hermitian=False)
+                except (ValueError, ZeroDivisionError):  # not positive definite in the order given: no such form
+                    return None
+                self._jacobian, self._diagonal = (J * L).applyfunc(sympy.expand), [sympy.cancel(D[i, i]) for i in range(D.shape[0])]
+        assert self._diagonal is not None
+        return self._jacobian, self._diagonal
+
+    def __call__(self, divisor: sympy.Expr) -> GramVerdict | None:
+        """The verdict on ``divisor`` (remembered), or None when it is not recognised as a Gram minor."""
+        if divisor not in self._answers:
+            if self.budget.left() <= 0:
+                return GramVerdict(False, self._out_of_budget())
+            try:
+                with self.budget.interrupting():
+                    self._answers[divisor] = self._decide(divisor)
+            except OverBudget:
+                return GramVerdict(False, self._out_of_budget())
+        return self._answers[divisor]
+
+    def _out_of_budget(self) -> str:
+        return (f"the Cauchy-Binet proof for Gram determinants was not tried: its budget ({self.budget.seconds:g} s "
+                "of CPU time) ran out")
+
+    def _decide(self, divisor: sympy.Expr) -> GramVerdict | None:
+        names = set(self.variables)
+        numerator, _ = sympy.fraction(sympy.together(divisor))
+        numerator = sympy.expand(numerator)
+        if not (numerator.free_symbols & names) or not (numerator.free_symbols & names) <= set(self.coordinates):
+            return None  # a Gram minor depends on the coordinates alone
+        factors = self._factors()
+        if factors is None:
+            return None
+        J, w = factors
+        own = sorted(numerator.free_symbols & names, key=lambda s: s.name)
+        try:
+            degree = sympy.Poly(numerator, *own).total_degree()
+        except sympy.PolynomialError:
+            return None
+        m = J.shape[0]
+        tried = 0
+        for k in range(1, min(m, GRAM_ROWS) + 1):
+            for K in itertools.combinations(range(m), k):
+                tried += 1
+                if tried > GRAM_SUBSETS:
+                    return None
+                rows = J.extract(list(K), list(range(J.shape[1])))
+                minor = self._minor(rows, w, own, degree, numerator)
+                if minor is not None:
+                    return self._certify(rows, w)
+        return None
+
+    def _minor(
+        self, rows: sympy.Matrix, w: list[sympy.Expr], own: list[sympy.Symbol], degree: int, numerator: sympy.Expr
+    ) -> sympy.Expr | None:
+        """``det(J_K W J_K^T)`` when ``numerator = c det(J_K W J_K^T)`` with ``c != 0`` free of the variables, else None."""
+        gram = rows * sympy.diag(*w) * rows.T
+        det = sympy.expand(gram.det(method="berkowitz"))
+        if det == 0:
+            return None
+        names = set(self.variables)
+        if (det.free_symbols & names) != set(own):
+            return None
+        try:
+            if sympy.Poly(det, *own).total_degree() != degree:
+                return None
+        except sympy.PolynomialError:
+            return None
+        ratio = sympy.cancel(numerator / det)
+        if ratio == 0 or ratio.free_symbols & names:
+            return None
+        return det
+
+    def _certify(self, rows: sympy.Matrix, w: list[sympy.Expr]) -> GramVerdict:
+        """Cauchy–Binet on ``det(J_K W J_K^T)``: positive weights and one group constant nonzero on the surface."""
+        k, n = rows.shape
+        columns = [s for s in range(n) if w[s] != 0]
+        if len(columns) < k:
+            return GramVerdict(False, "it is a Gram determinant det(J W J^T) with fewer positive weights than rows")
+        count = 1
+        for i in range(k):
+            count = count * (len(columns) - i) // (i + 1)
+        if count > GRAM_TERMS:
+            return GramVerdict(False, f"it is a Gram determinant det(J W J^T) of {count} Cauchy-Binet terms, more than "
+                                      f"the {GRAM_TERMS} the proof expands")
+        groups: dict[sympy.Expr, sympy.Expr] = {}
+        for S in itertools.combinations(columns, k):
+            minor = sympy.expand(rows.extract(list(range(k)), list(S)).det(method="berkowitz"))
+            if minor == 0:
+                continue
+            if minor.has(sympy.I):
+                return GramVerdict(False, "it is a Gram determinant det(J W J^T) whose Jacobian J is not real")
+            weight = sympy.Mul(*(w[s] for s in S))
+            groups[weight] = groups.get(weight, sympy.S.Zero) + minor**2
+        unknown = [weight for weight in groups if weight.is_positive is not True]
+        if unknown:
+            shown = ", ".join(str(u) for u in unknown[:4])
+            return GramVerdict(False, (
+                f"its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with weights, but "
+                f"the weights {shown} are not known to be positive (declare the parameters positive, "
+                "sympy.Symbol(name, positive=True), to have it proven)"))
+        for weight, total in sorted(groups.items(), key=lambda item: sympy.count_ops(item[1])):
+            if self._constant_nonzero(total):
+                return GramVerdict(True)
+        return GramVerdict(False, (
+            "its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with positive "
+            "weights, but no group of its terms is proven a nonzero constant on the surface"))
+
+    def _constant_nonzero(self, total: sympy.Expr) -> bool:
+        """Whether a sum of squares is a nonzero constant on the surface, factor by factor."""
+        names = set(self.variables)
+        try:
+            coefficient, listed = sympy.factor_list(sympy.expand(total))
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            return False
+        if coefficient == 0:
+            return False
+        for factor, _ in listed:
+            if not factor.free_symbols & names:
+                if factor == 0:
+                    return False
+                continue
+            value = constant_on_surface(factor, self.surface, self.variables, self._memo)
+            if value is not None and value != 0:
+                continue
+            if sum_of_squares_on_surface(factor, self.surface, self.variables, self._memo):
+                continue
+            return False
+        return True
