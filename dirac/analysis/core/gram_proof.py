@@ -250,7 +250,7 @@ class GramProver:
                 f"its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with weights, but "
                 f"the weights {shown} are not known to be positive (declare the parameters positive, "
                 "sympy.Symbol(name, positive=True), to have it proven)"))
-        for weight, total in sorted(groups.items(), key=lambda item: sympy.count_ops(item[1])):
+        for total in sorted(groups.values(), key=sympy.count_ops):
             if self._constant_nonzero(total):
                 return GramVerdict(True)
         return GramVerdict(False, (
