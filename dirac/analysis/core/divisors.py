@@ -43,7 +43,6 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from math import factorial
-from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy
@@ -53,13 +52,10 @@ from dirac.analysis.core.algebra import printed, prints_shorter
 from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.errors import AnalysisError
 
-if TYPE_CHECKING:
-    from dirac.analysis.core.gram_proof import GramVerdict
-
 __all__ = [
     "Division", "SingularLocus", "Unsearched", "Undecided", "too_long_to_search", "structural_divisors", "value_on_surface", "denominator_factors", "singular_loci",
     "constant_on_surface", "square_on_surface", "determinant_grid", "nonvanishing_on", "pfaffian",
-    "sum_of_squares_on_surface", "LEGENDRE_SINGULAR",
+    "sum_of_squares_on_surface", "GramVerdict", "LEGENDRE_SINGULAR",
     "MULTIPLIERS_SINGULAR",
 ]
 
@@ -630,6 +626,19 @@ STRUCTURAL_SEARCHES = 8
 #: ... and only those that print shorter than this (characters): the projections onto a longer one, a nested pivot
 #: of (228) of thousands of characters, cost a third of a second each and found no point there
 SEARCH_TEXT_LIMIT = 1000
+
+
+@dataclass(frozen=True)
+class GramVerdict:
+    """The answer of an optional proof rule about one divisor (:class:`~dirac.analysis.core.gram_proof.GramProver`).
+
+    ``proven`` is true only with a certificate; ``reason`` says why not when the rule
+    recognised the divisor (or ran out of its budget), else is empty: it is added to the
+    divisor's :class:`Undecided` reason.
+    """
+
+    proven: bool
+    reason: str = ""
 
 
 @dataclass(frozen=True)

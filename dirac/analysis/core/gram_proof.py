@@ -35,12 +35,11 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import sympy
 
 from dirac.analysis.core.budget import CpuBudget, OverBudget
-from dirac.analysis.core.divisors import constant_on_surface, sum_of_squares_on_surface
+from dirac.analysis.core.divisors import GramVerdict, constant_on_surface, sum_of_squares_on_surface
 
 __all__ = ["GramProver", "GramVerdict", "GRAM_BUDGET"]
 
@@ -52,18 +51,6 @@ GRAM_ROWS = 4
 GRAM_SUBSETS = 64
 #: largest number of Cauchy–Binet terms (column sets ``S``) expanded for one minor
 GRAM_TERMS = 2000
-
-
-@dataclass(frozen=True)
-class GramVerdict:
-    """The answer of :class:`GramProver` about one divisor.
-
-    ``proven`` is true only with a certificate; ``reason`` says why not when the divisor
-    was recognised as a Gram minor (or the budget ran out), else is empty.
-    """
-
-    proven: bool
-    reason: str = ""
 
 
 class GramProver:
