@@ -16,9 +16,13 @@ Analysis*, 2nd ed., Sect. 0.8.7; for ``k = 2`` and ``W = 1`` Lagrange's identity
     det(J_K W J_K^T) = sum_{|S| = k} det(J_KS)^2 prod_{s in S} w_s
 
 for a diagonal ``W = diag(w)``; a constant symmetric ``W = L D L^T`` is brought to that
-form with ``J L`` and ``D``. When every weight product ``prod w_S`` is positive (numbers,
-or parameters declared ``positive=True``) each term is ``>= 0``; the terms that share a
-weight product are grouped, and when one group's sum of squares is a nonzero constant on
+form with ``J L`` and ``D``. When the weight products ``prod w_S`` all have one sign
+(each one's ratio to the first is positive: numbers, or parameters declared
+``positive=True``; a single mass ``m`` for all coordinates gives one weight, whose sign does
+not matter) the terms that share a weight product are grouped, ``det = w_0 sum_g r_g S_g``
+with ``r_g > 0`` and sums of squares ``S_g >= 0`` (also a finer grouping: by the weights and the rows of
+``J_K`` that the columns enter, so that the terms of a chain of equal masses that take one column of each
+bob form a group of their own), and when one group's ``S_g`` is a nonzero constant on
 the surface (each factor of it an exact identity ``c + sum a_i phi_i``,
 :func:`~dirac.analysis.core.divisors.constant_on_surface`), the minor is at least that
 group times its weight: it never vanishes on the surface. The double pendulum's
@@ -44,7 +48,7 @@ from dirac.analysis.core.divisors import GramVerdict, constant_on_surface, sum_o
 __all__ = ["GramProver", "GramVerdict", "GRAM_BUDGET"]
 
 #: CPU seconds that the Gram proofs of one analysis may take in all (past it, divisors stay not ruled out)
-GRAM_BUDGET = 1.0
+GRAM_BUDGET = 2.0
 #: largest number of rows of a principal minor tried (``k`` of ``det(J_K W J_K^T)``)
 GRAM_ROWS = 4
 #: largest number of row sets ``K`` compared with one divisor
@@ -221,7 +225,11 @@ class GramProver:
         if count > GRAM_TERMS:
             return GramVerdict(False, f"it is a Gram determinant det(J W J^T) of {count} Cauchy-Binet terms, more than "
                                       f"the {GRAM_TERMS} the proof expands")
-        groups: dict[sympy.Expr, sympy.Expr] = {}
+        # a column's class: its weight and the rows of J_K it enters (the bobs of a chain of equal masses share
+        # a weight, but the terms taking one column of each bob add up to |r1|^2 |d|^2, constant on the surface)
+        kind = {s: (w[s], tuple(r for r in range(k) if rows[r, s] != 0)) for s in columns}
+        groups: dict[sympy.Expr, sympy.Expr] = {}  # weight product -> sum of its squares
+        classes: dict[tuple, sympy.Expr] = {}  # column classes -> sum of their squares (a finer grouping)
         for S in itertools.combinations(columns, k):
             minor = sympy.expand(rows.extract(list(range(k)), list(S)).det(method="berkowitz"))
             if minor == 0:
@@ -230,19 +238,35 @@ class GramProver:
                 return GramVerdict(False, "it is a Gram determinant det(J W J^T) whose Jacobian J is not real")
             weight = sympy.Mul(*(w[s] for s in S))
             groups[weight] = groups.get(weight, sympy.S.Zero) + minor**2
-        unknown = [weight for weight in groups if weight.is_positive is not True]
+            key = tuple(sorted((kind[s] for s in S), key=str))
+            classes[key] = classes.get(key, sympy.S.Zero) + minor**2
+        if not groups:
+            return GramVerdict(False, "it is a Gram determinant det(J W J^T) with no nonzero Cauchy-Binet term")
+        reference = next(iter(groups))
+        unknown = [weight for weight in groups if not _positive(sympy.cancel(weight / reference))]
         if unknown:
-            shown = ", ".join(str(u) for u in unknown[:4])
+            shown = ", ".join(str(u) for u in [reference, *unknown][:4])
             return GramVerdict(False, (
                 f"its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with weights, but "
-                f"the weights {shown} are not known to be positive (declare the parameters positive, "
+                f"the weights {shown} are not known to have one sign (declare the parameters positive, "
                 "sympy.Symbol(name, positive=True), to have it proven)"))
-        for total in sorted(groups.values(), key=sympy.count_ops):
+        # every group is a sum of squares >= 0 times a weight of one sign: one group nonzero on the surface suffices
+        candidates = dict.fromkeys([*sorted(groups.values(), key=sympy.count_ops),
+                                    *sorted(classes.values(), key=sympy.count_ops)])
+        for total in candidates:
             if self._constant_nonzero(total):
                 return GramVerdict(True)
         return GramVerdict(False, (
-            "its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with positive "
-            "weights, but no group of its terms is proven a nonzero constant on the surface"))
+            "its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with weights of one "
+            "sign, but no group of its terms is proven a nonzero constant on the surface"))
+
+    def _polynomial_surface(self) -> list[sympy.Expr]:
+        """The constraints without functions such as ``sin(w t)``: the identities ``c + sum a_i phi_i`` are sought
+        modulo these (fewer constraints, the same surface or a larger one: still a proof)."""
+        key = ("polynomial surface",)
+        if key not in self._memo:
+            self._memo[key] = [c for c in self.surface if not c.atoms(sympy.Function)]
+        return self._memo[key]
 
     def _constant_nonzero(self, total: sympy.Expr) -> bool:
         """Whether a sum of squares is a nonzero constant on the surface, factor by factor."""
@@ -258,10 +282,21 @@ class GramProver:
                 if factor == 0:
                     return False
                 continue
-            value = constant_on_surface(factor, self.surface, self.variables, self._memo)
+            surface = self._polynomial_surface()
+            value = constant_on_surface(factor, surface, self.variables, self._memo)
             if value is not None and value != 0:
                 continue
-            if sum_of_squares_on_surface(factor, self.surface, self.variables, self._memo):
+            if sum_of_squares_on_surface(factor, surface, self.variables, self._memo):
                 continue
             return False
         return True
+
+
+def _positive(expr: sympy.Expr) -> bool:
+    """Whether ``expr`` (numbers and parameters) is positive, each parameter nonzero (as the analysis reads
+    them: at generic values; a weight of ``W = d^2 H_c/dp^2`` holds it in a denominator, ``1/m``)."""
+    if expr.is_positive:
+        return True
+    nonzero = {s: sympy.Dummy(s.name, real=True, nonzero=True) for s in expr.free_symbols
+               if s.is_real and s.is_zero is None}
+    return bool(nonzero) and expr.xreplace(nonzero).is_positive is True

@@ -12,7 +12,9 @@ Hand derivations:
   ``= 16/m1^2 (x1 dy - y1 dx)^2 + 16 l1^2 l2^2/(m1 m2)`` on the surface (Lagrange's identity):
   positive for positive masses. For masses of unknown sign ``m1 m2 < 0`` lets it vanish:
   at ``m1 = 1, m2 = -1`` with ``r1`` perpendicular to ``d``, ``(x1 dy - y1 dx)^2 = l1^2 l2^2`` and
-  ``det G = 16 l1^2 l2^2 (1 - 1) = 0``; so no proof may be claimed.
+  ``det G = 16 l1^2 l2^2 (1 - 1) = 0``; so no proof may be claimed. With one mass ``m`` for both
+  bobs (``m1 = m2 = m``) ``det G = 16/m^2 ((x1 dy - y1 dx)^2 + |r1|^2 |d|^2) >= 16 l1^2 l2^2/m^2``
+  whatever the sign of ``m``: all weights are ``1/m^2``.
 * Viviani's curve, a particle of mass ``m`` on the sphere ``x^2 + y^2 + z^2 = 1`` and the
   cylinder ``x^2 + y^2 = x``, ``W = 1/m``: ``det G = |grad chi_1 x grad chi_2|^2 / m^2`` with
   ``grad chi_1 x grad chi_2 = (-4 y z, 2 z (2 x - 1), 2 y)``, zero at ``(1, 0, 0)``, a point of
@@ -63,12 +65,21 @@ def test_masses_of_unknown_sign_prove_nothing():
     assert prover is not None
     verdict = prover(schur)
     assert verdict is not None and not verdict.proven
-    assert "not known to be positive" in verdict.reason and "1/(m1*m2)" in verdict.reason
+    assert "not known to have one sign" in verdict.reason and "1/(m1*m2)" in verdict.reason
     # numbers of opposite signs: the weight 1/(m1 m2) = -1 is negative, and no proof either
     prover, schur, _ = _double_pendulum(sympy.Integer(1), sympy.Integer(-1))
     assert prover is not None
     verdict = prover(schur)
     assert verdict is not None and not verdict.proven
+
+
+def test_one_mass_of_unknown_sign_is_one_weight_and_proves():
+    """``m1 = m2 = m`` real: one weight ``1/m^2``, whose sign does not matter (module docstring)."""
+    m = sympy.Symbol("m", real=True)
+    prover, schur, _ = _double_pendulum(m, m)
+    assert prover is not None
+    verdict = prover(schur)
+    assert verdict is not None and verdict.proven
 
 
 def test_the_built_in_double_pendulum_leaves_no_division_open():
@@ -86,7 +97,7 @@ def test_the_double_pendulum_with_masses_of_unknown_sign_stays_not_ruled_out():
         parameters={"m1": 1.0, "m2": 1.0, "g": 9.81, "l1": 1.0, "l2": 1.0})
     analysis = dirac.analyze(L)
     [open_] = analysis.singular_loci_unsearched
-    assert "not ruled out" in str(open_) and "not known to be positive" in str(open_)
+    assert "not ruled out" in str(open_) and "not known to have one sign" in str(open_)
 
 
 def test_a_gram_determinant_that_vanishes_on_the_surface_is_never_proven():
