@@ -873,6 +873,10 @@ def singular_loci(
             if undecided is not None:
                 undecided.append(Undecided(d.divisor, d.stage, d.what, TOO_LONG_TO_SEARCH))
             continue
+        if gram is not None and short and not d.structural:
+            verdict = gram(d.divisor)  # before the search: a proof saves its projections (and is remembered)
+            if verdict is not None and verdict.proven:
+                continue  # its numerator is a Gram minor, positive on the surface by Cauchy-Binet: no locus
         searched += d.structural
         try:
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
