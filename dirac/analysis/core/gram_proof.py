@@ -164,6 +164,9 @@ class GramProver:
                     self._answers[divisor] = self._decide(divisor)
             except OverBudget:
                 return GramVerdict(False, self._out_of_budget())
+            except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, ValueError, TypeError,
+                    ZeroDivisionError):
+                self._answers[divisor] = None  # sympy could not take a step of the proof: no proof, nothing claimed
         return self._answers[divisor]
 
     def _out_of_budget(self) -> str:
@@ -243,6 +246,9 @@ class GramProver:
     def _certify(self, rows: sympy.Matrix, w: list[sympy.Expr]) -> GramVerdict:
         """Cauchy–Binet on ``det(J_K W J_K^T)``: positive weights and one group constant nonzero on the surface."""
         k, n = rows.shape
+        if not all(symbol.is_real for symbol in rows.free_symbols):
+            return GramVerdict(False, "it is a Gram determinant det(J W J^T) whose Jacobian J has entries not known "
+                                      "to be real (the squares det(J_KS)^2 need real entries)")
         columns = [s for s in range(n) if w[s] != 0]
         if len(columns) < k:
             return GramVerdict(False, "it is a Gram determinant det(J W J^T) with fewer positive weights than rows")
