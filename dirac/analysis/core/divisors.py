@@ -22,7 +22,10 @@ Dynamics", Sect. 4.3 on points where ranks change):
 an exact identity ``f = c + sum a_i phi_i`` with a constant ``c != 0``
 (:func:`constant_on_surface`), or ``f = c det M`` with a Gram matrix ``M^T M`` constant on
 ``S`` and of nonzero determinant, so that ``f^2`` is a nonzero constant there
-(:func:`square_on_surface`: ``det R = +-1`` on ``R^T R = 1``). Without a proof it tests the
+(:func:`square_on_surface`: ``det R = +-1`` on ``R^T R = 1``), or a numerator that is a principal
+minor of the Gram matrix ``J W J^T`` of the holonomic constraints, a sum of squares with weights
+of one sign by the Cauchy–Binet formula (:mod:`dirac.analysis.core.gram_proof`, given to
+:func:`singular_loci` by the caller). Without a proof it tests the
 divisor by sampling: a Gauss–Newton projection onto ``S`` and ``f = 0`` together
 (:meth:`~dirac.analysis.core.numeric.Numerics.surface_points`) finds a point of the
 locus, or shows none nearby in its attempts.

@@ -20,6 +20,9 @@ Hand derivations:
   ``grad chi_1 x grad chi_2 = (-4 y z, 2 z (2 x - 1), 2 y)``, zero at ``(1, 0, 0)``, a point of
   both surfaces where the curve crosses itself: the Gram determinant vanishes there and must
   not be proven nonzero.
+* A bead of mass ``m`` on a hoop of radius ``R`` turning as ``-x sin(w t) + y cos(w t) = 0``:
+  the one-row minor of the sphere ``x^2 + y^2 + z^2 = R^2`` is ``|grad chi_1|^2/m = 4 (x^2 + y^2 + z^2)/m``,
+  ``= 4 R^2/m`` on the surface whatever the turning constraint (which holds ``sin(w t)``).
 """
 
 import sympy
@@ -134,3 +137,16 @@ def test_a_divisor_that_is_no_gram_minor_is_not_recognised_and_the_budget_is_kep
     assert spent is not None
     verdict = spent(schur)
     assert verdict is not None and not verdict.proven and "budget" in verdict.reason
+
+
+def test_a_one_row_minor_beside_a_turning_constraint_is_proven():
+    """The bead on the turning hoop (module docstring): the divisor ``x^2 + y^2 + z^2`` is ``R^2`` on the surface."""
+    m, R, w, t = sympy.symbols("m R w t", real=True)
+    chi = [x**2 + y**2 + z**2 - R**2, -x * sympy.sin(w * t) + y * sympy.cos(w * t)]
+    H = (px**2 + py**2 + pz**2) / (2 * m) + m * 9 * z
+    prover = GramProver.from_hamiltonian(H, (x, y, z), (px, py, pz), chi, (x, y, z, px, py, pz))
+    assert prover is not None
+    verdict = prover(x**2 + y**2 + z**2)
+    assert verdict is not None and verdict.proven
+    verdict = prover(x**2 + y**2)  # the cylinder's |grad|^2 is no principal minor here: not recognised
+    assert verdict is None
