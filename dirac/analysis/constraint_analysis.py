@@ -36,6 +36,7 @@ from dirac.analysis.core.divisors import (
     singular_loci,
     sum_of_squares_on_surface,
 )
+from dirac.analysis.core.gram_proof import GramProver
 from dirac.analysis.core.linear_solve import SolveTooLarge
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import free_symbols_of
@@ -358,8 +359,10 @@ class ConstraintAnalysis:
         numerics = self._numerics.sharing_compiled(self._generic, seed=self._seed + 1)
         numerics.avoid = list(self._numerics.avoid)
         undecided: list[Undecided] = []
+        gram = GramProver.on_first_use(self.canonical_hamiltonian, self._space.coordinates, self._space.momenta,
+                                       surface, variables)  # Gram minors of the multiplier solution (Cauchy-Binet)
         loci = singular_loci(found, surface, numerics, variables, undecided=undecided,
-                             regular_at=self._solved_block_regular(numerics))
+                             regular_at=self._solved_block_regular(numerics), gram=gram)
         self._unsearched = (*unsearched, *undecided)
         return loci
 

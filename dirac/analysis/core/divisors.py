@@ -22,7 +22,10 @@ Dynamics", Sect. 4.3 on points where ranks change):
 an exact identity ``f = c + sum a_i phi_i`` with a constant ``c != 0``
 (:func:`constant_on_surface`), or ``f = c det M`` with a Gram matrix ``M^T M`` constant on
 ``S`` and of nonzero determinant, so that ``f^2`` is a nonzero constant there
-(:func:`square_on_surface`: ``det R = +-1`` on ``R^T R = 1``). Without a proof it tests the
+(:func:`square_on_surface`: ``det R = +-1`` on ``R^T R = 1``), or a numerator that is a principal
+minor of the Gram matrix ``J W J^T`` of the holonomic constraints, a sum of squares with weights
+of one sign by the Cauchy–Binet formula (:mod:`dirac.analysis.core.gram_proof`, given to
+:func:`singular_loci` by the caller). Without a proof it tests the
 divisor by sampling: a Gauss–Newton projection onto ``S`` and ``f = 0`` together
 (:meth:`~dirac.analysis.core.numeric.Numerics.surface_points`) finds a point of the
 locus, or shows none nearby in its attempts.
@@ -55,7 +58,7 @@ from dirac.errors import AnalysisError
 __all__ = [
     "Division", "SingularLocus", "Unsearched", "Undecided", "too_long_to_search", "structural_divisors", "value_on_surface", "denominator_factors", "singular_loci",
     "constant_on_surface", "square_on_surface", "determinant_grid", "nonvanishing_on", "pfaffian",
-    "sum_of_squares_on_surface", "LEGENDRE_SINGULAR",
+    "sum_of_squares_on_surface", "GramVerdict", "LEGENDRE_SINGULAR",
     "MULTIPLIERS_SINGULAR",
 ]
 
@@ -629,6 +632,19 @@ SEARCH_TEXT_LIMIT = 1000
 
 
 @dataclass(frozen=True)
+class GramVerdict:
+    """The answer of an optional proof rule about one divisor (:class:`~dirac.analysis.core.gram_proof.GramProver`).
+
+    ``proven`` is true only with a certificate; ``reason`` says why not when the rule
+    recognised the divisor (or ran out of its budget), else is empty: it is added to the
+    divisor's :class:`Undecided` reason.
+    """
+
+    proven: bool
+    reason: str = ""
+
+
+@dataclass(frozen=True)
 class Undecided:
     """A divisor that is neither proven nonzero on the surface nor found to vanish there
     (:func:`singular_loci`): the report says so, with the ``reason`` and the divisor's
@@ -802,6 +818,7 @@ def singular_loci(
     undecided: list[Undecided] | None = None,
     regular_at: Callable[[np.ndarray], bool] | None = None,
     budget: float = STRUCTURAL_BUDGET,
+    gram: Callable[[sympy.Expr], GramVerdict | None] | None = None,
 ) -> tuple[SingularLocus, ...]:
     """The divisions whose divisor vanishes somewhere on the surface ``surface = 0``, as :class:`SingularLocus`.
 
@@ -818,7 +835,10 @@ def singular_loci(
     (:data:`PIVOT_SINGULAR`); otherwise its ``what`` says that a numerator may cancel
     (:data:`AS_WRITTEN`). No point found is no proof: such a divisor goes to
     ``undecided`` (:class:`Undecided`), unless it is a short divisor that
-    :func:`sum_of_squares_on_surface` proves nonzero; so do the divisors read off trees left
+    :func:`sum_of_squares_on_surface` proves nonzero, or ``gram`` (when given: a
+    :class:`~dirac.analysis.core.gram_proof.GramProver`, whose :class:`GramVerdict` reason is added
+    when it recognised the divisor) proves a principal minor of ``J W J^T`` positive on the surface by
+    the Cauchy–Binet formula; so do the divisors read off trees left
     when ``budget`` CPU seconds of these decisions, or ``STRUCTURAL_SEARCHES`` searches, have
     run out.
     """
@@ -856,15 +876,20 @@ def singular_loci(
             if undecided is not None:
                 undecided.append(Undecided(d.divisor, d.stage, d.what, TOO_LONG_TO_SEARCH))
             continue
+        if gram is not None and short and not d.structural:
+            verdict = gram(d.divisor)  # before the search: a proof saves its projections (and is remembered)
+            if verdict is not None and verdict.proven:
+                continue  # its numerator is a Gram minor, positive on the surface by Cauchy-Binet: no locus
         searched += d.structural
         try:
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
         except AnalysisError:
-            if undecided is not None:
-                if d.structural:
-                    undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND))
-                elif not sum_of_squares_on_surface(d.divisor, surface, variables, memo):
-                    undecided.append(Undecided(d.divisor, d.stage, d.what, NOT_FOUND, FACTOR_ORIGIN))
+            if undecided is not None and (d.structural or not sum_of_squares_on_surface(d.divisor, surface, variables, memo)):
+                verdict = gram(d.divisor) if gram is not None else None
+                if verdict is not None and verdict.proven:
+                    continue  # its numerator is a Gram minor, positive on the surface by Cauchy-Binet: no locus
+                reason = NOT_FOUND + (f"; {verdict.reason}" if verdict is not None and verdict.reason else "")
+                undecided.append(Undecided(d.divisor, d.stage, d.what, reason, *(() if d.structural else (FACTOR_ORIGIN,))))
             continue  # no point found: proven nonzero, or said not ruled out
         what = d.what
         if d.structural:
