@@ -283,7 +283,7 @@ class GramProver:
             return GramVerdict(False, (
                 f"its numerator is a Gram determinant det(J W J^T), by Cauchy-Binet a sum of squares with weights, but "
                 f"the weights {shown} are not known to have one sign (declare the parameters positive, "
-                "sympy.Symbol(name, positive=True), to have it proven)"))
+                "sympy.Symbol(name, positive=True), or fix their values, --param NAME=VALUE, to have it proven)"))
         # every group is a sum of squares >= 0 times a weight of one sign: one group nonzero on the surface suffices
         candidates = dict.fromkeys(sorted([*classes.values(), *groups.values()], key=_size))  # small first
         for total in candidates:
