@@ -397,7 +397,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     r = np.empty(__N__)
     J = np.empty((2 * __N__, __N__))  # rows 0 .. n-1: (1)'s Jacobian, n .. 2n-1: (2)'s
     pivx = np.empty(2 * __N__, dtype=np.int64)
-    dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors
+    DINV_WORK
     f = np.empty(__N__)
     ph = np.empty(__N__)
     v0 = np.empty(__N__)
@@ -713,11 +713,13 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
             rattle = offset_lu_source(n) + (
                 unconstrained.replace("NEWTON_SOLVE\n", "lu_solve_n(J, pivx, dinv, col, o)\n")
                 .replace("NEWTON_FACTOR\n", "for ob in range(0, 2 * __N__, __N__):\n"
-                         "                            lu_factor_n(J, pivx, dinv, ob)\n"))
+                         "                            lu_factor_n(J, pivx, dinv, ob)\n")
+                .replace("DINV_WORK\n", "dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors\n"))
         else:
             rattle = (unconstrained.replace("NEWTON_SOLVE\n", "lu_solve(J[o:o + __N__], pivx[o:o + __N__], col)\n")
                       .replace("NEWTON_FACTOR\n", "lu_factor(J[:__N__], pivx[:__N__])\n"
-                               "                        lu_factor(J[__N__:], pivx[__N__:])\n"))
+                               "                        lu_factor(J[__N__:], pivx[__N__:])\n")
+                      .replace("    DINV_WORK\n", ""))
     return _fill(by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 
 

@@ -193,8 +193,8 @@ def offset_lu_source(n: int) -> str:
     """Source of ``lu_factor_n(A, piv, dinv, o)`` and ``lu_solve_n(A, piv, dinv, b, o)``: the
     LU factors (partial pivoting, Golub & Van Loan, Algorithm 3.4.1) of an ``n x n`` matrix
     kept in rows ``o .. o + n - 1`` of ``A`` (row exchanges in ``piv[o:]``, the reciprocals
-    of the pivots in ``dinv[o:]``) and the solve with them, written out for this ``n`` on
-    local floats, inlined where they are called (the unconstrained RATTLE loop of
+    of the pivots in ``dinv[o:]``), in loops of literal length, and the solve with them,
+    written out for this ``n`` on local floats, inlined where they are called (the unconstrained RATTLE loop of
     :mod:`dirac.codegen.kernel_templates`, a few Newton matrices per sub-step, several
     solves each).
 
@@ -211,28 +211,29 @@ def offset_lu_source(n: int) -> str:
     if not 1 <= n <= UNROLLED_MAX_SIZE:
         raise ValueError(f"an unrolled offset LU needs 1 <= n <= {UNROLLED_MAX_SIZE}, not {n}")
 
-    def a(i: int, j: int) -> str:
-        return f"a{i}_{j}"
-
     lines = ["", "", '@numba.njit(cache=True, inline="always")', "def lu_factor_n(A, piv, dinv, o):",
              f'    """Rows o .. o + {n} - 1 of A <- the LU factors of the ({n}, {n}) matrix there (row exchanges',
-             '    in piv[o:], reciprocal pivots in dinv[o:]), in place."""']
-    lines += [f"    {a(i, j)} = A[o + {i}, {j}]" for i in range(n) for j in range(n)]
-    for c in range(n - 1):
-        lines += [f"    best = abs({a(c, c)})", f"    r_best = {c}"]
-        for r in range(c + 1, n):
-            lines += [f"    if abs({a(r, c)}) > best:", f"        best = abs({a(r, c)})", f"        r_best = {r}"]
-        lines.append(f"    piv[o + {c}] = r_best")
-        for r in range(c + 1, n):
-            lines.append(f"    {'if' if r == c + 1 else 'elif'} r_best == {r}:")
-            lines += [f"        {a(c, j)}, {a(r, j)} = {a(r, j)}, {a(c, j)}" for j in range(c, n)]
-        lines.append(f"    d = 1.0 / {a(c, c)}")
-        lines.append(f"    dinv[o + {c}] = d")
-        for r in range(c + 1, n):
-            lines.append(f"    {a(r, c)} = {a(r, c)} * d")
-            lines += [f"    {a(r, j)} = {a(r, j)} - {a(r, c)} * {a(c, j)}" for j in range(c + 1, n)]
-    lines += [f"    piv[o + {n - 1}] = {n - 1}", f"    dinv[o + {n - 1}] = 1.0 / {a(n - 1, n - 1)}"]
-    lines += [f"    A[o + {i}, {j}] = {a(i, j)}" for i in range(n) for j in range(n)]
+             '    in piv[o:], reciprocal pivots in dinv[o:]), in place."""',
+             f"    for c in range({n}):",
+             "        best = abs(A[o + c, c])",
+             "        r_best = c",
+             f"        for r in range(c + 1, {n}):",
+             "            if abs(A[o + r, c]) > best:",
+             "                best = abs(A[o + r, c])",
+             "                r_best = r",
+             "        piv[o + c] = r_best",
+             "        if r_best != c:",
+             f"            for j in range(c, {n}):",
+             "                tmp = A[o + c, j]",
+             "                A[o + c, j] = A[o + r_best, j]",
+             "                A[o + r_best, j] = tmp",
+             "        d = 1.0 / A[o + c, c]",
+             "        dinv[o + c] = d",
+             f"        for r in range(c + 1, {n}):",
+             "            f = A[o + r, c] * d",
+             "            A[o + r, c] = f",
+             f"            for j in range(c + 1, {n}):",
+             "                A[o + r, j] -= f * A[o + c, j]"]
     lines += ["", "", '@numba.njit(cache=True, inline="always")', "def lu_solve_n(A, piv, dinv, b, o):",
               f'    """b <- A^{{-1}} b for the factors of lu_factor_n of the ({n}, {n}) matrix in rows o .. o + {n} - 1',
               '    of A, in place."""']
