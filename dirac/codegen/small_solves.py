@@ -206,7 +206,9 @@ def offset_lu_source(n: int) -> str:
     of dependent operations of a Newton iteration (they were most of its latency). The pivot
     choices are those of the loops (the first row of largest ``|A[r, c]|``); the results
     differ from the loops' by rounding only. A zero pivot divides by zero
-    (``ZeroDivisionError``, a singular Newton matrix), as the loops do.
+    (``ZeroDivisionError``, a singular Newton matrix) in both tiers: the reciprocal is formed
+    from ``float(pivot)``, a Python float when interpreted (numpy's scalar division would
+    return inf), a no-op when compiled.
     """
     if not 1 <= n <= UNROLLED_MAX_SIZE:
         raise ValueError(f"an unrolled offset LU needs 1 <= n <= {UNROLLED_MAX_SIZE}, not {n}")
@@ -227,7 +229,7 @@ def offset_lu_source(n: int) -> str:
              "                tmp = A[o + c, j]",
              "                A[o + c, j] = A[o + r_best, j]",
              "                A[o + r_best, j] = tmp",
-             "        d = 1.0 / A[o + c, c]",
+             "        d = 1.0 / float(A[o + c, c])",  # a Python float in the interpreter: 1 / 0 raises there too
              "        dinv[o + c] = d",
              f"        for r in range(c + 1, {n}):",
              "            f = A[o + r, c] * d",
