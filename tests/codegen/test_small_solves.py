@@ -112,7 +112,7 @@ def _offset(size: int, matrices: list[np.ndarray], rhs: list[np.ndarray]):
     piv = np.full(J.shape[0], -1, dtype=np.int64)
     dinv = np.full(J.shape[0], np.nan)
     solutions = []
-    for block, b in enumerate(rhs):
+    for block in range(len(rhs)):
         module.lu_factor_n(J, piv, dinv, block * size)
     for block, b in enumerate(rhs):
         x = b.copy()
