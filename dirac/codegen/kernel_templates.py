@@ -14,12 +14,12 @@ the sub-step ``s`` of step ``j`` starts at ``t + j dt + dt (c_1 + ... + c_{s-1})
 
 from __future__ import annotations
 
-from dirac.codegen.small_solves import offset_lu_solve_source
+from dirac.codegen.small_solves import offset_lu_source
 
 __all__ = ["mechanical_templates", "analysed_templates", "RATTLE_NEWTON", "UNROLLED_NEWTON_MAX"]
 
-#: the largest n whose unconstrained RATTLE loop inlines the unrolled solve of its Newton
-#: matrices (:func:`dirac.codegen.small_solves.offset_lu_solve_source`); larger n call the
+#: the largest n whose unconstrained RATTLE loop inlines the unrolled factors and solve of its Newton
+#: matrices (:func:`dirac.codegen.small_solves.offset_lu_source`); larger n call the
 #: LU's own solve on the block's rows. The unrolled solve has n^2 statements and numba types
 #: and lowers each: for an N-link pendulum in angles, N = 5, the kernel compiled in 2 s
 #: more CPU with it (whole process 6.9 s against 4.7 s, paired runs) for a step 12 % faster
@@ -397,6 +397,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     r = np.empty(__N__)
     J = np.empty((2 * __N__, __N__))  # rows 0 .. n-1: (1)'s Jacobian, n .. 2n-1: (2)'s
     pivx = np.empty(2 * __N__, dtype=np.int64)
+    DINV_WORK
     f = np.empty(__N__)
     ph = np.empty(__N__)
     v0 = np.empty(__N__)
@@ -476,8 +477,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                             for j in range(__N__):
                                 J[i, j] = M0[i, j] - 0.5 * h * B[i, j]
                                 J[__N__ + i, j] = M0[i, j] + 0.5 * h * B[j, i]
-                        lu_factor(J[:__N__], pivx[:__N__])
-                        lu_factor(J[__N__:], pivx[__N__:])
+                        NEWTON_FACTOR
                         stage = 1
                         continue
                     for i in range(__N__):
@@ -709,10 +709,17 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
         else:
             unconstrained = (_UNCONSTRAINED.replace("VELOCITY\n", "velocity(x, ph, ta, c, v1, work, pivn)\n")
                              .replace("MASS0\n", "mass(q, tau, c, M0)\n"))
-        if n <= UNROLLED_NEWTON_MAX:
-            rattle = offset_lu_solve_source(n) + unconstrained.replace("NEWTON_SOLVE\n", "lu_solve_n(J, pivx, col, o)\n")
+        if n <= UNROLLED_NEWTON_MAX:  # one copy of the unrolled factorization, run for both blocks
+            rattle = offset_lu_source(n) + (
+                unconstrained.replace("NEWTON_SOLVE\n", "lu_solve_n(J, pivx, dinv, col, o)\n")
+                .replace("NEWTON_FACTOR\n", "for ob in range(0, 2 * __N__, __N__):\n"
+                         "                            lu_factor_n(J, pivx, dinv, ob)\n")
+                .replace("DINV_WORK\n", "dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors\n"))
         else:
-            rattle = unconstrained.replace("NEWTON_SOLVE\n", "lu_solve(J[o:o + __N__], pivx[o:o + __N__], col)\n")
+            rattle = (unconstrained.replace("NEWTON_SOLVE\n", "lu_solve(J[o:o + __N__], pivx[o:o + __N__], col)\n")
+                      .replace("NEWTON_FACTOR\n", "lu_factor(J[:__N__], pivx[:__N__])\n"
+                               "                        lu_factor(J[__N__:], pivx[__N__:])\n")
+                      .replace("    DINV_WORK\n", ""))
     return _fill(by_elimination + rattle + _FIELD + common, n, m, 2 * m)
 
 

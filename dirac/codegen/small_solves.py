@@ -26,10 +26,10 @@ faster (the unrolled 6 x 6 took 3-4 times as long), so the compiled tier keeps i
 
 from __future__ import annotations
 
-__all__ = ["solve_source", "lu_source", "unrolled_lu_source", "offset_lu_solve_source", "UNROLLED_MAX_SIZE"]
+__all__ = ["solve_source", "lu_source", "unrolled_lu_source", "offset_lu_source", "UNROLLED_MAX_SIZE"]
 
-#: largest matrix size whose LU is unrolled (for the interpreted tier; the solve of
-#: :func:`offset_lu_solve_source` for both tiers); the source grows like k^3 (k^2 for a solve)
+#: largest matrix size whose LU is unrolled (for the interpreted tier; the factors and solve
+#: of :func:`offset_lu_source` for both tiers); the source grows like k^3 (k^2 for a solve)
 UNROLLED_MAX_SIZE = 8
 
 
@@ -189,45 +189,64 @@ def unrolled_lu_source(size: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-def offset_lu_solve_source(n: int) -> str:
-    """Source of ``lu_solve_n(A, piv, b, o)``: the solve of :func:`lu_source`'s ``lu_solve``
-    with the factors of an ``n x n`` matrix kept in rows ``o .. o + n - 1`` of ``A`` (row
-    exchanges in ``piv[o:]``), inlined where it is called (the unconstrained RATTLE loop of
-    :mod:`dirac.codegen.kernel_templates`, whose call with three array arguments cost more
-    than the solve).
+def offset_lu_source(n: int) -> str:
+    """Source of ``lu_factor_n(A, piv, dinv, o)`` and ``lu_solve_n(A, piv, dinv, b, o)``: the
+    LU factors (partial pivoting, Golub & Van Loan, Algorithm 3.4.1) of an ``n x n`` matrix
+    kept in rows ``o .. o + n - 1`` of ``A`` (row exchanges in ``piv[o:]``, the reciprocals
+    of the pivots in ``dinv[o:]``), in loops of literal length, and the solve with them,
+    written out for this ``n`` on local floats, inlined where they are called (the unconstrained RATTLE loop of
+    :mod:`dirac.codegen.kernel_templates`, a few Newton matrices per sub-step, several
+    solves each).
 
-    Up to :data:`UNROLLED_MAX_SIZE` the statements are written out without loops or
-    branches (a row exchange with itself leaves ``b`` as it is), in the same order, so with
-    the same numbers (and a loop nest less to compile); larger ``n`` keep the loops.
+    Against the looped :func:`lu_source` on a slice ``A[o:o + n]``: no array views (each
+    slice took and dropped a reference, two atomic operations per slice), no loads and
+    stores of ``b`` through a row exchange's computed index inside the elimination, and the
+    backward substitution multiplies by ``dinv`` (``1 / A[c, c]`` formed once per
+    factorization) instead of dividing in every solve, taking the divisions off the chain
+    of dependent operations of a Newton iteration (they were most of its latency). The pivot
+    choices are those of the loops (the first row of largest ``|A[r, c]|``); the results
+    differ from the loops' by rounding only. A zero pivot divides by zero
+    (``ZeroDivisionError``, a singular Newton matrix) in both tiers: the reciprocal is formed
+    from ``float(pivot)``, a Python float when interpreted (numpy's scalar division would
+    return inf), a no-op when compiled.
     """
-    head = f'''
+    if not 1 <= n <= UNROLLED_MAX_SIZE:
+        raise ValueError(f"an unrolled offset LU needs 1 <= n <= {UNROLLED_MAX_SIZE}, not {n}")
 
-@numba.njit(cache=True, inline="always")
-def lu_solve_n(A, piv, b, o):
-    """b <- A^{{-1}} b for the factors of lu_factor of the ({n}, {n}) matrix in rows o .. o + {n} - 1
-    of A (row exchanges in piv[o:]), in place."""
-'''
-    if n > UNROLLED_MAX_SIZE:
-        return head + f'''    for c in range({n}):
-        r = piv[o + c]
-        if r != c:
-            tmp = b[c]
-            b[c] = b[r]
-            b[r] = tmp
-        for r in range(c + 1, {n}):
-            b[r] -= A[o + r, c] * b[c]
-    for c in range({n - 1}, -1, -1):
-        acc = b[c]
-        for r in range(c + 1, {n}):
-            acc -= A[o + c, r] * b[r]
-        b[c] = acc / A[o + c, c]
-'''
-    lines = []
-    for c in range(n):
-        if c < n - 1:
-            lines += [f"    r = piv[o + {c}]", f"    tmp = b[{c}]", f"    b[{c}] = b[r]", "    b[r] = tmp"]
-        lines += [f"    b[{r}] -= A[o + {r}, {c}] * b[{c}]" for r in range(c + 1, n)]
+    lines = ["", "", '@numba.njit(cache=True, inline="always")', "def lu_factor_n(A, piv, dinv, o):",
+             f'    """Rows o .. o + {n} - 1 of A <- the LU factors of the ({n}, {n}) matrix there (row exchanges',
+             '    in piv[o:], reciprocal pivots in dinv[o:]), in place."""',
+             f"    for c in range({n}):",
+             "        best = abs(A[o + c, c])",
+             "        r_best = c",
+             f"        for r in range(c + 1, {n}):",
+             "            if abs(A[o + r, c]) > best:",
+             "                best = abs(A[o + r, c])",
+             "                r_best = r",
+             "        piv[o + c] = r_best",
+             "        if r_best != c:",
+             f"            for j in range(c, {n}):",
+             "                tmp = A[o + c, j]",
+             "                A[o + c, j] = A[o + r_best, j]",
+             "                A[o + r_best, j] = tmp",
+             "        d = 1.0 / float(A[o + c, c])",  # a Python float in the interpreter: 1 / 0 raises there too
+             "        dinv[o + c] = d",
+             f"        for r in range(c + 1, {n}):",
+             "            f = A[o + r, c] * d",
+             "            A[o + r, c] = f",
+             f"            for j in range(c + 1, {n}):",
+             "                A[o + r, j] -= f * A[o + c, j]"]
+    lines += ["", "", '@numba.njit(cache=True, inline="always")', "def lu_solve_n(A, piv, dinv, b, o):",
+              f'    """b <- A^{{-1}} b for the factors of lu_factor_n of the ({n}, {n}) matrix in rows o .. o + {n} - 1',
+              '    of A, in place."""']
+    lines += [f"    b{i} = b[{i}]" for i in range(n)]
+    for c in range(n - 1):
+        lines.append(f"    r = piv[o + {c}]")
+        for r in range(c + 1, n):
+            lines += [f"    {'if' if r == c + 1 else 'elif'} r == {r}:", f"        b{c}, b{r} = b{r}, b{c}"]
+        lines += [f"    b{r} = b{r} - A[o + {r}, {c}] * b{c}" for r in range(c + 1, n)]
     for c in range(n - 1, -1, -1):
-        terms = "".join(f" - A[o + {c}, {r}] * b[{r}]" for r in range(c + 1, n))
-        lines.append(f"    b[{c}] = (b[{c}]{terms}) / A[o + {c}, {c}]")
-    return head + "\n".join(lines) + "\n"
+        terms = "".join(f" - A[o + {c}, {r}] * b{r}" for r in range(c + 1, n))
+        lines.append(f"    b{c} = (b{c}{terms}) * dinv[o + {c}]" if terms else f"    b{c} = b{c} * dinv[o + {c}]")
+    lines += [f"    b[{i}] = b{i}" for i in range(n)]
+    return "\n".join(lines) + "\n"

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dirac.codegen.numba_backend import interpret_source
-from dirac.codegen.small_solves import UNROLLED_MAX_SIZE, lu_source, unrolled_lu_source
+from dirac.codegen.small_solves import UNROLLED_MAX_SIZE, lu_source, offset_lu_source, unrolled_lu_source
 
 _HEADER = "import math\nimport numpy as np\nimport numba\n"
 
@@ -101,3 +101,66 @@ def test_a_singular_matrix_divides_by_zero(solves) -> None:
 def test_a_size_below_one_is_refused() -> None:
     with pytest.raises(ValueError, match="at least 1"):
         unrolled_lu_source(0)
+
+
+def _offset(size: int, matrices: list[np.ndarray], rhs: list[np.ndarray]):
+    """Factor the matrices stacked in the rows of one array with lu_factor_n at offsets
+    0, size, 2 size, ... (as the unconstrained RATTLE loop keeps its two Newton matrices) and
+    solve each with lu_solve_n; returns (stacked factors, piv, solutions)."""
+    module = interpret_source(_HEADER + offset_lu_source(size))
+    J = np.vstack(matrices)
+    piv = np.full(J.shape[0], -1, dtype=np.int64)
+    dinv = np.full(J.shape[0], np.nan)
+    solutions = []
+    for block in range(len(rhs)):
+        module.lu_factor_n(J, piv, dinv, block * size)
+    for block, b in enumerate(rhs):
+        x = b.copy()
+        module.lu_solve_n(J, piv, dinv, x, block * size)
+        solutions.append(x)
+    return J, piv, dinv, solutions
+
+
+def test_the_offset_lu_by_hand() -> None:
+    """The hand-worked A = [[2, 1], [4, 3]] of the unrolled LU, stacked below the identity:
+    the identity's block keeps piv (0, 1) and reciprocal pivots (1, 1); A's block exchanges its
+    rows (|4| > |2|), multiplier 2/4 = 0.5, U = [[4, 3], [0, -0.5]], reciprocal pivots
+    (1/4, -2); A x = (3, 7) gives x = (1, 1), I x = b gives b."""
+    J, piv, dinv, (y, x) = _offset(2, [np.eye(2), np.array([[2.0, 1.0], [4.0, 3.0]])],
+                                   [np.array([5.0, -6.0]), np.array([3.0, 7.0])])
+    assert piv.tolist() == [0, 1, 1, 1]
+    assert dinv.tolist() == [1.0, 1.0, 0.25, -2.0]
+    assert J[2:].tolist() == [[4.0, 3.0], [0.5, -0.5]]
+    assert x.tolist() == [1.0, 1.0] and y.tolist() == [5.0, -6.0]
+
+
+@pytest.mark.parametrize("size", [1, 2, 3, 5])
+def test_the_offset_lu_against_numpy_and_the_loops_pivots(solves, size) -> None:
+    """Two blocks, random and row-permuted (every exchange taken): each block's solution agrees
+    with numpy.linalg.solve (LAPACK gesv) to round-off, the row exchanges are the looped
+    lu_factor's own (same pivot choices), and the other block is left as it was."""
+    rng = np.random.default_rng(40 + size)
+    for trial in range(20):
+        first = rng.normal(size=(size, size)) + (0.0 if trial % 2 else size * np.eye(size))
+        second = rng.permutation(np.eye(size)) + 1e-3 * rng.normal(size=(size, size))
+        b1, b2 = rng.normal(size=size), rng.normal(size=size)
+        J, piv, _, (x1, x2) = _offset(size, [first, second], [b1, b2])
+        for matrix, b, x, block in ((first, b1, x1, 0), (second, b2, x2, 1)):
+            reference = np.linalg.solve(matrix, b)
+            scale = np.linalg.cond(matrix) * (1.0 + np.max(np.abs(reference)))
+            assert np.max(np.abs(x - reference)) <= 1e-14 * scale
+            _, looped_piv, _ = _looped(solves, matrix, b)
+            assert piv[block * size:(block + 1) * size].tolist() == looped_piv.tolist()
+
+
+def test_the_offset_lu_of_a_singular_block_divides_by_zero() -> None:
+    """All ones (rank 1) in the second block: its second pivot is exactly zero and forming its
+    reciprocal raises, as numba's compiled division does (a singular Newton matrix)."""
+    with pytest.raises(ZeroDivisionError):
+        _offset(3, [np.eye(3), np.ones((3, 3))], [np.ones(3), np.ones(3)])
+
+
+def test_an_offset_lu_out_of_range_is_refused() -> None:
+    for size in (0, UNROLLED_MAX_SIZE + 1):
+        with pytest.raises(ValueError, match="unrolled offset LU"):
+            offset_lu_source(size)
