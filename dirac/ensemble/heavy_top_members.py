@@ -38,10 +38,11 @@ import numpy as np
 
 from dirac.ensemble.crossing_source import locate_source
 from dirac.ensemble.general_chunk import member_results, step_grid
-from dirac.ensemble.general_scene import HeavyTopEnsembleScene, heavy_top_names, split_condition
+from dirac.ensemble.general_scene import HeavyTopEnsembleScene, heavy_top_names
 from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.ensemble.member_values import member_column
 from dirac.ensemble.member_values import member_label as _where
+from dirac.ensemble.reduction_layout import reduction_layout
 from dirac.errors import InputError, warn
 
 __all__ = ["CompiledTop", "compiled_heavy_top", "check_heavy_top_states", "heavy_top_initial_states",
@@ -109,34 +110,10 @@ def _build(scene: HeavyTopEnsembleScene) -> CompiledTop:
 
     from dirac.codegen.kernel_source import emit_function
     from dirac.codegen.numba_backend import import_source
-    from dirac.model.expressions import parse_expression
     from dirac.rigidbody.schemes import SCHEMES
 
     names = heavy_top_names()
-    exprs: list[Any] = []
-    conditions: list[tuple[Any, str]] = []
-    layout: dict[str, list] = {"cross": [], "ext": [], "poincare": []}
-    for reduction in scene.reductions:
-        parsed = [parse_expression(text, names, what=f"reduction {reduction.name}") for text in reduction.exprs]
-        if reduction.kind == "first_crossing":
-            group = []
-            for value, when in zip(parsed, reduction.whens):
-                exprs.append(value)
-                cond = -1
-                if when is not None:
-                    lhs, op, rhs = split_condition(when, reduction.name)
-                    left = parse_expression(lhs, names, what=f"reduction {reduction.name} when")
-                    right = parse_expression(rhs, names, what=f"reduction {reduction.name} when")
-                    conditions.append((left - right if op in (">", ">=") else right - left, ">" if op in (">", "<") else ">="))
-                    cond = len(conditions) - 1
-                group.append((len(exprs) - 1, cond))
-            layout["cross"].append((reduction.name, group))
-        elif reduction.kind in ("max", "min"):
-            exprs.append(parsed[0])
-            layout["ext"].append((reduction.name, reduction.kind, len(exprs) - 1))
-        elif reduction.kind == "poincare":
-            exprs.append(parsed[0])
-            layout["poincare"].append((reduction.name, len(exprs) - 1, reduction.count))
+    exprs, conditions, layout = reduction_layout(scene, names)
     M = [names[f"M_{i}"] for i in (1, 2, 3)]
     R = sympy.Matrix(3, 3, lambda i, j: names[f"R_{i + 1}{j + 1}"])
     parameters = [names[p] for p in ("I_1", "I_2", "I_3", "mass_gravity", "chi_1", "chi_2", "chi_3")]
