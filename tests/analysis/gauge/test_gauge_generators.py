@@ -221,3 +221,27 @@ def test_castellani_check_rejects_a_wrong_chain():
     assert _chain_problem(space, numerics, [gauss, s["p_z"]], H, points, basis) == ""
     assert "fails" in _chain_problem(space, numerics, [-gauss, s["p_z"]], H, points, basis)
     assert "not a first-class" in _first_class_problem(space, numerics, [s["x"]], analysis.constraints, points)
+
+
+def test_a_chain_whose_terms_swell_is_not_built_and_said_so():
+    """A random three-coordinate Lagrangian (found by the never-a-traceback test) whose part
+    q1 = 0 has three first-class constraints: Castellani's brackets {G_k, H'} grow 280, 925,
+    53860 characters in three stages, and each expansion differentiates the last (the fourth
+    ran for minutes). The chain is not built past CHAIN_TERM_LIMIT: no generator is reported,
+    the report says which chain and why, and the first-class constraints' gauge transformation
+    is said to be undecided, not denied."""
+    from dirac.analysis.gauge.generators import CHAIN_TERM_LIMIT
+    from dirac.model.lagrangian import Lagrangian
+
+    system = Lagrangian.from_strings(
+        "swelling", ["q1", "q2", "q3"],
+        "q3*q1_dot*q2_dot + q1_dot*q3_dot/2 - q1*q2_dot**2/2 + q3_dot**2 - q3**2",
+        constraints=["(3*q1*q3)**2"])
+    with pytest.warns(dirac.DiracWarning, match="crossing branches"):
+        analysis = dirac.analyze(system)
+    part = next(c.analysis for c in analysis.components if c.condition == "q1 = 0")
+    gauge = part.gauge_structure
+    assert gauge.generators == []
+    assert len(gauge.rejected) == 1 and "was not built" in gauge.rejected[0]
+    assert f"longer than {CHAIN_TERM_LIMIT} characters" in gauge.rejected[0]
+    assert gauge.without_transformation and all("is not decided" in gauge.account(c) for c in gauge.without_transformation)
