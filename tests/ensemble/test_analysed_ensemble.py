@@ -4,12 +4,12 @@ midpoint rule on a linear flow, refused bad input."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 import zarr
+from ensemble_stores import run_ensemble_cli as _cli
+from ensemble_stores import scene_file as _scene
+from ensemble_stores import stored_arrays as _arrays
 
 from dirac.ensemble.engine import run_ensemble
 
@@ -21,15 +21,6 @@ lagrangian = "x*y_dot - (x**2 + y**2)/2 + z_dot**2/2 - z**2/2"
 """
 
 
-def _scene(tmp_path, system: str, initial: str, run: str, ensemble: str, name: str = "scene.toml"):
-    path = tmp_path / name
-    path.write_text(f"{system}\n[initial]\n{initial}\n[run]\n{run}\n[ensemble]\n{ensemble}\n")
-    return path
-
-
-def _arrays(out) -> dict[str, np.ndarray]:
-    group = zarr.open_group(str(out / "data.zarr"), mode="r")
-    return {name: np.asarray(group[name][:]) for name in group.array_keys()}
 
 
 def test_members_equal_single_runs(tmp_path):
@@ -137,10 +128,6 @@ def test_early_stop_on_the_dirac_flow(tmp_path):
     j = int(np.argmax(np.cos((k + 1) * theta) <= 0.0))
     assert np.all(stored["steps"] == j + 1)
 
-
-def _cli(scene, out):
-    return subprocess.run([sys.executable, "-m", "dirac", "ensemble", str(scene), "--out", str(out), "--no-progress"],
-                          capture_output=True, text=True, timeout=300)
 
 
 @pytest.mark.parametrize("initial, run, ensemble, message", [

@@ -10,6 +10,9 @@ import sys
 import numpy as np
 import pytest
 import zarr
+from ensemble_stores import run_ensemble_cli as _cli
+from ensemble_stores import scene_file as _scene
+from ensemble_stores import stored_arrays as _arrays
 
 from dirac.ensemble.engine import run_ensemble
 from dirac.ensemble.scene import load_ensemble_scene
@@ -34,15 +37,6 @@ FLIP = ('{ kind = "first_crossing", name = "flip_time", expr = ["x1", "x2 - x1"]
         'when = ["y1 > 0", "y2 - y1 > 0"] }')
 
 
-def _scene(tmp_path, system: str, initial: str, run: str, ensemble: str, name: str = "scene.toml"):
-    path = tmp_path / name
-    path.write_text(f"{system}\n[initial]\n{initial}\n[run]\n{run}\n[ensemble]\n{ensemble}\n")
-    return path
-
-
-def _arrays(out) -> dict[str, np.ndarray]:
-    group = zarr.open_group(str(out / "data.zarr"), mode="r")
-    return {name: np.asarray(group[name][:]) for name in group.array_keys()}
 
 
 def test_members_equal_single_runs(tmp_path):
@@ -192,10 +186,6 @@ def test_damped_pendulum_basins_from_energy(tmp_path):
     ratio = coarse[fine > 0] / fine[fine > 0]
     assert 3.9 < np.median(ratio) < 4.1  # (the member at rest at th = 0 has no error at all)
 
-
-def _cli(scene, out):
-    return subprocess.run([sys.executable, "-m", "dirac", "ensemble", str(scene), "--out", str(out), "--no-progress"],
-                          capture_output=True, text=True, timeout=300)
 
 
 @pytest.mark.parametrize("initial, ensemble, project, message", [

@@ -6,12 +6,11 @@ members whose torque kick fails."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 import zarr
+from ensemble_stores import run_ensemble_cli as _cli
+from ensemble_stores import stored_arrays as _arrays
 
 from dirac.ensemble.engine import run_ensemble
 
@@ -38,10 +37,6 @@ grid = {{ spin = [0.4, 4.6, 8], mgl = [0.5, 1.0, 2] }}
 reductions = [{{ kind = "max", name = "max_tilt", expr = "1 - gamma_3" }}, "final", "energy_error", "constraint_error"]
 """
 
-
-def _arrays(out) -> dict[str, np.ndarray]:
-    group = zarr.open_group(str(out / "data.zarr"), mode="r")
-    return {name: np.asarray(group[name][:]) for name in group.array_keys()}
 
 
 def _tilted(angle: float) -> np.ndarray:
@@ -274,10 +269,6 @@ def test_chart_identical_local_dask_and_resumed(chart, tmp_path):
     assert report.complete and report.chunks_computed == 2 and report.chunks_skipped == 2
     assert np.array_equal(_arrays(out)["max_tilt"], reference["max_tilt"])
 
-
-def _cli(scene, out):
-    return subprocess.run([sys.executable, "-m", "dirac", "ensemble", str(scene), "--out", str(out), "--no-progress"],
-                          capture_output=True, text=True, timeout=300)
 
 
 @pytest.mark.parametrize("change, message", [
