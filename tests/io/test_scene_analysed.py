@@ -41,3 +41,11 @@ def test_project_true_is_refused_for_a_system_run_on_its_analysis():
     completed): it is refused with the way out, as the ensemble of the same system refuses it."""
     with pytest.raises(InputError, match=r"project = true: 'ring' runs on the Dirac flow.*set project = false"):
         scene_from_dict({"system": RING, "initial": {**START, "project": True}, "run": RUN})
+
+
+def test_initial_state_repeats_by_default():
+    """``AnalysedSystem.initial_state`` without a seed completes from the same start as a scene
+    does (seed 0), so a Python run repeats to the last bit as a scene run does."""
+    problem = scene_from_dict({"system": RING, "initial": START, "run": RUN}).problem
+    again = problem.analysed.initial_state(START["q"], q_dot=START["q_dot"])
+    assert np.array_equal(problem.z0[0], again)
