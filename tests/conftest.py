@@ -10,11 +10,24 @@ worker, so a module-scoped fixture (an analysis, compiled kernels) is still buil
 the kernels a file's tests share are compiled once. The workers share the cache of
 generated code (``$DIRAC_CACHE_DIR``, else ``~/.cache/dirac/generated``) as a user's
 parallel runs do: every writer of it uses file names of its own before an atomic rename.
+
+Property tests (hypothesis) draw the same examples in every bounded run (``derandomize``,
+no example database): a run of the suite is reproducible, and a rare draw that is slow or
+fails cannot appear in one CI run and not in the next. The full stress runs
+(``DIRAC_FULL_STRESS=1``) draw new examples each time, which is where the search for
+failures goes on.
 """
 
 from __future__ import annotations
 
+import os
+
 import pytest
+from hypothesis import settings
+
+settings.register_profile("bounded", derandomize=True, database=None)
+settings.register_profile("exploring")
+settings.load_profile("exploring" if os.environ.get("DIRAC_FULL_STRESS") == "1" else "bounded")
 
 
 @pytest.fixture

@@ -421,7 +421,8 @@ def _driven_steps(w: Any, exact: bool) -> None:
     segments from ``t0 + k dt`` (``k`` the first step of the segment), with the step times
     ``t0 + k dt + j dt`` of the single run's kernel calls; a segment ends at an impulse. An
     impulse inside a step cuts it in two (``rest`` to the impulse, ``dt - rest`` after); one
-    on a step boundary (within ``1e-9 dt``) acts between two steps, or after the call's last.
+    on a step boundary (within ``1e-9 dt``) acts between two steps, or after the call's last;
+    further impulses inside the same step cut it again, each from the last.
     A kick whose Newton iteration fails fails the member."""
     step_args = "p, em, en" if exact else "axes, rates, fractions, casimir_rate"
     w(3, "t0 = t_call")
@@ -445,10 +446,21 @@ def _driven_steps(w: Any, exact: bool) -> None:
     w(4, "if cut:")
     w(5, "t_here = t0 + step * dt")
     w(5, "rest = t_imp - t_here")
+    w(5, "step_end = t0 + (step + 1) * dt")
     w(5, f"failed = ht_step(M, R, a, w, gammas, t_here, rest, N, work, {step_args}) < 0")
+    w(5, "covered = rest")
+    w(5, "at = t_imp")
     w(5, "if not failed:")
     w(6, "q = ht_impulses(M, a, work, q, t_imp)")
-    w(6, f"failed = ht_step(M, R, a, w, gammas, t_imp, dt - rest, N, work, {step_args}) < 0")
+    w(5, "while not failed and q < IMP_T.shape[0] and IMP_T[q] < step_end - slack:  # more in this step")
+    w(6, "following = IMP_T[q]")
+    w(6, f"failed = ht_step(M, R, a, w, gammas, at, following - at, N, work, {step_args}) < 0")
+    w(6, "if not failed:")
+    w(7, "q = ht_impulses(M, a, work, q, following)")
+    w(7, "covered += following - at")
+    w(7, "at = following")
+    w(5, "if not failed:")
+    w(6, f"failed = ht_step(M, R, a, w, gammas, at, dt - covered, N, work, {step_args}) < 0")
     w(5, "first = step + 1")
     w(5, "start = t0 + (step + 1) * dt")
     w(4, "else:")

@@ -170,11 +170,12 @@ class AnalysedSystem:
         return out
 
     def initial_state(self, q: dict[str, float], q_dot: dict[str, float] | None = None,
-                      p: dict[str, float] | None = None, seed: int | None = None) -> np.ndarray:
+                      p: dict[str, float] | None = None, seed: int | None = 0) -> np.ndarray:
         """A point of the constraint surface with the given coordinates and velocities
         (``p = dL/dq_dot``) or momenta; the multipliers and the rest are completed by
-        :meth:`ConstraintAnalysis.surface_point` (from a random start: ``seed`` fixes it,
-        and with it the last bits of the completed values).
+        :meth:`ConstraintAnalysis.surface_point` (Gauss–Newton from a pseudo-random start
+        drawn with ``seed``: the same seed gives the same last bits of the completed values
+        in every process; ``None`` draws a fresh start).
 
         Raises
         ------

@@ -28,7 +28,8 @@ heavy top adds ``mass_gravity`` (``m g``) and ``center_of_mass`` (body frame) un
 are refused unless ``project = true`` in ``[initial]``. A Lagrangian that is not of the
 form ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the velocities, singular) is
 integrated on the full phase space of its Dirac–Bergmann analysis (``midpoint`` or the
-scipy baselines; the multipliers are completed on the constraint surface, outputs ``z``,
+scipy baselines; the multipliers are completed on the constraint surface from a fixed start, ``project = true``
+is refused; outputs ``z``,
 ``q``, ``p``, ``energy``, ``constraint_residual``). Parameters of a Lagrangian are
 overridden under ``[system] parameters``. A system with generalized forces (``forces``
 in its system file or inline) or a scene with ``[[impulses]]`` (``t = 0.5``,
@@ -498,6 +499,11 @@ def _analysed_problem(lagrangian: Lagrangian, overrides: dict, initial: dict, so
     analysis completes the initial state on the constraint surface."""
     from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
 
+    if validate_boolean(initial.get("project", False), scene_label(source, "[initial] project")):
+        # the values given are held and the rest completed on the surface: nothing would be projected
+        raise InputError(f"{source}: [initial] project = true: {lagrangian.name!r} runs on the Dirac flow of its "
+                         "analysis, whose initial state is completed on the constraint surface from q and q_dot "
+                         "(or p); set project = false and give values on the surface")
     analysed = AnalysedSystem.from_lagrangian(lagrangian, overrides)
     names = tuple(s.name for s in lagrangian.coordinates)
     if "q" not in initial:
@@ -505,10 +511,10 @@ def _analysed_problem(lagrangian: Lagrangian, overrides: dict, initial: dict, so
     q = dict(zip(names, _coordinates(initial["q"], "q", names, source, required=True).tolist()))
     if "p" in initial:
         p = dict(zip(names, _coordinates(initial["p"], "p", names, source, required=False).tolist()))
-        z0 = analysed.initial_state(q, p=p)
+        z0 = analysed.initial_state(q, p=p, seed=0)
     else:
         velocity = dict(zip(names, _coordinates(initial.get("q_dot", {}), "q_dot", names, source, required=False).tolist()))
-        z0 = analysed.initial_state(q, q_dot=velocity)
+        z0 = analysed.initial_state(q, q_dot=velocity, seed=0)
     try:
         return AnalysedProblem(analysed, z0)
     except InputError as exc:

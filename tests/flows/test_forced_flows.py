@@ -187,6 +187,33 @@ def test_impulse_between_grid_points_is_landed_on(damped_pendulum):
     assert np.max(np.abs(theta - reference)) < 3e-8
 
 
+@pytest.mark.parametrize("method", ["forced-rattle-2", "forced-rattle-4", "midpoint"])
+def test_several_impulses_inside_one_step_each_act_at_its_time(method):
+    """A free particle (L = m x_dot^2 / 2, the force -c x_dot with c = 0 so that it is a forced
+    system): by hand x(T) = x0 + v0 T + sum_i J_i (T - t_i) / m, which these one-step methods
+    reproduce to rounding (the velocity is constant between impulses). Impulses at 0.55 and
+    0.57 (and a third at 0.57) fall inside one step of dt = 0.1. The step was advanced past its
+    end once per extra impulse: x(T) was off by about (J_2 + J_3) dt / m."""
+    particle = dirac.Lagrangian.from_strings("free", ["x"], "m/2*x_dot**2", parameters={"m": 2.0, "c": 0.0},
+                                             forces={"x": "-c*x_dot"})
+    impulses = [(0.55, {"x": 1.0}), (0.57, {"x": 0.5}), (0.57, {"x": -0.25}), (0.8, {"x": 0.125})]
+    problem = ForcedProblem(particle, [0.3], [0.4], impulses=impulses)
+    sol = dirac.integrate(problem, method, t_end=1.0, dt=0.1, samples=3, outputs=["q", "q_dot"])
+    expected = 0.3 + 0.2 * 1.0 + sum(J["x"] * (1.0 - t) for t, J in impulses) / 2.0
+    assert sol.outputs["q"][-1][0] == pytest.approx(expected, abs=1e-14)
+    assert sol.outputs["q_dot"][-1][0] == pytest.approx(0.2 + sum(J["x"] for _, J in impulses) / 2.0, abs=1e-14)
+
+
+def test_two_impulses_at_one_time_inside_a_step_act_as_their_sum(damped_pendulum):
+    """The projected impulse is linear in J (apply_impulse), so two blows at one time give the
+    state of one blow with their sum."""
+    two = ForcedProblem(damped_pendulum, *_start(0.7), impulses=[(0.55, {"x": 1.0}), (0.55, {"y": 0.5})])
+    one = ForcedProblem(damped_pendulum, *_start(0.7), impulses=[(0.55, {"x": 1.0, "y": 0.5})])
+    runs = [dirac.integrate(p, "forced-rattle-2", t_end=1.0, dt=0.1, samples=2, outputs=["q", "p"]) for p in (two, one)]
+    assert np.allclose(runs[0].outputs["q"][-1], runs[1].outputs["q"][-1], rtol=0, atol=1e-13)
+    assert np.allclose(runs[0].outputs["p"][-1], runs[1].outputs["p"][-1], rtol=0, atol=1e-13)
+
+
 def test_impulses_before_the_start_are_refused(damped_pendulum):
     with pytest.raises(InputError, match="not after the start"):
         ForcedProblem(damped_pendulum, *_start(0.3), impulses=[(-1.0, {"x": 1.0})])

@@ -64,10 +64,16 @@ class ImpulsesBetweenSteps:
             self.work[b] += work
 
     def step(self, n_steps: int, dt: float) -> None:
+        """``n_steps`` steps of the grid ``start + k dt``. A step with impulses inside is cut
+        at each of them: pieces from the grid point to the first impulse, between the
+        impulses (none between two at one time) and from the last to the next grid point,
+        counted as one step; an impulse on a grid point (within ``1e-9 dt``) acts between
+        two steps."""
         start = self.time
         end = start + n_steps * dt
+        slack = _GRID_SLACK * dt
         done = 0
-        while self.pending and self.pending[0].t <= end + _GRID_SLACK * dt:
+        while self.pending and self.pending[0].t <= end + slack:
             impulse = self.pending.pop(0)
             offset = (impulse.t - (start + done * dt)) / dt  # steps from here to the impulse
             whole = int(math.floor(offset + _GRID_SLACK))
@@ -75,12 +81,26 @@ class ImpulsesBetweenSteps:
             self._advance(whole, dt)
             done += whole
             self.time = start + done * dt
-            if cut > _GRID_SLACK * dt:
+            if cut > slack:
+                step_end = start + (done + 1) * dt
                 self._advance(1, cut)
                 self.time = impulse.t
                 self._kick(impulse)
-                self._advance(1, dt - cut)
-                self.steps -= 1  # the two pieces of the cut step count as one step of the grid
+                covered, pieces = cut, 1
+                # further impulses inside the same step: each cut from the last (the step's
+                # state is now at the last impulse's time, not at a grid point)
+                while self.pending and self.pending[0].t < step_end - slack:
+                    following = self.pending.pop(0)
+                    piece = following.t - impulse.t
+                    if piece > slack:
+                        self._advance(1, piece)
+                        covered += piece
+                        pieces += 1
+                    self.time = following.t
+                    self._kick(following)
+                    impulse = following
+                self._advance(1, dt - covered)
+                self.steps -= pieces  # the pieces of the cut step count as one step of the grid
                 done += 1
                 self.time = start + done * dt
             else:

@@ -148,6 +148,10 @@ class TorquedStepper(RigidBodyStepper):
                             1, cell, self.newton_tolerance, self.max_iterations)
 
     def step(self, n_steps: int, dt: float) -> None:
+        """``n_steps`` steps of the grid ``t0 + k dt``; a step with impulses inside is cut at
+        each of them (pieces from the grid point to the first, between them, and from the last
+        to the next grid point); impulses on a grid point (within ``1e-9 dt``) act between
+        two steps."""
         t0 = self.t
         target = t0 + n_steps * dt
         done = 0
@@ -161,9 +165,18 @@ class TorquedStepper(RigidBodyStepper):
             t_here = t0 + done * dt
             rest = t_impulse - t_here
             if rest > slack and done < n_steps:  # the impulse falls inside the next step: cut it there
+                step_end = t0 + (done + 1) * dt
                 self._advance_or_fail(1, rest, t_here, done)
                 self._apply_impulses_at(t_impulse)
-                self._advance_or_fail(1, dt - rest, t_impulse, done)
+                covered, at = rest, t_impulse
+                # later impulses inside the same step: cut at each (the body is at the last one's time)
+                while self._next < len(self.impulses) and self.impulses[self._next].t < step_end - slack:
+                    following = self.impulses[self._next].t
+                    self._advance_or_fail(1, following - at, at, done)
+                    self._apply_impulses_at(following)
+                    covered += following - at
+                    at = following
+                self._advance_or_fail(1, dt - covered, at, done)
                 done += 1
             else:
                 self._apply_impulses_at(t_impulse)
