@@ -12,9 +12,9 @@ batch) advances them by :func:`dirac.rigidbody.batch.advance_batch`: blocks of
 :func:`compute_rigid_chunk` runs a chunk of members through one compiled call,
 :func:`_rb_run`: ``numba.prange`` over the blocks of members, and for each block the whole
 sample grid ``t_k = k t_end / (samples - 1)`` -- the same ``rotate_block`` sub-flows in
-the same order, in calls of at most ``min(steps per sample, CALL_STEPS)`` steps whose
-adjacent half-steps are merged (first-same-as-last) exactly as one ``advance_batch`` call
-merges them -- recording the trajectory outputs and updating the reductions at every
+the same order, the steps of each sample interval merged (first-same-as-last: adjacent
+half-steps of the same sub-flow joined) exactly as one ``advance_batch`` call over that
+interval merges them -- recording the trajectory outputs and updating the reductions at every
 sample inside the loop (no Python loop over samples or members). The attitude rows are
 neither loaded nor turned when no output needs ``R`` (``with_R``).
 
@@ -45,12 +45,7 @@ from dirac.ensemble.kernel_lock import KERNEL_LOCK
 from dirac.ensemble.scene import TRAJECTORY_OUTPUTS, EnsembleScene
 from dirac.rigidbody.batch import BLOCK, choose_trigonometry, composed_sequence, rotate_block
 
-__all__ = ["CALL_STEPS", "compute_rigid_chunk", "warm_up"]
-
-#: Most steps merged into one call of the composed step (first-same-as-last across the
-#: steps of a call), as a single run's fixed-step loop cuts a sample interval
-#: (:data:`dirac.flows.integration.CHUNK_STEPS`).
-CALL_STEPS = 20_000
+__all__ = ["compute_rigid_chunk", "warm_up"]
 
 # what the loop records (indices into its ``wants`` flags)
 _WANT_M, _WANT_R, _WANT_ENERGY, _WANT_CASIMIR, _WANT_LAB, _FLIP, _ENERGY_ERROR, _CASIMIR_ERROR = range(8)
@@ -106,7 +101,7 @@ def _record(X, width, start, k, wants, TM, TR, TE, TC, TL):
 
 
 @njit(cache=True, parallel=True)
-def _rb_run(M, R, inv, axes, fractions, dt, times, per_interval, call, with_R, trig, n_workers, wants, cols,
+def _rb_run(M, R, inv, axes, fractions, dt, times, per_interval, with_R, trig, n_workers, wants, cols,
             TM, TR, TE, TC, TL, FLIP, EERR, CERR):
     """Advance every member over the sample grid ``times``, recording outputs and reductions.
 
@@ -154,16 +149,13 @@ def _rb_run(M, R, inv, axes, fractions, dt, times, per_interval, call, with_R, t
                     CERR[b] = 0.0
             _record(X, width, start, 0, wants, TM, TR, TE, TC, TL)
             for k in range(1, times.shape[0]):
-                done = 0
-                while done < per_interval:  # one call of the composed step: half-steps merged within it
-                    n_steps = min(call, per_interval - done)
-                    rotate_block(X, S, C, width, axes[0], fd[0], with_R, trig)
-                    for step in range(n_steps):
-                        for q in range(1, last):
-                            rotate_block(X, S, C, width, axes[q], fd[q], with_R, trig)
-                        h_last = fd_join if step < n_steps - 1 else fd[last]
-                        rotate_block(X, S, C, width, axes[last], h_last, with_R, trig)
-                    done += n_steps
+                # the interval's steps, half-steps merged between them (as advance_batch)
+                rotate_block(X, S, C, width, axes[0], fd[0], with_R, trig)
+                for step in range(per_interval):
+                    for q in range(1, last):
+                        rotate_block(X, S, C, width, axes[q], fd[q], with_R, trig)
+                    h_last = fd_join if step < per_interval - 1 else fd[last]
+                    rotate_block(X, S, C, width, axes[last], h_last, with_R, trig)
                 _record(X, width, start, k, wants, TM, TR, TE, TC, TL)
                 t_prev = times[k - 1]
                 t = times[k]
@@ -257,7 +249,7 @@ def compute_rigid_chunk(scene: EnsembleScene, start: int, stop: int,
     if n > 0:
         with KERNEL_LOCK:
             _rb_run(M, R_arg, inv, axes, fractions, float(scene.dt), scene.times(), scene.steps_per_sample,
-                    min(scene.steps_per_sample, CALL_STEPS), with_R, trig, n_workers, wants, cols,
+                    with_R, trig, n_workers, wants, cols,
                     TM, TR, TE, TC, TL, FLIP, EERR, CERR)
     trajectories = {"M": TM, "R": TR, "energy": TE, "casimir": TC, "lab_momentum": TL}
     arrays: dict[str, np.ndarray] = {name: trajectories[name] for name in scene.outputs if name in TRAJECTORY_OUTPUTS}
