@@ -217,9 +217,9 @@ def compute_rigid_chunk(scene: EnsembleScene, start: int, stop: int,
     R = np.ascontiguousarray(R, dtype=float)
     inertia = np.ascontiguousarray(inertia, dtype=float)
     n = M.shape[0]
-    results: dict[str, np.ndarray] = {}
+    initial: dict[str, np.ndarray] = {}  # the drawn data, before the loop overwrites M and R
     if "initial_state" in scene.reductions:
-        results.update(initial_M=M.copy(), initial_R=R.copy(), inertia=inertia.copy())
+        initial.update(initial_M=M.copy(), initial_R=R.copy(), inertia=inertia.copy())
     inv = np.ascontiguousarray(1.0 / inertia)
     axes, fractions = composed_sequence(tuple(float(c) for c in scene.coefficients))
     wants = np.zeros(8, dtype=np.bool_)
@@ -263,7 +263,7 @@ def compute_rigid_chunk(scene: EnsembleScene, start: int, stop: int,
         elif name == "final_state":
             arrays.update(final_M=M, final_R=R)
         elif name == "initial_state":
-            arrays.update(results)
+            arrays.update(initial)
     return arrays
 
 
