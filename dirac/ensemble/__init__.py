@@ -5,8 +5,9 @@ Modules, one job each:
 - :mod:`dirac.ensemble.scene` -- ``[ensemble]`` scenes, validated (:func:`load_ensemble_scene`);
 - :mod:`dirac.ensemble.distributions` -- named distributions of ``M``, ``R``, inertia;
 - :mod:`dirac.ensemble.sampling` -- counter-based draws keyed by ``(seed, member)``;
-- :mod:`dirac.ensemble.reductions` -- streaming per-member summaries (flip time, ...);
-- :mod:`dirac.ensemble.chunk` -- one chunk: draw, advance (batched kernel), reduce;
+- :mod:`dirac.ensemble.reductions` -- the free rigid body's per-member summaries and their arrays;
+- :mod:`dirac.ensemble.rigid_members` -- the free rigid body's member loop (a batched run's kernel, compiled);
+- :mod:`dirac.ensemble.chunk` -- one chunk: draw, run the scene's member loop;
 - :mod:`dirac.ensemble.store` -- zarr store, per-chunk markers, atomic ``meta.json``;
 - :mod:`dirac.ensemble.chunk_plan` -- the default chunk size and each chunk's members;
 - :mod:`dirac.ensemble.run_record` -- ``meta.json``: what the ensemble is, which chunks are done;

@@ -81,10 +81,11 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
         figures stay meaningful on a machine shared with other jobs, where wall times
         are not.
     """
-    from dirac.ensemble.chunk import advance_members, warm_up
+    from dirac.ensemble.chunk import KERNEL_LOCK, warm_up
     from dirac.ensemble.chunk_plan import default_chunk_size
     from dirac.ensemble.dask_executor import dask_client, local_cluster
     from dirac.ensemble.engine import run_ensemble
+    from dirac.rigidbody.batch import advance_batch
 
     dt = 0.01
     scene = _scene(members, steps, dt)
@@ -99,7 +100,8 @@ def measure(members: int, steps: int, workers: int = 2, repeats: int = 2) -> dic
         M, R, inertia = scene.source.members(0, members)
         inv = 1.0 / inertia
         wall_mid, cpu_mid = time.perf_counter(), time.process_time()
-        advance_members(M, R, inv, dt, steps, scene.coefficients, True)
+        with KERNEL_LOCK:
+            advance_batch(M, R, inv, dt, steps, scene.coefficients, True)
         wall_end, cpu_end = time.perf_counter(), time.process_time()
         plain_runs.append((wall_end - wall, cpu_end - cpu))
         kernel_runs.append((wall_end - wall_mid, cpu_end - cpu_mid))

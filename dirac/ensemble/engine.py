@@ -12,7 +12,7 @@
    (:func:`_run_missing`):
 
    * local (default, :mod:`dirac.ensemble.local_executor`): the chunks one after the
-     other, each advanced by the batched kernel in parallel over all cores (numba), the
+     other, each run by the scene's member loop in parallel over all cores (numba), the
      write of chunk ``i`` overlapping the computation of chunk ``i + 1``;
    * dask (``scheduler=ADDRESS``, ``cluster="local"`` or a ``client``,
      :mod:`dirac.ensemble.dask_executor`): one task per chunk; each task draws,

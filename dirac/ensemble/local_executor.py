@@ -1,6 +1,6 @@
 """The local executor of the ensemble engine: chunk after chunk on this machine.
 
-Each chunk is advanced by the batched kernel in parallel over all cores (numba); the
+Each chunk is run by the scene's member loop in parallel over all cores (numba); the
 members of the next chunk are drawn, and the previous chunk is written, while a chunk is
 integrated. A failing chunk is tried ``retries + 1`` times, then reported (never dropped).
 """

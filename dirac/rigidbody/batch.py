@@ -36,6 +36,9 @@ __all__ = [
     "MAX_POLY_ANGLE",
     "advance_batch",
     "advance_batch_numpy",
+    "choose_trigonometry",
+    "composed_sequence",
+    "rotate_block",
     "sincos_poly",
     "sincos_poly_array",
 ]
@@ -187,7 +190,7 @@ _TRIG_SMALL = 2  # |theta| <= pi/4 for every sub-step: polynomial, no reduction 
 
 
 @njit(cache=True)
-def _rotate_block(X, S, C, width, k, h, with_R, trig):
+def rotate_block(X, S, C, width, k, h, with_R, trig):
     """One exact sub-flow ``H_k`` for the ``width`` bodies of the SoA block ``X``.
 
     ``X`` rows: 0-2 ``M``, 3-5 ``1/I``, 6-14 ``R`` (row-major); ``S``, ``C`` scratch rows.
@@ -258,12 +261,12 @@ def _advance_blocks(M, R, inv, axes, fractions, dt, n_steps, with_R, trig, n_wor
                         for col in range(3):
                             X[6 + 3 * a + col, i] = R[b, a, col]
             # first sub-step, then per step the inner ones and the (merged) last one
-            _rotate_block(X, S, C, width, axes[0], fd[0], with_R, trig)
+            rotate_block(X, S, C, width, axes[0], fd[0], with_R, trig)
             for step in range(n_steps):
                 for q in range(1, last):
-                    _rotate_block(X, S, C, width, axes[q], fd[q], with_R, trig)
+                    rotate_block(X, S, C, width, axes[q], fd[q], with_R, trig)
                 h_last = fd_join if step < n_steps - 1 else fd[last]
-                _rotate_block(X, S, C, width, axes[last], h_last, with_R, trig)
+                rotate_block(X, S, C, width, axes[last], h_last, with_R, trig)
             for i in range(width):
                 b = start + i
                 for a in range(3):
@@ -275,7 +278,7 @@ def _advance_blocks(M, R, inv, axes, fractions, dt, n_steps, with_R, trig, n_wor
 
 
 @lru_cache(maxsize=64)
-def _sequence(coefficients: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+def composed_sequence(coefficients: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
     """Axes and step fractions of the merged composed step (inertia-independent).
 
     Cached: an ensemble calls the kernel once per sample with the same coefficients. The
@@ -300,7 +303,7 @@ def _prepare(
     n_steps = int(n_steps)
     if n_steps <= 0 or M.shape[0] == 0:
         return None
-    axes, fractions = _sequence(tuple(float(c) for c in coefficients))
+    axes, fractions = composed_sequence(tuple(float(c) for c in coefficients))
     return inv, n_steps, axes, fractions
 
 
@@ -375,7 +378,23 @@ def advance_batch(
     if prepared is None:
         return
     inv, n_steps, axes, fractions = prepared
-    # largest rotation angle of any sub-step: |theta| <= max(fraction) |dt| max(1/I) |M|
+    trig = choose_trigonometry(M, inv, fractions, dt)
+    R_arg = R if with_R else np.zeros((1, 3, 3))
+    n_workers = max(1, min(_num_threads(), -(-M.shape[0] // BLOCK)))
+    _advance_blocks(M, R_arg, inv, axes, fractions, float(dt), n_steps, bool(with_R), trig, n_workers)
+
+
+def choose_trigonometry(M: np.ndarray, inv: np.ndarray, fractions: np.ndarray, dt: float) -> int:
+    """The trigonometry of :func:`rotate_block` for bodies ``M`` (rows) with ``1/I`` ``inv``.
+
+    From the largest rotation angle of any sub-step,
+    ``|theta| <= (max |fraction| + |fraction_0|) |dt| max(1/I) max |M|`` (the merged
+    first-same-as-last sub-step included): libm ``sin``/``cos`` beyond
+    :data:`MAX_POLY_ANGLE` (or a non-finite bound), the plain polynomial kernels when every
+    angle is within ``pi/4``, else reduction and polynomials (:func:`sincos_poly`).
+    """
+    if M.shape[0] == 0:
+        return _TRIG_SMALL
     bound = (
         float(np.max(np.abs(fractions)) + np.abs(fractions[0]))
         * abs(float(dt))
@@ -383,14 +402,10 @@ def advance_batch(
         * float(np.sqrt(np.max(np.einsum("ij,ij->i", M, M))))
     )
     if not np.isfinite(bound) or bound > MAX_POLY_ANGLE:
-        trig = _TRIG_LIBM
-    elif bound <= 0.25 * math.pi:
-        trig = _TRIG_SMALL
-    else:
-        trig = _TRIG_POLY
-    R_arg = R if with_R else np.zeros((1, 3, 3))
-    n_workers = max(1, min(_num_threads(), -(-M.shape[0] // BLOCK)))
-    _advance_blocks(M, R_arg, inv, axes, fractions, float(dt), n_steps, bool(with_R), trig, n_workers)
+        return _TRIG_LIBM
+    if bound <= 0.25 * math.pi:
+        return _TRIG_SMALL
+    return _TRIG_POLY
 
 
 def _num_threads() -> int:
