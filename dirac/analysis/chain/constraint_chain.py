@@ -1033,7 +1033,7 @@ class ConstraintChain:
             return independent_rows(cand_sparse, list(range(len(candidates))), base=base_sparse, notes=self.regularity_notes)
         cand = gradient_values(self.phase_space, self.numerics, candidates, points)
         base = list(gradient_values(self.phase_space, self.numerics, old, points)) if old else None
-        return independent_rows(list(cand), list(range(len(candidates))), base=base)
+        return independent_rows(list(cand), list(range(len(candidates))), base=base, equilibrate=True)
 
     def _eliminate(self, row, needed, constraints, P, Q, A_num, b_zero):
         """``psi_a = b_a - c_a . b_P`` for a row that shares multipliers with the pivot rows ``needed``.

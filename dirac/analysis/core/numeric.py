@@ -121,8 +121,26 @@ def columns_invertible_everywhere(matrices: Sequence[np.ndarray], rows: Sequence
     return []
 
 
+def unit_rows(rows: np.ndarray) -> np.ndarray:
+    """``rows`` each divided by its length (a zero or non-finite row is left as it is).
+
+    Rows already kept as independent enter a rank decision at unit length: the numerical
+    rank is relative to the largest singular value, and a kept row far shorter than the row
+    being tested counted as nearly zero. Whether a constraint is new must not depend on the
+    constant factors the constraints carry (``chi`` and ``10^6 chi`` are one surface): a
+    stage-4 gradient ``5e5 dq1 - 0.5 dlambda`` (near a pole of its coefficients) beside the
+    kept ``dq1`` made the stack's smallest singular value ``2e-12`` of its largest, and the
+    condition ``lambda = 0`` was dropped as dependent (Golub & Van Loan, *Matrix
+    Computations*, Sect. 3.5.2: row equilibration).
+    """
+    norms = np.linalg.norm(rows, axis=1, keepdims=True)
+    safe = np.where((norms > 0.0) & np.isfinite(norms), norms, 1.0)
+    return rows / safe
+
+
 def independent_rows(
-    matrices: Sequence[Any], order: Sequence[int], base: Sequence[Any] | None = None, notes: list[str] | None = None
+    matrices: Sequence[Any], order: Sequence[int], base: Sequence[Any] | None = None, notes: list[str] | None = None,
+    equilibrate: bool = False,
 ) -> list[int]:
     """Greedy choice of rows that raise the rank, in the given order of preference.
 
@@ -138,6 +156,10 @@ def independent_rows(
 
     notes
         Where a note is added when sparse rows could not be decided by elimination.
+    equilibrate
+        Rows of gradients of constraints: the rows already kept enter each decision at unit
+        length (:func:`unit_rows`), so that the constant factors the constraints carry do
+        not decide whether a new one is independent (dense path).
 
     Returns
     -------
@@ -175,8 +197,13 @@ def independent_rows(
                 stack.insert(0, base[k])
             current = np.vstack(stack) if stack else np.zeros((0, m.shape[1]))
             scale = (np.max(np.abs(m)) if m.size else 0.0) or 1.0  # an all-zero matrix has rank 0, not NaN
-            before = numeric_rank(current / scale) if len(current) else 0
-            after = numeric_rank(np.vstack([current, m[row : row + 1]]) / scale)
+            if equilibrate:  # the kept rows at unit length, the new one relative to its matrix (round-off stays small)
+                current = unit_rows(current)
+                before = numeric_rank(current) if len(current) else 0
+                after = numeric_rank(np.vstack([current, m[row : row + 1] / scale]))
+            else:
+                before = numeric_rank(current / scale) if len(current) else 0
+                after = numeric_rank(np.vstack([current, m[row : row + 1]]) / scale)
             votes += after > before
         if 2 * votes > len(matrices):
             chosen.append(row)
