@@ -17,6 +17,7 @@ they do not are found by :mod:`dirac.analysis.chain.special_values`).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -26,7 +27,8 @@ import sympy
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
-from dirac.codegen import UnsupportedExpression, array_function, scalar_function
+from dirac.analysis.core.scaled_function import scaled_function, terms_of
+from dirac.codegen import UnsupportedExpression, array_function
 from dirac.errors import AnalysisError
 
 __all__ = ["Numerics", "RankTest", "SingularSurface", "numeric_rank", "independent_rows"]
@@ -222,6 +224,8 @@ class Numerics:
         self.rng = np.random.default_rng(seed)
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
+        #: batches compiled by :func:`scaled_function`: they also give their expressions' term sizes
+        self._scaled: set[int] = set()
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
@@ -244,7 +248,7 @@ class Numerics:
         variables, no notes.
         """
         other = Numerics(self.phase_space, parameter_values, seed=seed, time=self.time)
-        other._index, other._batches = self._index, self._batches
+        other._index, other._batches, other._scaled = self._index, self._batches, self._scaled
         return other
 
     # ------------------------------------------------------------------ compiled functions
@@ -296,19 +300,22 @@ class Numerics:
         if not missing:
             return
         raw: Callable
+        batch = len(self._batches)
         try:
-            raw = scalar_function(self._args, missing)
+            scaled = scaled_function(self._args, missing)
+            raw = partial(scaled, False)
+            self._scaled.add(batch)
         except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
             raw = array_function(self._args, missing)
-        batch = len(self._batches)
         self._batches.append(raw)
         for i, e in enumerate(missing):
             self._index[e] = (batch, i)
 
-    def _call(self, batch: int, z: np.ndarray) -> np.ndarray:
-        """The values of one compiled batch at ``z`` (real parts of complex values)."""
+    def _call(self, batch: int, z: np.ndarray, sizes: bool = False) -> np.ndarray:
+        """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes."""
+        fn = self._batches[batch].func if sizes else self._batches[batch]  # a scaled batch's own function
         with np.errstate(all="ignore"):
-            out = self._batches[batch](*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
+            out = fn(*([True] if sizes else []), *np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
         try:
             values = np.asarray(out)
             if values.dtype.kind == "c":  # a complex value (a root of a negative number): its real part
@@ -332,14 +339,46 @@ class Numerics:
         return [jacobian(z) for z in points]
 
     def term_scale(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
-        """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests)."""
+        """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests).
+
+        The terms are added in their order (``((1 + |t_1|) + |t_2|) + ...``). An expression
+        compiled by :func:`~dirac.analysis.core.scaled_function.scaled_function` gives its
+        term sizes from the same compiled function as its value; only the others' terms are
+        compiled on their own.
+        """
         exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        zero = sympy.S.Zero
+        self._compile([e for e in exprs if e is not zero])
+        index, scaled = self._index, self._scaled
+        fused: dict[int, tuple[int, int]] = {}  # position -> (batch, index in it) of a scaled batch
+        for k, e in enumerate(exprs):
+            at = index.get(e)
+            if at is not None and at[0] in scaled:
+                fused[k] = at
+        if not fused:
+            return self._term_scale(exprs, points)
+        scale = np.ones((len(points), len(exprs)))
+        rest = [k for k in range(len(exprs)) if k not in fused]
+        if rest:
+            scale[:, rest] = self._term_scale([exprs[k] for k in rest], points)
+        gathers = [
+            (b, np.array([k for k, (c, _) in fused.items() if c == b], dtype=np.intp),
+             np.array([i for c, i in fused.values() if c == b], dtype=np.intp))
+            for b in sorted({c for c, _ in fused.values()})
+        ]
+        for row, z in enumerate(points):
+            for b, where, picks in gathers:
+                scale[row, where] = self._call(b, z, sizes=True)[picks]
+        return scale
+
+    def _term_scale(self, exprs: list[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
+        """:meth:`term_scale` from the terms compiled as expressions of their own."""
         split = self._terms.get(tuple(exprs))
         if split is None:
             terms: list[sympy.Expr] = []
             owner: list[int] = []
             for k, e in enumerate(exprs):
-                parts = e.args if isinstance(e, sympy.Add) else (e,)
+                parts = terms_of(e)
                 terms.extend(parts)
                 owner.extend([k] * len(parts))
             split = (terms, np.asarray(owner, dtype=np.intp))
