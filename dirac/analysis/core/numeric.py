@@ -544,7 +544,8 @@ class Numerics:
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
             for i, v in fixed.items():
                 z[i] = v
-            step_free = np.setdiff1d(free, self._held_variables(free))
+            held = self._held_variables(free)
+            step_free = np.setdiff1d(free, held) if held.size else free  # free: sorted and distinct already
             if jacobian is None:
                 points.append(z)
                 continue
