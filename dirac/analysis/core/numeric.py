@@ -313,9 +313,16 @@ class Numerics:
 
     def _call(self, batch: int, z: np.ndarray, sizes: bool = False) -> np.ndarray:
         """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes."""
-        fn = self._batches[batch].func if sizes else self._batches[batch]  # a scaled batch's own function
-        with np.errstate(all="ignore"):
-            out = fn(*([True] if sizes else []), *np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
+        args = [*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist()]
+        if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
+            out = self._batches[batch].func(True, *args) if sizes else self._batches[batch](*args)
+            try:
+                return np.array(out, dtype=float)
+            except TypeError:  # a complex value: its real part, below
+                pass
+        else:
+            with np.errstate(all="ignore"):
+                out = self._batches[batch](*args)
         try:
             values = np.asarray(out)
             if values.dtype.kind == "c":  # a complex value (a root of a negative number): its real part
