@@ -25,9 +25,9 @@ import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.scaled_function import ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
-from dirac.analysis.core.scaled_function import scaled_function, terms_of
 from dirac.codegen import UnsupportedExpression, array_function
 from dirac.errors import AnalysisError
 
@@ -225,7 +225,7 @@ class Numerics:
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
         #: batches compiled by :func:`scaled_function`: they also give their expressions' term sizes
-        self._scaled: set[int] = set()
+        self._scaled: dict[int, ScaledFunction] = {}
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
@@ -304,7 +304,7 @@ class Numerics:
         try:
             scaled = scaled_function(self._args, missing)
             raw = partial(scaled, False)
-            self._scaled.add(batch)
+            self._scaled[batch] = scaled
         except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
             raw = array_function(self._args, missing)
         self._batches.append(raw)
@@ -315,7 +315,7 @@ class Numerics:
         """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes."""
         args = [*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist()]
         if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
-            out = self._batches[batch].func(True, *args) if sizes else self._batches[batch](*args)
+            out = self._scaled[batch](True, *args) if sizes else self._batches[batch](*args)
             try:
                 return np.array(out, dtype=float)
             except TypeError:  # a complex value: its real part, below
