@@ -64,9 +64,10 @@ _PRINTED: dict[sympy.Basic, str] = {}
 PRINTED_KEPT = 256
 
 #: texts of sub-trees printed before, per printer settings (:class:`_SharedTextPrinter`);
-#: each memo is emptied when it holds more than SUBTREES_KEPT sub-trees
+#: each memo is emptied when its texts hold more than SUBTREE_CHARACTERS characters
 _SUBTREES: dict[tuple, dict[sympy.Basic, str]] = {}
-SUBTREES_KEPT = 200_000
+SUBTREE_CHARACTERS = 20_000_000
+_subtree_characters: dict[tuple, int] = {}
 
 
 class _SharedTextPrinter(StrPrinter):
@@ -82,10 +83,11 @@ class _SharedTextPrinter(StrPrinter):
 
     def __init__(self, settings: dict | None = None) -> None:
         super().__init__(settings)
-        key = tuple(sorted((k, repr(v)) for k, v in self._settings.items()))
-        self._memo = _SUBTREES.setdefault(key, {})
-        if len(self._memo) > SUBTREES_KEPT:
+        self._key = tuple(sorted((k, repr(v)) for k, v in self._settings.items()))
+        self._memo = _SUBTREES.setdefault(self._key, {})
+        if _subtree_characters.get(self._key, 0) > SUBTREE_CHARACTERS:
             self._memo.clear()
+            _subtree_characters[self._key] = 0
 
     def _print(self, expr: Any, **kwargs: Any) -> str:
         if kwargs or not isinstance(expr, sympy.Basic) or not expr.args:
@@ -94,6 +96,7 @@ class _SharedTextPrinter(StrPrinter):
         if hit is None:
             hit = super()._print(expr)
             self._memo[expr] = hit
+            _subtree_characters[self._key] = _subtree_characters.get(self._key, 0) + len(hit)
         return hit
 
 

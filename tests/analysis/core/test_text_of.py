@@ -36,3 +36,20 @@ def test_same_text_as_sympy() -> None:
 def test_hand_written_text() -> None:
     """x*y + (x*y)**2 prints as written by hand: x**2*y**2 + x*y."""
     assert text_of(x * y + (x * y) ** 2) == "x**2*y**2 + x*y"
+
+
+def test_memo_emptied_past_its_bound(monkeypatch) -> None:
+    """With a bound of 10 characters the memo is emptied before each print: it then holds what
+    printing that expression alone leaves in an empty memo, and the texts stay sympy's."""
+    from dirac.analysis.core import algebra
+
+    memo = algebra._SUBTREES.setdefault(algebra._SharedTextPrinter({"order": None})._key, {})
+    alone = []
+    for e in _expressions():
+        memo.clear()
+        text_of(e)
+        alone.append(dict(memo))
+    monkeypatch.setattr(algebra, "SUBTREE_CHARACTERS", 10)
+    for e, expected in zip(_expressions(), alone):
+        assert text_of(e) == str(e)
+        assert memo == expected
