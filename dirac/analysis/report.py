@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import sympy
 
-from dirac.analysis.core.algebra import printed, printed_at_most
+from dirac.analysis.core.algebra import printed, printed_at_most, text_of
 from dirac.analysis.gauge.generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
@@ -145,7 +145,7 @@ def expression_text(expr: sympy.Expr) -> str:
     longest = printed_at_most(expr, ORDERED_LIMIT + 1)
     if longest is not None and longest <= ORDERED_LIMIT:  # short in any order: no need to measure it
         return printed(expr)
-    text = sympy.sstr(expr, order="none")
+    text = text_of(expr, order="none")
     return printed(expr) if len(text) <= ORDERED_LIMIT else text
 
 
@@ -172,7 +172,7 @@ def _latex(expr: sympy.Expr) -> str:
     if size > TREE_LIMIT:
         return rf"\text{{(an expression of {size} tree nodes; see --json)}}"
     names = latex_names(expr)
-    if len(sympy.sstr(expr, order="none")) <= ORDERED_LIMIT:
+    if len(text_of(expr, order="none")) <= ORDERED_LIMIT:
         return sympy.latex(expr, symbol_names=names)
     return sympy.latex(expr, order="none", symbol_names=names)
 

@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 import sympy
-from scipy.sparse.linalg import MatrixRankWarning, splu
 
 from dirac.analysis.core.sparse_numeric import components, independent_rows_eliminated
 from dirac.analysis.legendre.regularity import IRREGULAR_GRADIENT, ROUND_OFF
@@ -72,6 +71,8 @@ def _normal_norms(base: sp.csr_matrix, rows: sp.csr_matrix) -> np.ndarray | None
     refinement (Björck, "Numerical Methods for Least Squares Problems", Sect. 2.9).
     ``None`` when a choice or a factorisation is not clear (the caller takes the dense path).
     """
+    from scipy.sparse.linalg import MatrixRankWarning, splu  # with scipy.linalg: imported when used
+
     norms = np.sqrt(np.asarray(rows.multiply(rows).sum(axis=1)).ravel())
     if base.shape[0]:
         chosen = independent_rows_eliminated([base], list(range(base.shape[0])))

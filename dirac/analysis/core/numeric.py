@@ -17,6 +17,7 @@ they do not are found by :mod:`dirac.analysis.chain.special_values`).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -24,9 +25,10 @@ import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.scaled_function import ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
-from dirac.codegen import UnsupportedExpression, array_function, scalar_function
+from dirac.codegen import UnsupportedExpression, array_function
 from dirac.errors import AnalysisError
 
 __all__ = ["Numerics", "RankTest", "SingularSurface", "numeric_rank", "independent_rows"]
@@ -249,6 +251,8 @@ class Numerics:
         self.rng = np.random.default_rng(seed)
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
+        #: batches compiled by :func:`scaled_function`: they also give their expressions' term sizes
+        self._scaled: dict[int, ScaledFunction] = {}
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
@@ -271,7 +275,7 @@ class Numerics:
         variables, no notes.
         """
         other = Numerics(self.phase_space, parameter_values, seed=seed, time=self.time)
-        other._index, other._batches = self._index, self._batches
+        other._index, other._batches, other._scaled = self._index, self._batches, self._scaled
         return other
 
     # ------------------------------------------------------------------ compiled functions
@@ -323,19 +327,29 @@ class Numerics:
         if not missing:
             return
         raw: Callable
+        batch = len(self._batches)
         try:
-            raw = scalar_function(self._args, missing)
+            scaled = scaled_function(self._args, missing)
+            raw = partial(scaled, False)
+            self._scaled[batch] = scaled
         except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
             raw = array_function(self._args, missing)
-        batch = len(self._batches)
         self._batches.append(raw)
         for i, e in enumerate(missing):
             self._index[e] = (batch, i)
 
-    def _call(self, batch: int, z: np.ndarray) -> np.ndarray:
-        """The values of one compiled batch at ``z`` (real parts of complex values)."""
-        with np.errstate(all="ignore"):
-            out = self._batches[batch](*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist())
+    def _call(self, batch: int, z: np.ndarray, sizes: bool = False) -> np.ndarray:
+        """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes."""
+        args = [*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist()]
+        if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
+            out = self._scaled[batch](True, *args) if sizes else self._batches[batch](*args)
+            try:
+                return np.array(out, dtype=float)
+            except TypeError:  # a complex value: its real part, below
+                pass
+        else:
+            with np.errstate(all="ignore"):
+                out = self._batches[batch](*args)
         try:
             values = np.asarray(out)
             if values.dtype.kind == "c":  # a complex value (a root of a negative number): its real part
@@ -359,14 +373,46 @@ class Numerics:
         return [jacobian(z) for z in points]
 
     def term_scale(self, exprs: Sequence[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
-        """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests)."""
+        """Size of each expression's terms at each point: ``1 + sum |term|`` (for relative zero tests).
+
+        The terms are added in their order (``((1 + |t_1|) + |t_2|) + ...``). An expression
+        compiled by :func:`~dirac.analysis.core.scaled_function.scaled_function` gives its
+        term sizes from the same compiled function as its value; only the others' terms are
+        compiled on their own.
+        """
         exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        zero = sympy.S.Zero
+        self._compile([e for e in exprs if e is not zero])
+        index, scaled = self._index, self._scaled
+        fused: dict[int, tuple[int, int]] = {}  # position -> (batch, index in it) of a scaled batch
+        for k, e in enumerate(exprs):
+            at = index.get(e)
+            if at is not None and at[0] in scaled:
+                fused[k] = at
+        if not fused:
+            return self._term_scale(exprs, points)
+        scale = np.ones((len(points), len(exprs)))
+        rest = [k for k in range(len(exprs)) if k not in fused]
+        if rest:
+            scale[:, rest] = self._term_scale([exprs[k] for k in rest], points)
+        gathers = [
+            (b, np.array([k for k, (c, _) in fused.items() if c == b], dtype=np.intp),
+             np.array([i for c, i in fused.values() if c == b], dtype=np.intp))
+            for b in sorted({c for c, _ in fused.values()})
+        ]
+        for row, z in enumerate(points):
+            for b, where, picks in gathers:
+                scale[row, where] = self._call(b, z, sizes=True)[picks]
+        return scale
+
+    def _term_scale(self, exprs: list[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
+        """:meth:`term_scale` from the terms compiled as expressions of their own."""
         split = self._terms.get(tuple(exprs))
         if split is None:
             terms: list[sympy.Expr] = []
             owner: list[int] = []
             for k, e in enumerate(exprs):
-                parts = e.args if isinstance(e, sympy.Add) else (e,)
+                parts = terms_of(e)
                 terms.extend(parts)
                 owner.extend([k] * len(parts))
             split = (terms, np.asarray(owner, dtype=np.intp))
@@ -532,7 +578,8 @@ class Numerics:
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
             for i, v in fixed.items():
                 z[i] = v
-            step_free = np.setdiff1d(free, self._held_variables(free))
+            held = self._held_variables(free)
+            step_free = np.setdiff1d(free, held) if held.size else free  # free: sorted and distinct already
             if jacobian is None:
                 points.append(z)
                 continue

@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
-from scipy.sparse.linalg import MatrixRankWarning, lsqr, splu
+
+from dirac.analysis.core.graphs import connected_components
 
 __all__ = ["independent_rows_one_pass", "independent_rows_eliminated", "Undecided", "CLEAR", "minimum_norm_step", "full_row_rank", "components", "ZERO"]
 
@@ -267,7 +267,7 @@ def independent_rows_eliminated(
 
 def components(pattern: sp.spmatrix) -> list[np.ndarray]:
     """Row sets of the connected components of the sparsity graph of a square ``pattern``."""
-    count, labels = connected_components(sp.csr_matrix(pattern != 0), directed=False)
+    count, labels = connected_components(sp.csr_matrix(pattern != 0))
     order = np.argsort(labels, kind="stable")
     cuts = np.flatnonzero(np.diff(labels[order])) + 1
     return [np.sort(block) for block in np.split(order, cuts)] if count else []
@@ -328,6 +328,8 @@ def _positive_definite(A: sp.csc_matrix) -> bool | None:
     backward stable). ``None`` when the solver had to pivot off the diagonal (a zero on
     it): the caller decides densely.
     """
+    from scipy.sparse.linalg import MatrixRankWarning, splu  # with scipy.linalg: imported when used
+
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", MatrixRankWarning)
@@ -347,6 +349,8 @@ def minimum_norm_step(jacobian: sp.spmatrix, residual: np.ndarray) -> np.ndarray
     minimum-norm solution, also for a rank-deficient ``J`` (reducible constraints): the
     step ``numpy.linalg.lstsq`` gives, without a dense factorisation.
     """
+    from scipy.sparse.linalg import MatrixRankWarning, lsqr, splu  # with scipy.linalg: imported when used
+
     J = sp.csr_matrix(jacobian, dtype=float)
     rhs = -np.asarray(residual, dtype=float)
     if J.shape[0] <= J.shape[1]:  # full row rank: dz = J^T y with J J^T y = -r, by sparse LU

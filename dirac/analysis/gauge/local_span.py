@@ -24,8 +24,8 @@ from collections.abc import Sequence
 import numpy as np
 import scipy.sparse as sp
 import sympy
-from scipy.sparse.csgraph import connected_components
 
+from dirac.analysis.core.graphs import connected_components
 from dirac.analysis.core.phase_space import PhaseSpace
 
 __all__ = ["BlockBasis", "sparse_gradients", "in_span_by_blocks", "gradient_sizes"]
@@ -72,7 +72,7 @@ class BlockBasis:
             b, n = base.shape
             pattern = (base != 0).astype(np.int8)
             graph = sp.bmat([[sp.csr_matrix((b, b), dtype=np.int8), pattern], [pattern.T, sp.csr_matrix((n, n), dtype=np.int8)]]).tocsr()
-            _, labels = connected_components(graph, directed=False)
+            _, labels = connected_components(graph)
             self.matrices.append(base)
             self.row_label.append(labels[:b])
             self.col_label.append(labels[b:])

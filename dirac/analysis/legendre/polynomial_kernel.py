@@ -34,6 +34,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 from fractions import Fraction
+from operator import add as add_exponents
 
 import numpy as np
 import sympy
@@ -126,7 +127,7 @@ def _ansatz(entries, q, domain, degree: int, columns: int, scaled_identity: bool
                 u = (j * columns + c) * len(monos) + mi
                 for i in range(k):
                     for mon, value in entries[i][j].terms():
-                        shifted = tuple(a + b for a, b in zip(mon, mono))
+                        shifted = tuple(map(add_exponents, mon, mono))  # the product's exponents
                         if not scaled_identity or i != c:
                             add(("zero", i, c, shifted), u, value)
                         elif i > 0:

@@ -1,0 +1,95 @@
+"""Compiled values of expressions together with the sizes of their terms, from one source.
+
+The numerical decisions of :class:`~dirac.analysis.core.numeric.Numerics` compare a value
+with the size of the terms it was computed from (``1 + sum |term|``, a relative zero
+test). Compiling the terms as expressions of their own prints and compiles every term's
+sub-expressions a second time, although they are already named in the straight-line code
+of the expression (``sharing="dag"``: one assignment per distinct sub-expression). Here
+one function computes both: the shared straight-line body, then either the values or,
+on request, the term sizes, each summed in the order of the terms
+(``((1 + |t_1|) + |t_2|) + ...``, the same floating-point sums as adding the terms' values
+one by one). Higham, *Accuracy and Stability of Numerical Algorithms* (2nd ed., 2002),
+Sect. 4.2: recursive summation, whose result depends only on the order of the terms.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import sympy
+
+from dirac.codegen import straight_line
+
+__all__ = ["ScaledFunction", "scaled_function", "terms_of"]
+
+#: ``f(flag, *arguments) -> list``: values (``flag`` false) or term sizes (``flag`` true)
+ScaledFunction = Callable[..., list[Any]]
+
+
+def terms_of(expr: sympy.Expr) -> tuple[sympy.Expr, ...]:
+    """The top-level terms of ``expr``: the arguments of a sum, else ``expr`` itself."""
+    return expr.args if isinstance(expr, sympy.Add) else (expr,)
+
+
+def _literal(value: float) -> str:
+    """Python source of a float that reads back as the same float (``inf`` and ``nan`` too)."""
+    return repr(value) if math.isfinite(value) else f"float({repr(value)!r})"
+
+
+def _nan_on_error(fn: ScaledFunction, n: int) -> ScaledFunction:
+    def wrapped(flag: bool, *args: float) -> list[Any]:
+        try:
+            return fn(flag, *args)
+        except (ValueError, ZeroDivisionError, OverflowError):
+            return [math.nan] * n
+
+    return wrapped
+
+
+def scaled_function(arguments: Sequence[sympy.Symbol], expressions: Sequence[sympy.Expr]) -> ScaledFunction:
+    """Compile ``expressions`` into ``f(flag, *arguments)``: their values, or with ``flag`` their term sizes.
+
+    Parameters
+    ----------
+    arguments
+        The symbols, in call order.
+    expressions
+        Expressions in ``arguments`` that are not numbers.
+
+    Returns
+    -------
+    callable
+        ``f(False, a_0, a_1, ...)``: the values of the expressions;
+        ``f(True, a_0, a_1, ...)``: ``1 + |t_1| + |t_2| + ...`` for each expression, its
+        terms ``t_i`` (:func:`terms_of`) added in their order, a term that is a number as
+        ``|float(t)|``, of a complex value its real part. Every value is NaN when the point
+        is outside the domain (a math domain error, a division by zero, an overflow).
+
+    Raises
+    ------
+    dirac.codegen.UnsupportedExpression
+        For a node the scalar printer cannot compile.
+    """
+    expressions = list(expressions)
+    inputs = {symbol: f"a{k}" for k, symbol in enumerate(arguments)}
+    owned = [terms_of(e) for e in expressions]
+    symbolic = list(dict.fromkeys(t for terms in owned for t in terms if not t.is_number))
+    # the terms as further outputs: each is a node of its expression, already named in the body
+    code = straight_line(inputs, [*expressions, *symbolic], "math", "dag")
+    term_name = dict(zip(symbolic, code.outputs[len(expressions):]))
+
+    def size(terms: tuple[sympy.Expr, ...]) -> str:
+        parts = [_literal(abs(float(t))) if t.is_number else f"abs(({term_name[t]}).real)" for t in terms]
+        return " + ".join(["1.0", *parts])
+
+    signature = ", ".join(["flag", *(f"a{k}" for k in range(len(arguments)))])
+    source = (
+        f"def _f({signature}):\n" + "\n".join(code.body())
+        + f"\n    if flag:\n        return [{', '.join(size(terms) for terms in owned)}]"
+        + f"\n    return [{', '.join(code.outputs[: len(expressions)])}]\n"
+    )
+    namespace: dict[str, Any] = {"math": math}
+    exec(compile(source, "<dirac codegen>", "exec"), namespace)
+    return _nan_on_error(namespace["_f"], len(expressions))

@@ -1,0 +1,66 @@
+"""Values and term sizes from one compiled function (dirac.analysis.core.scaled_function).
+
+The expected numbers are computed by hand from the expressions below (a sum's terms are
+its arguments, each taken in absolute value, added after 1 in their order).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import sympy
+
+from dirac.analysis.core.numeric import Numerics
+from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.scaled_function import scaled_function, terms_of
+
+x, y, a = sympy.symbols("x y a")
+
+
+def test_values_and_sizes_by_hand() -> None:
+    """f = x*y - 3 + sin(x), g = x**2 at (x, y) = (2, 0.5): values and 1 + sum |term| as derived by hand."""
+    f = x * y - 3 + sympy.sin(x)
+    g = x**2
+    fn = scaled_function([x, y], [f, g])
+    assert fn(False, 2.0, 0.5) == [2.0 * 0.5 - 3 + math.sin(2.0), 4.0]
+    sizes = fn(True, 2.0, 0.5)
+    expected_f = 1.0
+    for term in terms_of(f):  # the order of sympy's arguments, as Numerics sums them
+        expected_f += {x * y: 1.0, sympy.Integer(-3): 3.0, sympy.sin(x): math.sin(2.0)}[term]
+    assert sizes == [expected_f, 1.0 + 4.0]
+
+
+def test_sizes_of_a_cancelling_sum() -> None:
+    """x - y at x = y = 1: value 0, size 1 + |x| + |-y| = 3 (the terms' sizes stay where the value cancels)."""
+    fn = scaled_function([x, y], [x - y])
+    assert fn(False, 1.0, 1.0) == [0.0]
+    assert fn(True, 1.0, 1.0) == [3.0]
+
+
+def test_domain_error_gives_nan() -> None:
+    """log(x) at x = -1 is outside the domain: every value and size is NaN."""
+    fn = scaled_function([x], [sympy.log(x) + 1])
+    assert all(math.isnan(v) for v in fn(False, -1.0))
+    assert all(math.isnan(v) for v in fn(True, -1.0))
+
+
+def test_term_scale_of_numerics_by_hand() -> None:
+    """Numerics.term_scale of a*x + y - 2 (parameter a = 3) at x = 1, y = -4: 1 + 3 + 4 + 2 = 10."""
+    space = PhaseSpace((x,), (y,), (a,))
+    numerics = Numerics(space, {a: 3.0})
+    expr = a * x + y - 2
+    z = np.array([1.0, -4.0])
+    assert numerics.evaluate([expr], [z])[0, 0] == 3.0 - 4.0 - 2.0
+    assert numerics.term_scale([expr, sympy.S.Zero, sympy.Integer(5)], [z]).tolist() == [[10.0, 1.0, 6.0]]
+
+
+def test_term_scale_before_and_after_compilation_agree() -> None:
+    """The sizes of expressions not compiled yet (compiled by term_scale) and of compiled ones are the hand sums."""
+    space = PhaseSpace((x,), (y,))
+    numerics = Numerics(space, {})
+    exprs = [x * y + x**2 - y, x - 7]
+    z = np.array([2.0, -3.0])
+    hand = [[1.0 + 6.0 + 4.0 + 3.0, 1.0 + 2.0 + 7.0]]
+    assert numerics.term_scale(exprs, [z]).tolist() == hand  # compiled here
+    assert numerics.term_scale(exprs, [z]).tolist() == hand  # from the compiled function
