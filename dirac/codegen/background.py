@@ -47,10 +47,11 @@ HISTORY_FILE = "compile_history.json"
 DEFAULT_SECONDS_PER_CHAR = 2.7e-4
 DEFAULT_COMPILE_FLOOR = 0.5
 #: without a history: CPU seconds a background child spends before its compilation starts
-#: (the interpreter, numpy, numba and the generated module imported: 0.8-1.2 s measured on the
-#: 2-core machine of docs/performance.md, quiet to busy), which a compilation in the parent,
-#: with numba imported once, does not pay
-DEFAULT_CHILD_START_SECONDS = 1.0
+#: (the interpreter, numpy, numba and the generated module imported: 0.32-0.38 s for
+#: ``python -c "import numpy, numba"`` alone, 0.50 s recorded by a child at load average 7, on
+#: the 2-core machine of docs/performance.md), which a compilation in the parent, with numba
+#: imported once, does not pay
+DEFAULT_CHILD_START_SECONDS = 0.5
 _KEEP = 64
 
 

@@ -57,7 +57,8 @@ from dirac.codegen.numba_backend import (
 from dirac.codegen.scalar_arrays import scalar_function
 from dirac.errors import inform
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "CHECK_SECONDS",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "SHARED_CORE_FACTOR",
+           "CHECK_SECONDS",
            "WARM_UP_STEPS", "WARM_UP_UNTIMED_STEPS", "WAIT_FACTOR", "choose_road", "background_enabled", "spare_core",
            "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached", "tiered", "tiered_module"]
 
@@ -78,6 +79,13 @@ NUMBA_IMPORT_SECONDS = 0.5
 #: numba's on-disk cache (the index, the unpickled library; numba's import apart): 0.33 s
 #: measured for the RATTLE loop of the symmetric top in Euler angles on a busy machine
 CACHE_LOAD_SECONDS = 0.3
+#: how much longer a background child takes beside the run it serves: the two processes share
+#: the machine's two cores (on a virtual machine, often two threads of one physical core) and
+#: each slows the other. On a quiet machine the child compiling the triple pendulum's loop
+#: beside the interpreted run took about 5.3 s of CPU where the same compilation alone took
+#: 3.6 s (1.47); at load average 3-6, 4.3 s against 3.6 (1.2). The background road's
+#: estimate (:meth:`TieredFunction.background_estimate`) scales the child's work by this
+SHARED_CORE_FACTOR = 1.45
 #: interpreted seconds between two looks at a background compilation (a step loop runs in
 #: parts of about this length while one is in flight)
 CHECK_SECONDS = 0.05
@@ -125,11 +133,12 @@ def choose_road(interpreted: float, compile_seconds: float, background: float | 
     Notes
     -----
     Wall and CPU of each road, with the compiled steps nearly free: interpreted ``I`` and
-    ``I``; compile ``E`` and ``E``; background ``min(I, B)`` and ``min(I, B) + B`` (the
+    ``I``; compile ``E`` and ``E``; background ``min(I, B)`` and about ``min(I, B) + B`` (the
     interpreted steps before the switch, plus the child's whole compilation). ``B`` exceeds
-    ``E`` by the child's start-up and the load from the cache, so when the estimate is right
-    the compilation in the process wins on both counts wherever compiling pays (``I > E``):
-    a background compilation bought on that band ran the triple pendulum's 1e5-step study in
+    ``E`` by the child's start-up, the load from the cache and the slowdown of two processes
+    sharing two cores (:data:`SHARED_CORE_FACTOR`), so when the estimate is right the
+    compilation in the process wins on both counts wherever compiling pays (``I > E``): a
+    background compilation bought on that band ran the triple pendulum's 1e5-step study in
     7.3 s of wall and 13.1 s of CPU where the compilation in the process took 4.9 and 5.2.
     The background road is kept for the one case it serves: the remainder exceeds the estimate
     by less than ``W`` (an estimate off by that much would make the wait in the process longer
@@ -345,10 +354,19 @@ class TieredFunction:
     def background_estimate(self) -> float:
         """Estimated seconds until a background compilation of this function, started now,
         would have its machine code running here: the child's start-up
-        (:func:`~dirac.codegen.background.estimate_child_start_seconds`), its compilation,
-        then, in this process, numba's import (while not imported) and the load from the cache
-        (:data:`CACHE_LOAD_SECONDS`)."""
-        return estimate_child_start_seconds() + self.compile_estimate() + CACHE_LOAD_SECONDS
+        (:func:`~dirac.codegen.background.estimate_child_start_seconds`, numba's import in
+        it) and its compilation, both slowed by :data:`SHARED_CORE_FACTOR` beside the run;
+        then, in this process, numba's import (while not imported) and the load from the
+        cache (:data:`CACHE_LOAD_SECONDS`)::
+
+            B = SHARED_CORE_FACTOR * (start + E - import) + import + CACHE_LOAD_SECONDS
+
+        with ``E`` = :meth:`compile_estimate` and ``import`` its part for numba's import."""
+        import sys
+
+        numba_import = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
+        child = estimate_child_start_seconds() + self.compile_estimate() - numba_import
+        return SHARED_CORE_FACTOR * child + numba_import + CACHE_LOAD_SECONDS
 
     def kernel_chars(self) -> int:
         """The size of what numba compiles for this function (:func:`kernel_chars`)."""

@@ -53,10 +53,10 @@ def test_the_child_records_its_start_up_and_the_estimate_reads_it(tmp_path, monk
     compiled (interpreter, numpy, numba, the module: positive, and far below a compilation's
     seconds of CPU only for tiny kernels, so only its sign is checked); the estimate of a
     child's start-up is the median of those recorded (0.7, 0.9, 1.4 written by hand: 0.9),
-    and the built-in 1 s without any."""
+    and the built-in 0.5 s without any."""
     monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path / "cache"))
     (tmp_path / "cache").mkdir()
-    assert background.estimate_child_start_seconds() == background.DEFAULT_CHILD_START_SECONDS == 1.0
+    assert background.estimate_child_start_seconds() == background.DEFAULT_CHILD_START_SECONDS == 0.5
     for start in (1.4, 0.7, 0.9):
         background.record_compile_seconds(100, 2.0, "run (background)", start=start)
     background.record_compile_seconds(100, 2.0, "run")  # a compilation in the process: no start-up
