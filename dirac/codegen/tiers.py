@@ -557,15 +557,18 @@ class TieredFunction:
         interpreted where the run took 6.3 s and sent it to a background compilation. So the
         cold call and :data:`WARM_UP_UNTIMED_STEPS` steps after it are left out of the rate,
         and the rate is measured on a call of :data:`WARM_UP_STEPS` steps (a split loop; a
-        loop that cannot be split measures its one-step call)."""
+        loop that cannot be split measures its one-step call); for a run of fewer than 768
+        steps both are an eighth of it at most (a short run's rate decides little)."""
         if self.tier == "interpreted" and current_policy() == "auto" and planned is not None and self.seconds_per_step() is None:
             seconds, steps = self.interpreted_seconds, self.interpreted_steps
             self._interpreted_call(1, args)
-            if self._split_positions() is not None:
-                self._part(args, 0, WARM_UP_UNTIMED_STEPS, compiled=False)
+            # a short run spends at most about a quarter more on scratch steps (its rate matters little)
+            untimed, timed = min(WARM_UP_UNTIMED_STEPS, planned // 8), min(WARM_UP_STEPS, max(1, planned // 8))
+            if self._split_positions() is not None and untimed:
+                self._part(args, 0, untimed, compiled=False)
             self.interpreted_seconds, self.interpreted_steps = seconds, steps  # the cold steps: not the rate
             if self._split_positions() is not None:
-                self._part(args, 0, WARM_UP_STEPS, compiled=False)
+                self._part(args, 0, timed, compiled=False)
             else:
                 self._interpreted_call(1, args)
         self.run_steps(1, planned, *args)
