@@ -121,11 +121,15 @@ def record_compile_seconds(chars: int, seconds: float, what: str, history: Path 
         return
 
 
-def estimate_compile_seconds(chars: int) -> float:
-    """Estimated seconds to compile a kernel of ``chars`` characters of source: the median
-    measured seconds per character of the history times ``chars`` (at least
-    :data:`DEFAULT_COMPILE_FLOOR`), else the built-in rate :data:`DEFAULT_SECONDS_PER_CHAR`."""
-    rates = sorted(e["seconds"] / e["chars"] for e in _read_history())
+def estimate_compile_seconds(chars: int, shared: float = 1.0) -> float:
+    """Estimated seconds to compile a kernel of ``chars`` characters of source in a process of
+    its own: the median measured seconds per character of the history times ``chars`` (at
+    least :data:`DEFAULT_COMPILE_FLOOR`), else the built-in rate
+    :data:`DEFAULT_SECONDS_PER_CHAR`. A background child compiled beside the run it served,
+    the two sharing the cores: its seconds count divided by ``shared``, the slowdown that
+    sharing brings (:data:`dirac.codegen.tiers.SHARED_CORE_FACTOR`)."""
+    rates = sorted(e["seconds"] / e["chars"] / (shared if "background" in str(e.get("what", "")) else 1.0)
+                   for e in _read_history())
     rate = rates[len(rates) // 2] if rates else DEFAULT_SECONDS_PER_CHAR
     return max(DEFAULT_COMPILE_FLOOR, rate * chars)
 

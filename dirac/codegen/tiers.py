@@ -349,7 +349,7 @@ class TieredFunction:
         import sys
 
         start = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
-        return estimate_compile_seconds(self.kernel_chars()) + start
+        return estimate_compile_seconds(self.kernel_chars(), SHARED_CORE_FACTOR) + start
 
     def background_estimate(self) -> float:
         """Estimated seconds until a background compilation of this function, started now,
