@@ -10,9 +10,10 @@ like a tiered JIT, when to switch:
 * the compiled form is used at once when it costs nothing to get: already compiled in
   this process, or its machine code is in numba's on-disk cache (a warm cache);
 * otherwise the interpreted form runs, and its time is measured; once the interpreted
-  time spent, or the time a step loop is expected to need (its measured time per step
-  times the steps still planned), exceeds :data:`COMPILE_SECONDS`, the function is
-  compiled and the compiled form takes over.
+  time spent exceeds :data:`COMPILE_SECONDS`, the function is compiled and the compiled
+  form takes over; a step loop prices its roads first (its measured time per step times
+  the steps still planned against the estimated compilation, in this process or in a
+  child beside it: :func:`choose_road`).
 
 ``DIRAC_KERNELS=compiled`` in the environment (or :func:`set_policy` ``("compiled")``,
 which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
@@ -554,11 +555,11 @@ class TieredFunction:
         1 s interpreted, look like 5 s and wait 3 s for the compiler. The next tens of steps
         are still slow while the interpreter specialises the loop (the triple pendulum in
         angles: 65-71 us a step, then 46-51 us), which put its 1e5-step study at 7.2 s
-        interpreted where the run took 6.3 s and sent it to a background compilation. So the
+        interpreted (4.6-5.1 s at the warm rate) and sent it to a background compilation. So the
         cold call and :data:`WARM_UP_UNTIMED_STEPS` steps after it are left out of the rate,
         and the rate is measured on a call of :data:`WARM_UP_STEPS` steps (a split loop; a
-        loop that cannot be split measures its one-step call); for a run of fewer than 768
-        steps both are an eighth of it at most (a short run's rate decides little)."""
+        loop that cannot be split measures its one-step call); for a run of fewer than 512
+        steps each is an eighth of it at most (a short run's rate decides little)."""
         if self.tier == "interpreted" and current_policy() == "auto" and planned is not None and self.seconds_per_step() is None:
             seconds, steps = self.interpreted_seconds, self.interpreted_steps
             self._interpreted_call(1, args)
