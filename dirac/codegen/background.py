@@ -35,9 +35,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-__all__ = ["BackgroundCompile", "estimate_compile_seconds", "record_compile_seconds", "HISTORY_FILE", "describe",
-           "numba_type", "mark_ready", "kernel_chars",
-           "DEFAULT_SECONDS_PER_CHAR", "DEFAULT_COMPILE_FLOOR"]
+__all__ = ["BackgroundCompile", "estimate_compile_seconds", "estimate_child_start_seconds", "record_compile_seconds",
+           "HISTORY_FILE", "describe", "numba_type", "mark_ready", "kernel_chars",
+           "DEFAULT_SECONDS_PER_CHAR", "DEFAULT_COMPILE_FLOOR", "DEFAULT_CHILD_START_SECONDS"]
 
 HISTORY_FILE = "compile_history.json"
 #: without a history: seconds of CPU per character of the kernel numba compiles
@@ -46,6 +46,12 @@ HISTORY_FILE = "compile_history.json"
 #: numba's own start-up included) and the floor (that start-up, for the smallest kernel)
 DEFAULT_SECONDS_PER_CHAR = 2.7e-4
 DEFAULT_COMPILE_FLOOR = 0.5
+#: without a history: CPU seconds a background child spends before its compilation starts
+#: (the interpreter, numpy, numba and the generated module imported: 0.32-0.38 s for
+#: ``python -c "import numpy, numba"`` alone, 0.50 s recorded by a child at load average 7, on
+#: the 2-core machine of docs/performance.md), which a compilation in the parent, with numba
+#: imported once, does not pay
+DEFAULT_CHILD_START_SECONDS = 0.5
 _KEEP = 64
 
 
@@ -93,15 +99,21 @@ def _read_history(path: Path | None = None) -> list[dict[str, Any]]:
             and isinstance(e.get("seconds"), (int, float)) and e["chars"] > 0]
 
 
-def record_compile_seconds(chars: int, seconds: float, what: str, history: Path | None = None) -> None:
+def record_compile_seconds(chars: int, seconds: float, what: str, history: Path | None = None,
+                           start: float | None = None) -> None:
     """Append one measured compilation (``seconds`` for ``chars`` characters of source) to
     the history in the cache directory, or to the file ``history`` (the child, which does not
     import the engine to find the cache; the last 64 are kept; a failure to write is ignored:
-    the history only informs estimates)."""
+    the history only informs estimates). ``start``: the CPU seconds a background child spent
+    before its compilation (its whole CPU is ``start + seconds``), read by
+    :func:`estimate_child_start_seconds`."""
     try:
         path = history or _history_path()
         entries = _read_history(path)[-(_KEEP - 1):]
-        entries.append({"chars": int(chars), "seconds": round(float(seconds), 4), "what": what[:80]})
+        entry: dict[str, Any] = {"chars": int(chars), "seconds": round(float(seconds), 4), "what": what[:80]}
+        if start is not None:
+            entry["start"] = round(float(start), 4)
+        entries.append(entry)
         temporary = path.with_suffix(f".{os.getpid()}.tmp")
         temporary.write_text(json.dumps(entries), encoding="utf-8")
         os.replace(temporary, path)
@@ -109,13 +121,25 @@ def record_compile_seconds(chars: int, seconds: float, what: str, history: Path 
         return
 
 
-def estimate_compile_seconds(chars: int) -> float:
-    """Estimated seconds to compile a kernel of ``chars`` characters of source: the median
-    measured seconds per character of the history times ``chars`` (at least
-    :data:`DEFAULT_COMPILE_FLOOR`), else the built-in rate :data:`DEFAULT_SECONDS_PER_CHAR`."""
-    rates = sorted(e["seconds"] / e["chars"] for e in _read_history())
+def estimate_compile_seconds(chars: int, shared: float = 1.0) -> float:
+    """Estimated seconds to compile a kernel of ``chars`` characters of source in a process of
+    its own: the median measured seconds per character of the history times ``chars`` (at
+    least :data:`DEFAULT_COMPILE_FLOOR`), else the built-in rate
+    :data:`DEFAULT_SECONDS_PER_CHAR`. A background child compiled beside the run it served,
+    the two sharing the cores: its seconds count divided by ``shared``, the slowdown that
+    sharing brings (:data:`dirac.codegen.tiers.SHARED_CORE_FACTOR`)."""
+    rates = sorted(e["seconds"] / e["chars"] / (shared if "background" in str(e.get("what", "")) else 1.0)
+                   for e in _read_history())
     rate = rates[len(rates) // 2] if rates else DEFAULT_SECONDS_PER_CHAR
     return max(DEFAULT_COMPILE_FLOOR, rate * chars)
+
+
+def estimate_child_start_seconds() -> float:
+    """Estimated CPU seconds a background child spends before it compiles (its interpreter,
+    numpy, numba and the generated module imported): the median of the start-ups the
+    history's background compilations recorded, else :data:`DEFAULT_CHILD_START_SECONDS`."""
+    starts = sorted(float(e["start"]) for e in _read_history() if isinstance(e.get("start"), (int, float)))
+    return starts[len(starts) // 2] if starts else DEFAULT_CHILD_START_SECONDS
 
 
 class BackgroundCompile:
@@ -196,8 +220,9 @@ _BOOTSTRAP = "import runpy, sys; del sys.path[0]; runpy.run_path(sys.argv[1], ru
 
 def _main(argv: list[str]) -> int:
     """The child: compile function ``name`` of the generated module at ``path`` for the types
-    in ``signature_file`` into numba's cache, record its CPU seconds in the history of the
-    module's folder (the cache directory) and write its ready marker."""
+    in ``signature_file`` into numba's cache, record its CPU seconds (the compilation, and the
+    start-up before it: the parent's estimate of a background road counts both) in the
+    history of the module's folder (the cache directory) and write its ready marker."""
     import importlib.util
 
     path, name, signature_file, chars = argv
@@ -210,10 +235,10 @@ def _main(argv: list[str]) -> int:
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module
     spec.loader.exec_module(module)
-    start = time.process_time()
+    start = time.process_time()  # the child's CPU so far: its start-up (process_time counts from the start)
     getattr(module, name).compile(signature)
     record_compile_seconds(int(chars), time.process_time() - start, f"{name} (background)",
-                           Path(path).parent / HISTORY_FILE)
+                           Path(path).parent / HISTORY_FILE, start=start)
     mark_ready(Path(path).with_name(f"{module_name}.{name}.ready"))
     return 0
 

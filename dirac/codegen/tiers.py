@@ -10,9 +10,10 @@ like a tiered JIT, when to switch:
 * the compiled form is used at once when it costs nothing to get: already compiled in
   this process, or its machine code is in numba's on-disk cache (a warm cache);
 * otherwise the interpreted form runs, and its time is measured; once the interpreted
-  time spent, or the time a step loop is expected to need (its measured time per step
-  times the steps still planned), exceeds :data:`COMPILE_SECONDS`, the function is
-  compiled and the compiled form takes over.
+  time spent exceeds :data:`COMPILE_SECONDS`, the function is compiled and the compiled
+  form takes over; a step loop prices its roads first (its measured time per step times
+  the steps still planned against the estimated compilation, in this process or in a
+  child beside it: :func:`choose_road`).
 
 ``DIRAC_KERNELS=compiled`` in the environment (or :func:`set_policy` ``("compiled")``,
 which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
@@ -39,6 +40,7 @@ import numpy as np
 
 from dirac.codegen.background import (
     BackgroundCompile,
+    estimate_child_start_seconds,
     estimate_compile_seconds,
     kernel_chars,
     mark_ready,
@@ -56,28 +58,102 @@ from dirac.codegen.numba_backend import (
 from dirac.codegen.scalar_arrays import scalar_function
 from dirac.errors import inform
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CHECK_SECONDS", "WARM_UP_STEPS", "WAIT_FACTOR", "background_enabled", "spare_core", "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached",
-           "tiered", "tiered_module"]
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "SHARED_CORE_FACTOR",
+           "CHECK_SECONDS",
+           "WARM_UP_STEPS", "WARM_UP_UNTIMED_STEPS", "WAIT_FACTOR", "choose_road", "background_enabled", "spare_core",
+           "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached", "tiered", "tiered_module"]
 
 #: interpreted seconds after which a function is compiled (about one cold compilation of
 #: a small kernel; ``dirac bench`` measures the actual figures)
 COMPILE_SECONDS = 1.0
 #: a step loop whose interpreted remainder exceeds this many times the estimated compile time
 #: waits for the compilation in the process (the estimate may be off by this factor and the
-#: wait still not exceed the interpreted run); below it, a background compilation lets the
-#: run go on interpreted
+#: wait still not exceed the interpreted run); below it, and above the estimate, a background
+#: compilation lets the run go on interpreted when that road can end the run sooner than the
+#: interpreter (:func:`choose_road`)
 WAIT_FACTOR = 2.0
 #: CPU seconds of ``import numba`` in a fresh process (0.5-0.55 s measured on the 2-core machine
 #: of docs/performance.md, where a bare interpreter starts in 0.04 s), which a first compilation
 #: pays on top of the compile times the history records
 NUMBA_IMPORT_SECONDS = 0.5
+#: CPU seconds the parent spends, after a background compilation, to load the machine code from
+#: numba's on-disk cache (the index, the unpickled library; numba's import apart): 0.33 s
+#: measured for the RATTLE loop of the symmetric top in Euler angles on a busy machine
+CACHE_LOAD_SECONDS = 0.3
+#: how much longer a background child takes beside the run it serves: the two processes share
+#: the machine's two cores (on a virtual machine, often two threads of one physical core) and
+#: each slows the other. On a quiet machine the child compiling the triple pendulum's loop
+#: beside the interpreted run took about 5.3 s of CPU where the same compilation alone took
+#: 3.6 s (1.47); at load average 3-6, 4.3 s against 3.6 (1.2). The background road's
+#: estimate (:meth:`TieredFunction.background_estimate`) scales the child's work by this
+SHARED_CORE_FACTOR = 1.45
 #: interpreted seconds between two looks at a background compilation (a step loop runs in
 #: parts of about this length while one is in flight)
 CHECK_SECONDS = 0.05
 #: steps of the call on scratch arguments that measures a step loop's interpreted rate before
 #: a run (:meth:`TieredFunction.warm_up`): enough that the cost of the call itself (about one
 #: step of a small system) adds a few per cent to the rate, few enough to cost milliseconds
-WARM_UP_STEPS = 16
+WARM_UP_STEPS = 64
+#: steps run, untimed, before that call: the interpreter specialises a loop's bytecode over its
+#: first tens of executions (the triple pendulum in angles: 65-71 us a step over steps 2-33,
+#: 46-51 us from step 34 on), so a rate measured on them overestimates the run
+WARM_UP_UNTIMED_STEPS = 32
+
+
+def choose_road(interpreted: float, compile_seconds: float, background: float | None) -> str:
+    """The road of a step loop that runs interpreted: ``"interpreted"`` (to its end),
+    ``"compile"`` (wait for the compiler in this process) or ``"background"`` (a child process
+    compiles while the loop goes on interpreted).
+
+    Parameters
+    ----------
+    interpreted
+        ``I``: estimated CPU seconds of the interpreted remainder (measured rate times the steps
+        to go; ``inf`` for a run of unknown length).
+    compile_seconds
+        ``E``: estimated seconds of a compilation in this process (numba's import included
+        while it is not imported).
+    background
+        ``B``: estimated seconds until a background compilation's machine code runs here: the
+        child's start-up, its compilation and the parent's load of the result (numba's import,
+        :data:`CACHE_LOAD_SECONDS`); None when no background road is open (no idle core, or
+        turned off, or failed before, or a loop that cannot be split).
+
+    Returns
+    -------
+    str
+        The road, by this table (with ``c`` = :data:`COMPILE_SECONDS`, ``W`` = :data:`WAIT_FACTOR`):
+
+        ================================  ==============
+        ``I <= max(c, E)``                interpreted
+        ``I > W E``                       compile
+        ``E < I <= W E``, ``B < I``       background
+        ``E < I <= W E``, otherwise       compile
+        ================================  ==============
+
+    Notes
+    -----
+    Wall and CPU of each road, with the compiled steps nearly free: interpreted ``I`` and
+    ``I``; compile ``E`` and ``E``; background ``min(I, B)`` and about ``min(I, B) + B`` (the
+    interpreted steps before the switch, plus the child's whole compilation). ``B`` exceeds
+    ``E`` by the child's start-up, the load from the cache and the slowdown of two processes
+    sharing two cores (:data:`SHARED_CORE_FACTOR`), so when the estimate is right the
+    compilation in the process wins on both counts wherever compiling pays (``I > E``): a
+    background compilation bought on that band ran the triple pendulum's 1e5-step study in
+    7.3 s of wall and 13.1 s of CPU where the compilation in the process took 4.9 and 5.2.
+    The background road is kept for the one case it serves: the remainder exceeds the estimate
+    by less than ``W`` (an estimate off by that much would make the wait in the process longer
+    than the interpreted run) and the child can still end the run sooner than the interpreter
+    (``B < I``); it then never waits longer than the interpreted run (Paleczny, Vick & Click,
+    "The Java HotSpot server compiler", JVM '01, for background compilation in a tiered JIT).
+    """
+    if interpreted <= max(COMPILE_SECONDS, compile_seconds):
+        return "interpreted"
+    if interpreted > WAIT_FACTOR * compile_seconds:
+        return "compile"
+    if background is not None and background < interpreted:
+        return "background"
+    return "compile"
 
 
 def spare_core() -> bool:
@@ -274,7 +350,24 @@ class TieredFunction:
         import sys
 
         start = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
-        return estimate_compile_seconds(self.kernel_chars()) + start
+        return estimate_compile_seconds(self.kernel_chars(), SHARED_CORE_FACTOR) + start
+
+    def background_estimate(self) -> float:
+        """Estimated seconds until a background compilation of this function, started now,
+        would have its machine code running here: the child's start-up
+        (:func:`~dirac.codegen.background.estimate_child_start_seconds`, numba's import in
+        it) and its compilation, both slowed by :data:`SHARED_CORE_FACTOR` beside the run;
+        then, in this process, numba's import (while not imported) and the load from the
+        cache (:data:`CACHE_LOAD_SECONDS`)::
+
+            B = SHARED_CORE_FACTOR * (start + E - import) + import + CACHE_LOAD_SECONDS
+
+        with ``E`` = :meth:`compile_estimate` and ``import`` its part for numba's import."""
+        import sys
+
+        numba_import = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
+        child = estimate_child_start_seconds() + self.compile_estimate() - numba_import
+        return SHARED_CORE_FACTOR * child + numba_import + CACHE_LOAD_SECONDS
 
     def kernel_chars(self) -> int:
         """The size of what numba compiles for this function (:func:`kernel_chars`)."""
@@ -394,32 +487,22 @@ class TieredFunction:
         if remaining <= COMPILE_SECONDS:
             return
         estimate = self.compile_estimate()
-        if remaining > WAIT_FACTOR * estimate:
-            # the interpreted remainder costs far more than the compilation: waiting for it here
-            # is the shortest road (a child would add its own start, about half a second of
-            # importing numba, to the wait and keep a second core busy interpreting steps that
-            # the compiled loop does in microseconds)
+        background = None
+        if estimate < remaining <= WAIT_FACTOR * estimate and background_enabled() and not self.background_failed \
+                and spare_core():
+            background = self.background_estimate()
+        road = choose_road(remaining, estimate, background)
+        if road == "compile":
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
                          "compile", args)
-            return
-        if remaining <= estimate:
-            # the interpreted remainder costs less than compiling: a compilation, in this process or
-            # beside it, would cost more CPU than it could save (a double pendulum's t_end = 100 run
-            # spent 9 s of CPU where its interpreted run alone took 5)
-            return
-        if background_enabled() and not self.background_failed and spare_core():
+        elif road == "background":
             announce_compilation(f"{self.name} of {self.module.title}",
-                                 f"in a separate process, about {self.compile_estimate():.1g} s, while the run goes "
+                                 f"in a separate process, about {background:.1g} s, while the run goes "
                                  f"on interpreted ({'an unknown number of' if planned is None else planned} steps to go)")
             path = source_path(self.module.source)
             if not path.exists():  # the file numba compiles from, written without importing it
                 write_source(self.module.source)
             self.background = BackgroundCompile(path, self.name, args, self.kernel_chars())
-        elif remaining > estimate:
-            # no core to spare and a run longer than the compilation: compiling here costs the
-            # least (a child would share the core with the interpreted run)
-            self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
-                         "compile", args)
 
     def run_steps(self, steps: int, planned: int | None, *args: Any) -> Any:
         """Call a step loop advancing ``steps`` steps, of ``planned`` steps still to come
@@ -431,13 +514,14 @@ class TieredFunction:
         (:func:`~dirac.codegen.background.estimate_compile_seconds`, from the size of the
         kernel and the measured history): when the interpreted remainder exceeds
         :data:`WAIT_FACTOR` ``* E`` (a run of unknown length included), the function is
-        compiled in this process at once, the shortest wait; otherwise a loop that can be
-        split (arguments ``t, dt, n_steps, info``) is compiled in a separate process
-        (:class:`~dirac.codegen.background.BackgroundCompile`) while it goes on
+        compiled in this process at once, the shortest wait. Between ``E`` and that, a loop
+        that can be split (arguments ``t, dt, n_steps, info``) is compiled in a separate
+        process (:class:`~dirac.codegen.background.BackgroundCompile`) while it goes on
         interpreted, and switches to the compiled form at the first step boundary after
-        the compilation is done: such a run never waits for the compiler. That happens when
-        a core is idle (:func:`spare_core`) or the remainder is shorter than ``E``; on a
-        busy machine a longer run compiles in this process. Other loops, or with
+        the compilation is done (such a run never waits for the compiler), when a core is
+        idle (:func:`spare_core`) and that road is expected to end the run sooner than the
+        interpreter (:meth:`background_estimate` below the remainder); otherwise it compiles
+        in this process. The whole table is :func:`choose_road`. Other loops, or with
         ``DIRAC_BACKGROUND_COMPILE=0``, compile in this process when the interpreted time
         still to come exceeds ``E``.
         """
@@ -449,7 +533,8 @@ class TieredFunction:
                 self.compile("DIRAC_KERNELS=compiled", args)
             elif planned is None:
                 self.compile("a run of unknown length", args)
-            elif per_step is not None and per_step * planned > max(COMPILE_SECONDS, self.compile_estimate()):
+            elif per_step is not None and per_step * planned > COMPILE_SECONDS \
+                    and choose_road(per_step * planned, self.compile_estimate(), None) == "compile":
                 self.compile(f"about {planned} steps to go, {per_step * planned:.1f} s interpreted", args)
             elif per_step is None and steps > 1:
                 # no estimate yet: one interpreted step first would need a split of the call
@@ -467,15 +552,24 @@ class TieredFunction:
         0.1 ms, the symmetric top in Euler angles), and each call has its own cost on top of
         its steps (copies of the state, the floating-point error state: about 60 us, the size
         of a step of such a system). Timed as the rate, they made a 2e4-step run of that top,
-        1 s interpreted, look like 5 s and wait 3 s for the compiler. So the cold call is
-        left out of the rate and the rate is measured on a call of :data:`WARM_UP_STEPS`
-        steps (a split loop; a loop that cannot be split measures its one-step call)."""
+        1 s interpreted, look like 5 s and wait 3 s for the compiler. The next tens of steps
+        are still slow while the interpreter specialises the loop (the triple pendulum in
+        angles: 65-71 us a step, then 46-51 us), which put its 1e5-step study at 7.2 s
+        interpreted (4.6-5.1 s at the warm rate) and sent it to a background compilation. So the
+        cold call and :data:`WARM_UP_UNTIMED_STEPS` steps after it are left out of the rate,
+        and the rate is measured on a call of :data:`WARM_UP_STEPS` steps (a split loop; a
+        loop that cannot be split measures its one-step call); for a run of fewer than 512
+        steps each is an eighth of it at most (a short run's rate decides little)."""
         if self.tier == "interpreted" and current_policy() == "auto" and planned is not None and self.seconds_per_step() is None:
             seconds, steps = self.interpreted_seconds, self.interpreted_steps
             self._interpreted_call(1, args)
-            self.interpreted_seconds, self.interpreted_steps = seconds, steps  # the cold call: not the rate
+            # a short run spends at most about a quarter more on scratch steps (its rate matters little)
+            untimed, timed = min(WARM_UP_UNTIMED_STEPS, planned // 8), min(WARM_UP_STEPS, max(1, planned // 8))
+            if self._split_positions() is not None and untimed:
+                self._part(args, 0, untimed, compiled=False)
+            self.interpreted_seconds, self.interpreted_steps = seconds, steps  # the cold steps: not the rate
             if self._split_positions() is not None:
-                self._part(args, 0, WARM_UP_STEPS, compiled=False)
+                self._part(args, 0, timed, compiled=False)
             else:
                 self._interpreted_call(1, args)
         self.run_steps(1, planned, *args)

@@ -308,3 +308,51 @@ def test_the_cold_first_call_does_not_count_in_the_rate_that_decides_the_tier(tm
     function.run_steps(1000, 1000, x, 0.0, 0.1, 1000, info)
     assert function.background is None and function.tier == "interpreted"
     assert x[0] == _hand_loop(0.5, 1000) and info[0] == 1000 and info[2] == 1000
+
+
+@pytest.mark.parametrize(("interpreted", "compile_seconds", "background", "road"), [
+    (0.9, 0.1, None, "interpreted"),   # under COMPILE_SECONDS: never compiled
+    (3.0, 4.0, 2.0, "interpreted"),    # I <= E: the wait would exceed the interpreted run
+    (4.0, 4.0, 2.0, "interpreted"),    # I = E: compiling saves nothing
+    (8.5, 4.0, 5.0, "compile"),        # I > 2 E: waiting here is the shortest road
+    (math.inf, 4.0, 5.0, "compile"),   # a run of unknown length
+    (7.0, 4.0, 5.5, "background"),     # E < I <= 2 E and the child ends the run before the interpreter would
+    (5.0, 4.0, 5.5, "compile"),        # E < I <= 2 E but B >= I: the background road would only interpret
+    (7.0, 4.0, None, "compile"),       # no background road open (busy machine): compile here
+])
+def test_the_road_table(interpreted: float, compile_seconds: float, background: float | None, road: str) -> None:
+    """choose_road against its table, worked by hand with COMPILE_SECONDS = 1 and
+    WAIT_FACTOR = 2: walls are interpreted I, compile E, background min(I, B); the background
+    road is taken only where compiling pays by less than the factor (I in (E, 2E]) and it
+    can end the run sooner than the interpreter (B < I)."""
+    assert (tiers.COMPILE_SECONDS, tiers.WAIT_FACTOR) == (1.0, 2.0)
+    assert tiers.choose_road(interpreted, compile_seconds, background) == road
+
+
+def test_the_triple_pendulum_study_compiles_in_the_process_when_the_child_cannot_win(tmp_path, monkeypatch) -> None:
+    """The regression this rule fixes, with the study's own figures put in by hand (the rate
+    and the estimates are fakes): 1e5 steps at 50 us a step, I = 5 s interpreted; a compile
+    estimate E = 4.19 s (its 13663 characters at the default 2.7e-4 s each, 3.69 s, and
+    numba's import, 0.5 s); an idle core; numba already imported here (pytest), so the
+    background road's estimate is B = 1.45 (0.5 + 4.19) + 0.3 = 7.10 s: 1.45 the slowdown
+    of two processes on two shared cores, 0.5 the child's start-up, 0.3 the load from the
+    cache. B > I: the child could not end the run before the interpreter, and the loop
+    compiles in the process (before, with I in (E, 2E], it started a child: 7.3 s of wall and
+    13.1 s of CPU against 4.9 and 5.2). The same loop planned for 1.6e5 steps (I = 8 s, still
+    below 2E = 8.38 s, and above B) takes the background road."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "numba", sys.modules.get("numba", object()))  # numba's import: paid
+    monkeypatch.setattr(tiers, "spare_core", lambda: True)
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 4.19)
+    monkeypatch.setattr(tiers.TieredFunction, "seconds_per_step", lambda self: 5e-5)
+    monkeypatch.setattr(tiers, "estimate_child_start_seconds", lambda: 0.5)
+    roads = []
+    monkeypatch.setattr(tiers.TieredFunction, "compile", lambda self, why, args=None: roads.append("compile"))
+    monkeypatch.setattr(tiers, "BackgroundCompile", lambda *a: roads.append("background"))
+    function = _loop_module(tmp_path, monkeypatch)
+    assert function.background_estimate() == pytest.approx(1.45 * (0.5 + 4.19) + 0.3)
+    args = (np.array([0.5]), 0.0, 1e-3, 1, np.zeros(4))
+    function._decide(100_000, args)
+    function._decide(160_000, args)
+    assert roads == ["compile", "background"]
