@@ -746,7 +746,10 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool, hoisted:
                 unconstrained.replace("NEWTON_SOLVE\n", "lu_solve_n(J, pivx, dinv, col, o)\n")
                 .replace("NEWTON_FACTOR\n", "for ob in range(0, 2 * __N__, __N__):\n"
                          "                            lu_factor_n(J, pivx, dinv, ob)\n")
-                .replace("DINV_WORK\n", "dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors\n"))
+                .replace("DINV_WORK\n", "dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors\n")
+                # the row exchanges as floats (compared with literals, never an index): no
+                # allocation of integers, whose implementation numba compiles once per process
+                .replace("pivx = np.empty(2 * __N__, dtype=np.int64)", "pivx = np.empty(2 * __N__)"))
         else:
             rattle = (unconstrained.replace("NEWTON_SOLVE\n", "lu_solve(J[o:o + __N__], pivx[o:o + __N__], col)\n")
                       .replace("NEWTON_FACTOR\n", "lu_factor(J[:__N__], pivx[:__N__])\n"
