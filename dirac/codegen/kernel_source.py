@@ -15,7 +15,14 @@ inlines everything. This module writes, per system, one numba module in which
   ``chi(q, t)``, potentials ``V(q, t)`` and masses ``M(q, t)`` may depend on it;
 * where a closed form exists it replaces the loops: RATTLE with a constant mass is
   unrolled into scalar code (:mod:`dirac.codegen.rattle_scalar`), ``v = M^{-1} p`` and
-  RATTLE's implicit stage are single expressions for diagonal and 2 x 2 mass matrices;
+  RATTLE's implicit stage are single expressions for diagonal and 2 x 2 mass matrices, and
+  ``v = M^{-1} p`` of the unconstrained loop for a full 3 x 3 mass (Cramer's rule,
+  ``adj(M) p / det(M)``: no LU compiled for the tops in Euler angles or the triple pendulum);
+* the unconstrained RATTLE loop reads the transcendental functions of ``(q, t)`` (``sin``,
+  ``cos``, ``sqrt``, ...) that its expressions share from ``transcendentals``, evaluated
+  once per configuration the loop visits (:func:`_hoist`; the loop's side:
+  :data:`dirac.codegen.kernel_templates._HOISTED`), not once per expression and Newton
+  iterate;
 * the Dirac field of an analysed system is printed by the same emitter as the public
   vector field (:func:`dirac.codegen.field_body.dirac_field_body`: ``C`` and its solve
   unrolled on scalars, or looped on a scratch array for a large ``C``).
@@ -212,7 +219,7 @@ def mechanical_kernel_source(
     ]
     constant = not any(entry.free_symbols & {*q, *([time] if time is not None else [])} for entry in mass)
     diagonal = all(mass[i, j] == 0 for i in range(n) for j in range(n) if i != j)
-    adjugate = n == ADJUGATE_VELOCITY_SIZE and m == 0 and forces is None and not diagonal
+    adjugate = n == ADJUGATE_VELOCITY_SIZE and m == 0 and forces is None and not diagonal and not constant
     closed_velocity = diagonal or n <= 2 or adjugate
     if closed_velocity:  # v = M^{-1} p in closed form (diagonal, 2 x 2 or 3 x 3 mass); else by elimination
         p_symbols = [sympy.Symbol(f"_p{i}", real=True) for i in range(n)]
@@ -233,10 +240,10 @@ def mechanical_kernel_source(
     if constant:  # M^{-1} once, symbolically; the constant-mass RATTLE is unrolled into scalars
         functions.append(constant_mass_rattle_source(q, parameters, mass.inv(), potential, list(chi), time))
     hoisted = 0
-    if m == 0:  # the unconstrained loop evaluates the transcendental functions of q once per q
+    if m == 0 and not constant:  # rattle_general (not run with a constant mass) evaluates the transcendental
+        # functions of q once per configuration
         fixed = {*q, *([time] if time is not None else []), *parameters}
         table: dict[sympy.Expr, sympy.Symbol] = {}
-        wa = ("w", table)
         pieces = [("mass", "M(q, t) from w = transcendentals(q, t), (n, n)", [("q", q)], list(mass), (n, n)),
                   ("force", "the force of `force` from w = transcendentals(q, t), (n,)", [("q", q), ("v", v)], force, (n,)),
                   ("mass_dq_v", "`mass_dq_v` from w = transcendentals(q, t), (n, n)", [("q", q), ("v", v)], dmass_v, (n, n))]
