@@ -15,7 +15,14 @@ inlines everything. This module writes, per system, one numba module in which
   ``chi(q, t)``, potentials ``V(q, t)`` and masses ``M(q, t)`` may depend on it;
 * where a closed form exists it replaces the loops: RATTLE with a constant mass is
   unrolled into scalar code (:mod:`dirac.codegen.rattle_scalar`), ``v = M^{-1} p`` and
-  RATTLE's implicit stage are single expressions for diagonal and 2 x 2 mass matrices;
+  RATTLE's implicit stage are single expressions for diagonal and 2 x 2 mass matrices, and
+  ``v = M^{-1} p`` of the unconstrained loop for a full 3 x 3 mass (Cramer's rule,
+  ``adj(M) p / det(M)``: no LU compiled for the tops in Euler angles or the triple pendulum);
+* the unconstrained RATTLE loop reads the transcendental functions of ``(q, t)`` (``sin``,
+  ``cos``, ``sqrt``, ...) that its expressions share from ``transcendentals``, evaluated
+  once per configuration the loop visits (:func:`_hoist`; the loop's side:
+  :data:`dirac.codegen.kernel_templates._HOISTED`), not once per expression and Newton
+  iterate;
 * the Dirac field of an analysed system is printed by the same emitter as the public
   vector field (:func:`dirac.codegen.field_body.dirac_field_body`: ``C`` and its solve
   unrolled on scalars, or looped on a scratch array for a large ``C``).
@@ -60,6 +67,10 @@ import numba
 #: RATTLE of :mod:`dirac.codegen.sparse_rattle` (its source and compile time grow linearly
 #: with the system; the unrolled one's like m^2 n); fewer constraints keep the unrolled one
 SPARSE_MIN_CONSTRAINTS = 4
+
+#: the size of a full mass matrix whose v = M^{-1} p an unconstrained, unforced kernel writes in
+#: closed form by Cramer's rule (adj(M) p / det(M)) instead of eliminating
+ADJUGATE_VELOCITY_SIZE = 3
 
 
 #: the decorator of the expression functions and small helpers: compiled into their callers
@@ -208,10 +219,16 @@ def mechanical_kernel_source(
     ]
     constant = not any(entry.free_symbols & {*q, *([time] if time is not None else [])} for entry in mass)
     diagonal = all(mass[i, j] == 0 for i in range(n) for j in range(n) if i != j)
-    closed_velocity = diagonal or n <= 2
-    if closed_velocity:  # v = M^{-1} p in closed form (diagonal or 2 x 2 mass); else by elimination
+    adjugate = n == ADJUGATE_VELOCITY_SIZE and m == 0 and forces is None and not diagonal and not constant
+    closed_velocity = diagonal or n <= 2 or adjugate
+    if closed_velocity:  # v = M^{-1} p in closed form (diagonal, 2 x 2 or 3 x 3 mass); else by elimination
         p_symbols = [sympy.Symbol(f"_p{i}", real=True) for i in range(n)]
-        inverse = sympy.diag(*[1 / mass[i, i] for i in range(n)]) if diagonal else mass.inv()
+        if diagonal:
+            inverse = sympy.diag(*[1 / mass[i, i] for i in range(n)])
+        elif adjugate:  # Cramer's rule: adj(M) / det(M), both polynomial in the entries of M
+            inverse = mass.adjugate() / mass.det(method="berkowitz")
+        else:
+            inverse = mass.inv()
         source = emit_function("velocity", "v = M(q, t)^{-1} p in closed form, (n,)", [("q", q), ("p", p_symbols)], ts,
                                list(inverse * sympy.Matrix(p_symbols)), (n,), parameters)
         # the signature of the eliminating version: its work arrays are not needed here
@@ -222,8 +239,48 @@ def mechanical_kernel_source(
             functions.append(_stage_residual(q, parameters, inverse, force, v, list(chi), time))
     if constant:  # M^{-1} once, symbolically; the constant-mass RATTLE is unrolled into scalars
         functions.append(constant_mass_rattle_source(q, parameters, mass.inv(), potential, list(chi), time))
-    body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m, not closed_velocity)
+    hoisted = 0
+    if m == 0 and not constant:  # rattle_general (not run with a constant mass) evaluates the transcendental
+        # functions of q once per configuration
+        fixed = {*q, *([time] if time is not None else []), *parameters}
+        table: dict[sympy.Expr, sympy.Symbol] = {}
+        pieces = [("mass", "M(q, t) from w = transcendentals(q, t), (n, n)", [("q", q)], list(mass), (n, n)),
+                  ("force", "the force of `force` from w = transcendentals(q, t), (n,)", [("q", q), ("v", v)], force, (n,)),
+                  ("mass_dq_v", "`mass_dq_v` from w = transcendentals(q, t), (n, n)", [("q", q), ("v", v)], dmass_v, (n, n))]
+        if closed_velocity:
+            pieces.append(("velocity", "v = M(q, t)^{-1} p from w = transcendentals(q, t), (n,)", [("q", q), ("p", p_symbols)],
+                           list(inverse * sympy.Matrix(p_symbols)), (n,)))
+        reduced = [[_hoist(sympy.sympify(e), fixed, table) for e in expressions] for *_, expressions, _ in pieces]
+        if table:
+            hoisted = len(table)
+            symbols = list(table.values())
+            functions.append(emit_function("transcendentals", "the transcendental functions of (q, t) the loop's expressions "
+                                           "share, (w,)", qa, ts, list(table), (hoisted,), parameters))
+            for (name, doc, arrays, _, shape), expressions in zip(pieces, reduced):
+                source = emit_function(f"{name}_w", doc, [*arrays, ("w", symbols)],
+                                       ts, expressions, shape, parameters)
+                if name == "velocity":
+                    source = source.replace("def velocity_w(q, p, w, t, c, out):", "def velocity_w(q, p, w, t, c, out, work, piv):")
+                functions.append(source)
+    body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m, not closed_velocity, hoisted)
     return _HEADER.format(title=title) + body
+
+
+def _hoist(expression: sympy.Expr, fixed: set[sympy.Symbol], table: dict[sympy.Expr, sympy.Symbol]) -> sympy.Expr:
+    """``expression`` with each outermost transcendental sub-expression of the ``fixed``
+    symbols alone (a function such as ``sin(q0 - q1)``, a power with a non-integer exponent
+    such as ``sqrt``) replaced by its symbol in ``table`` (added when new, ``_w0, _w1, ...``):
+    the step loop evaluates them once per configuration and every expression at that
+    configuration reads them (common sub-expressions of ``q`` shared across expressions)."""
+    if not expression.args:
+        return expression
+    transcendental = isinstance(expression, sympy.Function) or (
+        isinstance(expression, sympy.Pow) and not expression.exp.is_Integer)
+    if transcendental and expression.free_symbols <= fixed:
+        if expression not in table:
+            table[expression] = sympy.Symbol(f"_w{len(table)}", real=True)
+        return table[expression]
+    return expression.func(*[_hoist(a, fixed, table) for a in expression.args])
 
 
 def _stage_residual(q: list[sympy.Symbol], parameters: Sequence[sympy.Symbol], inverse: sympy.Matrix,

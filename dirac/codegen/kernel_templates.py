@@ -398,6 +398,7 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
     J = np.empty((2 * __N__, __N__))  # rows 0 .. n-1: (1)'s Jacobian, n .. 2n-1: (2)'s
     pivx = np.empty(2 * __N__, dtype=np.int64)
     DINV_WORK
+    HOIST_WORK
     f = np.empty(__N__)
     ph = np.empty(__N__)
     v0 = np.empty(__N__)
@@ -686,19 +687,46 @@ def residuals(z, t, c, out):
 '''
 
 
+#: the calls of the unconstrained loop that read the transcendental functions of q from ``w``
+#: (``transcendentals``) instead of evaluating them: each configuration the loop visits is
+#: evaluated once, where ``M(x, ta)^{-1} ph`` is (stage 0 at x = q, ta = tau; stage 2 at each
+#: iterate of q1, ta = tau1), and the calls after it at the same configuration read it: stage
+#: 0's ``M`` and ``(dM/dq_k) u`` at (q, tau), stage 1's forces at (q, tau) (stage 1 evaluates no
+#: velocity), and stage 3's force at (q1, tau1), whose q1 is the iterate stage 2 evaluated last
+#: (it converged there, and the loop set q = x without changing x)
+_HOISTED = (
+    ("mass(x, ta, c, work)", "transcendentals(x, ta, c, w)\n                    mass_w(x, w, ta, c, work)"),
+    ("velocity(x, ph, ta, c, v1, work, pivn)",
+     "transcendentals(x, ta, c, w)\n                    velocity_w(x, ph, w, ta, c, v1, work, pivn)"),
+    ("mass(q, tau, c, M0)", "mass_w(q, w, tau, c, M0)"),
+    ("mass_dq_v(q, v1, tau, c, B)", "mass_dq_v_w(q, v1, w, tau, c, B)"),
+    ("force(q, x, ta, c, f)", "force_w(q, x, w, ta, c, f)"),
+)
+
+
+def _hoisted(text: str, count: int) -> str:
+    """The unconstrained loop ``text`` reading the ``count`` transcendental functions of q from ``w``."""
+    for old, new in _HOISTED:
+        text = text.replace(old, new)
+    return text.replace("    HOIST_WORK\n", f"    w = np.empty({count})  # transcendentals(q, t) at the last configuration evaluated\n")
+
+
 def _fill(text: str, n: int, m: int, k: int) -> str:
     return (text.replace("__NX__", str(2 * n + m)).replace("__N__", str(n)).replace("__M__", str(m))
             .replace("__K__", str(k)))
 
 
-def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
+def mechanical_templates(n: int, m: int, velocity_by_elimination: bool, hoisted: int = 0) -> str:
     """Step loops of a mechanical system with ``n`` coordinates and ``m`` constraints:
     ``rattle_general``, ``field``, ``midpoint_run``, ``energy``, ``residuals`` (and
     their helpers). RATTLE with a constant mass is unrolled per system instead
     (:mod:`dirac.codegen.rattle_scalar`). ``velocity(q, p, t, c, v, work, piv)``
     (``v = M^{-1} p``) and ``rattle_residual`` (RATTLE's implicit stage) come from here,
     by elimination, when ``velocity_by_elimination``; else the module generates both in
-    closed form."""
+    closed form. ``hoisted > 0`` (unconstrained only): the module defines
+    ``transcendentals(q, t, c, w)`` (``hoisted`` values) and ``mass_w``, ``force_w``,
+    ``mass_dq_v_w`` (and ``velocity_w`` in closed form) that read them: the loop evaluates
+    them once per configuration (:data:`_HOISTED`)."""
     common = _COMMON.replace("        PROJECT\n", "").replace("    PROJECT_WORK\n", "")
     by_elimination = _VELOCITY_BY_ELIMINATION + _STAGE_RESIDUAL if velocity_by_elimination else ""
     if m > 0:
@@ -709,12 +737,19 @@ def mechanical_templates(n: int, m: int, velocity_by_elimination: bool) -> str:
         else:
             unconstrained = (_UNCONSTRAINED.replace("VELOCITY\n", "velocity(x, ph, ta, c, v1, work, pivn)\n")
                              .replace("MASS0\n", "mass(q, tau, c, M0)\n"))
+        if hoisted:
+            unconstrained = _hoisted(unconstrained, hoisted)
+        else:
+            unconstrained = unconstrained.replace("    HOIST_WORK\n", "")
         if n <= UNROLLED_NEWTON_MAX:  # one copy of the unrolled factorization, run for both blocks
             rattle = offset_lu_source(n) + (
                 unconstrained.replace("NEWTON_SOLVE\n", "lu_solve_n(J, pivx, dinv, col, o)\n")
                 .replace("NEWTON_FACTOR\n", "for ob in range(0, 2 * __N__, __N__):\n"
                          "                            lu_factor_n(J, pivx, dinv, ob)\n")
-                .replace("DINV_WORK\n", "dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors\n"))
+                .replace("DINV_WORK\n", "dinv = np.empty(2 * __N__)  # reciprocal pivots of the unrolled factors\n")
+                # the row exchanges as floats (compared with literals, never an index): no
+                # allocation of integers, whose implementation numba compiles once per process
+                .replace("pivx = np.empty(2 * __N__, dtype=np.int64)", "pivx = np.empty(2 * __N__)"))
         else:
             rattle = (unconstrained.replace("NEWTON_SOLVE\n", "lu_solve(J[o:o + __N__], pivx[o:o + __N__], col)\n")
                       .replace("NEWTON_FACTOR\n", "lu_factor(J[:__N__], pivx[:__N__])\n"
