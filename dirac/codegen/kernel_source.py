@@ -210,11 +210,8 @@ def mechanical_kernel_source(
         emit_function("constraints", "chi(q, t), (m,)", qa, ts, list(chi), (m,), parameters),
         emit_function("constraints_dt", "d chi/dt, (m,)", qa, ts, chi_t, (m,), parameters),
         emit_function("jacobian", "G = d chi/dq, (m, n)", qa, ts, list(jacobian), (m, n), parameters),
-        emit_function("mass", "M(q, t), (n, n)", qa, ts, list(mass), (n, n), parameters),
-        emit_function("force", "dV/dq - 1/2 v^T (dM/dq_k) v, (n,)", qva, ts, force, (n,), parameters),
         emit_function("hidden_dq", "d/dq_k (G v + d chi/dt) at fixed v, (m, n)", qva, ts, hidden_dq, (m, n), parameters),
         emit_function("hidden_dt", "d/dt (G v + d chi/dt) at fixed v, (m,)", qva, ts, hidden_dt, (m,), parameters),
-        emit_function("mass_dq_v", "[k, i] = sum_j dM_ij/dq_k v_j, (n, n)", qva, ts, dmass_v, (n, n), parameters),
         emit_function("mass_dt_v", "(dM/dt) v, (n,)", qva, ts, mass_dt_v, (n,), parameters),
     ]
     constant = not any(entry.free_symbols & {*q, *([time] if time is not None else [])} for entry in mass)
@@ -229,10 +226,9 @@ def mechanical_kernel_source(
             inverse = mass.adjugate() / mass.det(method="berkowitz")
         else:
             inverse = mass.inv()
-        source = emit_function("velocity", "v = M(q, t)^{-1} p in closed form, (n,)", [("q", q), ("p", p_symbols)], ts,
-                               list(inverse * sympy.Matrix(p_symbols)), (n,), parameters)
-        # the signature of the eliminating version: its work arrays are not needed here
-        functions.append(source.replace("def velocity(q, p, t, c, out):", "def velocity(q, p, t, c, out, work, piv):"))
+        velocity_exprs = list(inverse * sympy.Matrix(p_symbols))
+        if m or constant:  # else written below: from the shared transcendentals when there are any
+            functions.append(_closed_velocity(q, p_symbols, ts, velocity_exprs, parameters))
         if m or forces is not None:  # the constrained RATTLE and the forced loops solve with it;
             # the unconstrained loop of an unforced system never calls it (a third of the
             # symbolic work of a double pendulum's module)
@@ -249,7 +245,7 @@ def mechanical_kernel_source(
                   ("mass_dq_v", "`mass_dq_v` from w = transcendentals(q, t), (n, n)", [("q", q), ("v", v)], dmass_v, (n, n))]
         if closed_velocity:
             pieces.append(("velocity", "v = M(q, t)^{-1} p from w = transcendentals(q, t), (n,)", [("q", q), ("p", p_symbols)],
-                           list(inverse * sympy.Matrix(p_symbols)), (n,)))
+                           velocity_exprs, (n,)))
         reduced = [[_hoist(sympy.sympify(e), fixed, table) for e in expressions] for *_, expressions, _ in pieces]
         if table:
             hoisted = len(table)
@@ -262,8 +258,39 @@ def mechanical_kernel_source(
                 if name == "velocity":
                     source = source.replace("def velocity_w(q, p, w, t, c, out):", "def velocity_w(q, p, w, t, c, out, work, piv):")
                 functions.append(source)
+            # the other loops' M, force, (dM/dq) v and closed-form v = M^{-1} p read the same
+            # transcendentals: each expression is printed once (printed twice, a triple pendulum's
+            # module took 0.56 s more to write, most of it the 3 x 3 adjugate and its determinant)
+            wrapped = [("mass", "q, t, c, out", "q, w, t, c, out"), ("force", "q, v, t, c, out", "q, v, w, t, c, out"),
+                       ("mass_dq_v", "q, v, t, c, out", "q, v, w, t, c, out")]
+            if closed_velocity:
+                wrapped.append(("velocity", "q, p, t, c, out, work, piv", "q, p, w, t, c, out, work, piv"))
+            for name, signature, call in wrapped:
+                functions.append(f'''
+{INLINED}
+def {name}({signature}):
+    """{name} from the transcendentals of (q, t) (transcendentals, then {name}_w)."""
+    w = np.empty({hoisted})
+    transcendentals(q, t, c, w)
+    {name}_w({call})
+''')
+    if not hoisted:
+        functions += [emit_function("mass", "M(q, t), (n, n)", qa, ts, list(mass), (n, n), parameters),
+                      emit_function("force", "dV/dq - 1/2 v^T (dM/dq_k) v, (n,)", qva, ts, force, (n,), parameters),
+                      emit_function("mass_dq_v", "[k, i] = sum_j dM_ij/dq_k v_j, (n, n)", qva, ts, dmass_v, (n, n), parameters)]
+        if closed_velocity and not (m or constant):
+            functions.append(_closed_velocity(q, p_symbols, ts, velocity_exprs, parameters))
     body = _solves({m, 2 * m}) + "\n\n".join(functions) + mechanical_templates(n, m, not closed_velocity, hoisted)
     return _HEADER.format(title=title) + body
+
+
+def _closed_velocity(q: list[sympy.Symbol], p_symbols: list[sympy.Symbol], ts: list, expressions: list[sympy.Expr],
+                     parameters: Sequence[sympy.Symbol]) -> str:
+    """``velocity(q, p, t, c, out, work, piv)``: ``v = M(q, t)^{-1} p`` in closed form (the
+    signature of the eliminating version, whose work arrays it does not need)."""
+    source = emit_function("velocity", "v = M(q, t)^{-1} p in closed form, (n,)", [("q", q), ("p", p_symbols)], ts,
+                           expressions, (len(q),), parameters)
+    return source.replace("def velocity(q, p, t, c, out):", "def velocity(q, p, t, c, out, work, piv):")
 
 
 def _hoist(expression: sympy.Expr, fixed: set[sympy.Symbol], table: dict[sympy.Expr, sympy.Symbol]) -> sympy.Expr:
