@@ -230,12 +230,43 @@ def integrate(
         from dirac.errors import warn
 
         warn(f"impulses at t = {', '.join(f'{t:g}' for t in late)} come after t_end = {t_end:g}: they are not applied")
+    return _integrate_checked(checked, method, kind, chosen_outputs, t_end, samples, dt, tolerance, progress,
+                              drift_limit, newton_tolerance, max_newton_iterations)
+
+
+#: what a run that left the real domain of the system's expressions can do
+DOMAIN_HINT = ("a square root or logarithm of a negative number, a division by zero, or an overflow; start inside "
+               "the domain of the Lagrangian (and forces), or reduce dt if a step jumped out of it")
+
+
+def is_domain_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is an evaluation outside the real domain of an expression.
+
+    The interpreted kernels raise Python's own errors there: ``ValueError('math domain
+    error')`` (``math.sqrt(-1)``, ``math.log(0)``), ``ZeroDivisionError``, ``OverflowError``
+    and numpy's ``FloatingPointError`` (all :class:`ArithmeticError`); any other
+    ``ValueError`` is not one.
+    """
+    return isinstance(exc, ArithmeticError) or (isinstance(exc, ValueError) and str(exc) == "math domain error")
+
+
+def _integrate_checked(checked, method, kind, chosen_outputs, t_end, samples, dt, tolerance, progress, drift_limit,
+                       newton_tolerance, max_newton_iterations) -> Solution:
+    """:func:`integrate` after its arguments are checked: the method chosen and started, the loop run."""
     extra: dict[str, Any] = {}
     if (isinstance(method, str) and method == "auto"):
         from dirac.flows.methods.auto import choose_method
 
-        choice = choose_method(checked, kind, t_end=t_end, samples=samples, tolerance=tolerance, dt=dt,
-                               outputs=chosen_outputs)
+        try:
+            choice = choose_method(checked, kind, t_end=t_end, samples=samples, tolerance=tolerance, dt=dt,
+                                   outputs=chosen_outputs)
+        except (ArithmeticError, ValueError) as exc:
+            if not is_domain_error(exc):
+                raise
+            raise IntegrationError(
+                f"method auto: a trial run left the real domain of the system's expressions ({exc}): {DOMAIN_HINT}; "
+                "or choose a method and dt"
+            ) from None
         method_object, dt = get_method(choice.method), choice.dt
         extra["auto"] = {"chosen": choice.method, "reason": choice.reason, "estimated_error": choice.estimated_error}
         if choice.newton_tolerance is not None and choice.newton_tolerance < newton_tolerance:
@@ -270,10 +301,17 @@ def integrate(
         "planned_steps": (int(math.ceil(t_end / dt * (1.0 - 1e-12))) * int(getattr(checked, "batch", 1))
                           if dt is not None else None),
     }
-    stepper = method_object.start(checked, chosen_outputs, options)
-    stepper.warm_up()
-    if stepper.kind != "exact":
-        stepper.observe()  # compiles what the outputs need before the timed loop
+    try:
+        stepper = method_object.start(checked, chosen_outputs, options)
+        stepper.warm_up()
+        if stepper.kind != "exact":
+            stepper.observe()  # compiles what the outputs need before the timed loop
+    except (ArithmeticError, ValueError) as exc:
+        if not is_domain_error(exc):
+            raise
+        raise IntegrationError(
+            f"the system's expressions have no real value at the initial state ({exc}): {DOMAIN_HINT}"
+        ) from None
     return _Loop(checked, method_object, stepper, chosen_outputs, t_end, samples, dt, progress, drift_limit, extra).run()
 
 
@@ -397,6 +435,12 @@ class _Loop:
         except StepFailure as failure:
             self.cpu = time.process_time() - start
             message = f"{failure} {self._where()}"
+            raise IntegrationError(message, partial=self._solution(False, message)) from None
+        except (ArithmeticError, ValueError) as exc:
+            if not is_domain_error(exc):
+                raise
+            self.cpu = time.process_time() - start
+            message = f"a step left the real domain of the system's expressions ({exc}) {self._where()}: {DOMAIN_HINT}"
             raise IntegrationError(message, partial=self._solution(False, message)) from None
         except KeyboardInterrupt:
             self.cpu = time.process_time() - start

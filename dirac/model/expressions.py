@@ -19,7 +19,7 @@ import sympy
 from dirac.errors import InputError
 from dirac.validate import did_you_mean
 
-__all__ = ["parse_expression", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS", "TIME"]
+__all__ = ["parse_expression", "non_real_constant", "ALLOWED_FUNCTIONS", "ALLOWED_CONSTANTS", "TIME"]
 
 #: the time ``t`` of an explicitly time-dependent (rheonomic) Lagrangian or constraint
 TIME = sympy.Symbol("t", real=True)
@@ -208,3 +208,46 @@ class _Converter:
         values = [self.visit(head)]
         values.extend(-self.visit(term) if negative else self.visit(term) for negative, term in reversed(terms))
         return sympy.Add(*values)
+
+
+def non_real_constant(
+    expression: sympy.Expr, values: Mapping[sympy.Symbol, sympy.Expr] | None = None
+) -> tuple[sympy.Expr, complex] | None:
+    """The first part of ``expression`` with a value that is not a real number, or ``None``.
+
+    A Lagrangian, a constraint and a force are real functions of real variables. A
+    constant such as ``sqrt(-2)`` (``sqrt(2) I``), ``log(-1)`` (``I pi``), ``acos(2)`` or
+    ``(-8)**(1/3)`` (sympy's principal root, ``1 + sqrt(3) I``) makes them complex, and so
+    does ``sqrt(m)`` with a parameter ``m = -1``: the analysis's real arithmetic would then
+    drop imaginary parts or fail. The largest sub-expressions whose symbols all have a
+    value in ``values`` (none: constants) are evaluated with those values (30 digits); the
+    first whose imaginary part is not zero, or that has no finite value, is returned with
+    its value (``nan`` when it has none).
+    """
+    values = dict(values or {})
+    known = set(values)
+    stack = [sympy.sympify(expression)]
+    while stack:
+        node = stack.pop()
+        if node.is_Number or isinstance(node, sympy.NumberSymbol):
+            if not node.is_finite:
+                return node, complex(float("nan"))
+            continue
+        if node.free_symbols <= known:
+            try:
+                value = complex(node.xreplace(values).evalf(30))
+            except (TypeError, ValueError):
+                return node, complex(float("nan"))
+            if value.imag != 0.0 or value.real != value.real or abs(value.real) == float("inf"):
+                return node, value
+            continue
+        if isinstance(node, (sympy.Add, sympy.Mul)):
+            # the constant part of a sum or product is the sum or product of its constant terms or
+            # factors: sqrt(-2)*y is Mul(-1, sqrt(2), I, y), whose constant part is -sqrt(2)*I
+            constant = [a for a in node.args if a.free_symbols <= known]
+            if len(constant) > 1:
+                stack.append(node.func(*constant))
+                stack.extend(reversed([a for a in node.args if not a.free_symbols <= known]))
+                continue
+        stack.extend(reversed(node.args))
+    return None

@@ -27,7 +27,7 @@ from typing import Any
 import sympy
 
 from dirac.errors import InputError
-from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, TIME, parse_expression
+from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, TIME, non_real_constant, parse_expression
 from dirac.model.from_sympy import plain_forces, plain_parts
 from dirac.model.lagranges_method import is_lagranges_method, lagranges_method_parts
 from dirac.validate import did_you_mean, is_real_number, unknown_name_error, validate_finite
@@ -195,9 +195,11 @@ class Lagrangian:
         if unknown:
             names = ", ".join(sorted(s.name for s in unknown))
             raise InputError(f"the Lagrangian of {self.name!r} uses unknown names: {names}{_time_hint(unknown)}")
+        _refuse_non_real(self.expression, f"the Lagrangian of {self.name!r}", self.parameters)
         velocity_set = set(self.velocities)
         for index, chi in enumerate(self.constraints, start=1):
             label = f"constraint {index} ({chi})"
+            _refuse_non_real(chi, label, self.parameters)
             extra = chi.free_symbols - allowed
             if extra:
                 names = ", ".join(sorted(s.name for s in extra))
@@ -253,6 +255,7 @@ class Lagrangian:
                 )
             if expression.has(sympy.zoo, sympy.oo, -sympy.oo, sympy.nan):
                 raise InputError(f"the force on {label!r} is not finite: {expression}")
+            _refuse_non_real(expression, f"the force on {label!r}", self.parameters)
             if expression != 0:
                 checked[by_name[label]] = expression
         return checked
@@ -464,6 +467,12 @@ class Lagrangian:
         merged = {**self.fixed_values, **{k: float(v) for k, v in values.items()}}
         if self.validator is not None:
             self.validator(merged)
+        given: dict[sympy.Symbol, float | None] = {symbols[k]: float(v) for k, v in values.items()}
+        _refuse_non_real(self.expression, f"the Lagrangian of {self.name!r}", given)  # named before substitution
+        for index, chi in enumerate(self.constraints, start=1):
+            _refuse_non_real(chi, f"constraint {index} ({chi})", given)
+        for q, force in self.forces.items():
+            _refuse_non_real(force, f"the force on {q.name!r}", given)
         return Lagrangian(
             self.name,
             self.coordinates,
@@ -498,6 +507,26 @@ class Lagrangian:
         lines += [f"  constraint {k}: {c} = 0" for k, c in enumerate(self.constraints, start=1)]
         lines += [f"  force on {q.name}: Q = {e}" for q, e in self.forces.items()]
         return "\n".join(lines)
+
+
+def _refuse_non_real(expression: sympy.Expr, label: str, values: Mapping[sympy.Symbol, float | None]) -> None:
+    """Refuse ``expression`` when a part of it has no real value (:func:`non_real_constant`),
+    as written or with the parameters' values in ``values``."""
+    given = {p: _as_rational(v) for p, v in values.items() if is_real_number(v) and math.isfinite(v)}
+    found = non_real_constant(expression, given)
+    if found is None:
+        return
+    part, value = found
+    used = sorted((p for p in part.free_symbols if p in given), key=lambda p: p.name)
+    where = f" with {', '.join(f'{p.name} = {values[p]!r}' for p in used)}" if used else ""
+    if value != value:  # nan: no finite value
+        raise InputError(f"{label} is not finite{where}: its part {part} has no finite value")
+    raise InputError(
+        f"{label} is not real{where}: its part {part} = {value.real:.6g}{value.imag:+.6g} I is complex (a "
+        "Lagrangian, its constraints and forces are real functions); "
+        + ("give the parameter a value in its real domain" if used else
+           "write a real constant (for an odd root of a negative number, -(8**(1/3)) instead of (-8)**(1/3))")
+    )
 
 
 def _check_names(
