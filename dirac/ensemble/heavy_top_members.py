@@ -244,7 +244,9 @@ def ht_orthogonality(R):
     w(2, "while done < per_interval and not stop:")
     w(3, "n = min(call, per_interval - done)")
     if driven is not None:
-        _driven_steps(w, exact)
+        _driven_steps(w, exact,
+                      lambda depth, ta, h, tb: _observe_flow(w, depth, layout, conditions, n_exprs, ta, h, tb),
+                      lambda depth, t: _observe_kick(w, depth, layout, conditions, n_exprs, t))
     else:
         _undriven_steps(w, exact)
     w(4, "steps += 1")
@@ -262,40 +264,10 @@ def ht_orthogonality(R):
     w(5, f"status = {NON_FINITE!r}")
     w(5, "stop = True")
     w(5, "break")
-    w(4, f"for x in range({n_exprs}):")
-    w(5, "fa[x] = f[x]")
-    w(4, "ht_values(Mo, R, tb, c, f)")
-    for x, (_, kind, e) in enumerate(layout["ext"]):
-        w(4, f"if f[{e}] {'>' if kind == 'max' else '<'} EXT[i, {x}]:")
-        w(5, f"EXT[i, {x}] = f[{e}]")
-    locate = "Ma, Ra, Mo, R, ta, dt, c, Ms, Rs, fs"
-    for gi, (_, group) in enumerate(layout["cross"]):
-        w(4, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
-        w(5, "best = np.inf")
-        for e, cond in group:
-            w(5, f"if (fa[{e}] < 0.0 and f[{e}] >= 0.0) or (fa[{e}] > 0.0 and f[{e}] <= 0.0):")
-            w(6, f"u = ht_locate({e}, {locate}, fa[{e}], f[{e}])")
-            if cond >= 0:
-                w(6, "ht_conditions(Ms, Rs, ta + u * dt, c, g)")
-                w(6, f"if g[{cond}] {conditions[cond][1]} 0.0 and ta + u * dt < best:")
-            else:
-                w(6, "if ta + u * dt < best:")
-            w(7, "best = ta + u * dt")
-        w(5, "if best < np.inf:")
-        w(6, f"CROSS[i, {gi}] = best")
-    for pj, (_, e, count) in enumerate(layout["poincare"]):
-        w(4, f"if pc[{pj}] < {count} and fa[{e}] < 0.0 and f[{e}] >= 0.0:")
-        w(5, f"u = ht_locate({e}, {locate}, fa[{e}], f[{e}])")
-        w(5, f"PT[i, {pj}, pc[{pj}]] = ta + u * dt")
-        w(5, "for x in range(3):")
-        w(6, f"PM[i, {pj}, pc[{pj}], x] = Ms[x]")
-        w(6, "for y in range(3):")
-        w(7, f"PR[i, {pj}, pc[{pj}], x, y] = Rs[x, y]")
-        w(5, f"pc[{pj}] += 1")
-    w(4, "for x in range(3):")
-    w(5, "Ma[x] = Mo[x]")
-    w(5, "for y in range(3):")
-    w(6, "Ra[x, y] = R[x, y]")
+    if driven is not None:  # the last piece of a step cut by impulses starts at the last of them
+        w(4, "if cut:")
+        w(5, "ta = at")
+    _observe_flow(w, 4, layout, conditions, n_exprs, "ta", "dt" if driven is None else "h_obs", "tb")
     decided = [f"CROSS[i, {gi}] == CROSS[i, {gi}]" for gi in range(n_cross)]
     decided += [f"pc[{pj}] >= {count}" for pj, (_, _, count) in enumerate(layout["poincare"])]
     if decided:
@@ -304,7 +276,9 @@ def ht_orthogonality(R):
         w(5, "break")
     if driven is not None:
         w(3, "while q < IMP_T.shape[0] and IMP_T[q] <= target + slack:  # at the end of the call")
-        w(4, "q = ht_impulses(M, a, work, q, IMP_T[q])")
+        w(4, "t_imp = IMP_T[q]")
+        w(4, "q = ht_impulses(M, a, work, q, t_imp)")
+        _observe_kick(w, 4, layout, conditions, n_exprs, "t_imp")
         w(3, "t_call = target")
     w(3, "done += n")
     w(2, "if stop:")
@@ -335,6 +309,80 @@ def ht_run(lo, hi, MM, RR, C, W, AXES, RATES, FRACS, CAS, A, gammas, dt, starts,
 HT_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
 ''')
     return "\n".join(lines) + "\n"
+
+
+def _observe_flow(w: Any, depth: int, layout: dict, conditions: list, n_exprs: int, ta: str, h: str, tb: str) -> None:
+    """Observe the flow from ``(Ma, Ra)`` at ``ta`` to ``(Mo, R)`` at ``tb = ta + h``: the
+    expressions at the new state, extremes, crossings and Poincare points located on the
+    straight line between the two states (regula falsi, ``ht_locate``); the new state then
+    becomes the start of the next piece."""
+    d = depth
+    w(d, f"for x in range({n_exprs}):")
+    w(d + 1, "fa[x] = f[x]")
+    w(d, f"ht_values(Mo, R, {tb}, c, f)")
+    for x, (_, kind, e) in enumerate(layout["ext"]):
+        w(d, f"if f[{e}] {'>' if kind == 'max' else '<'} EXT[i, {x}]:")
+        w(d + 1, f"EXT[i, {x}] = f[{e}]")
+    locate = f"Ma, Ra, Mo, R, {ta}, {h}, c, Ms, Rs, fs"
+    for gi, (_, group) in enumerate(layout["cross"]):
+        w(d, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
+        w(d + 1, "best = np.inf")
+        for e, cond in group:
+            w(d + 1, f"if (fa[{e}] < 0.0 and f[{e}] >= 0.0) or (fa[{e}] > 0.0 and f[{e}] <= 0.0):")
+            w(d + 2, f"u = ht_locate({e}, {locate}, fa[{e}], f[{e}])")
+            if cond >= 0:
+                w(d + 2, f"ht_conditions(Ms, Rs, {ta} + u * {h}, c, g)")
+                w(d + 2, f"if g[{cond}] {conditions[cond][1]} 0.0 and {ta} + u * {h} < best:")
+            else:
+                w(d + 2, f"if {ta} + u * {h} < best:")
+            w(d + 3, f"best = {ta} + u * {h}")
+        w(d + 1, "if best < np.inf:")
+        w(d + 2, f"CROSS[i, {gi}] = best")
+    for pj, (_, e, count) in enumerate(layout["poincare"]):
+        w(d, f"if pc[{pj}] < {count} and fa[{e}] < 0.0 and f[{e}] >= 0.0:")
+        w(d + 1, f"u = ht_locate({e}, {locate}, fa[{e}], f[{e}])")
+        w(d + 1, f"PT[i, {pj}, pc[{pj}]] = {ta} + u * {h}")
+        w(d + 1, "for x in range(3):")
+        w(d + 2, f"PM[i, {pj}, pc[{pj}], x] = Ms[x]")
+        w(d + 2, "for y in range(3):")
+        w(d + 3, f"PR[i, {pj}, pc[{pj}], x, y] = Rs[x, y]")
+        w(d + 1, f"pc[{pj}] += 1")
+    w(d, "for x in range(3):")
+    w(d + 1, "Ma[x] = Mo[x]")
+    w(d + 1, "for y in range(3):")
+    w(d + 2, "Ra[x, y] = R[x, y]")
+
+
+def _observe_kick(w: Any, depth: int, layout: dict, conditions: list, n_exprs: int, t: str) -> None:
+    """Observe an impulse at time ``t``: the state jumps from ``(Ma, Ra)`` to ``(M, R)`` (``R``
+    does not move). Both are states of the trajectory at ``t``: the extremes take the state
+    after the kick; an expression that changes sign across it crosses at ``t`` (its ``when``
+    evaluated just after the kick); no Poincare point lies on a jump. Nothing is interpolated
+    across it: the next piece starts from the state after the kick."""
+    d = depth
+    w(d, "for x in range(3):")
+    w(d + 1, "Mo[x] = M[x]")
+    w(d, f"for x in range({n_exprs}):")
+    w(d + 1, "fa[x] = f[x]")
+    w(d, f"ht_values(Mo, R, {t}, c, f)")
+    for x, (_, kind, e) in enumerate(layout["ext"]):
+        w(d, f"if f[{e}] {'>' if kind == 'max' else '<'} EXT[i, {x}]:")
+        w(d + 1, f"EXT[i, {x}] = f[{e}]")
+    for gi, (_, group) in enumerate(layout["cross"]):
+        w(d, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
+        w(d + 1, "best = np.inf")
+        for e, cond in group:
+            w(d + 1, f"if (fa[{e}] < 0.0 and f[{e}] >= 0.0) or (fa[{e}] > 0.0 and f[{e}] <= 0.0):")
+            if cond >= 0:
+                w(d + 2, f"ht_conditions(Mo, R, {t}, c, g)")
+                w(d + 2, f"if g[{cond}] {conditions[cond][1]} 0.0:")
+                w(d + 3, f"best = {t}")
+            else:
+                w(d + 2, f"best = {t}")
+        w(d + 1, "if best < np.inf:")
+        w(d + 2, f"CROSS[i, {gi}] = best")
+    w(d, "for x in range(3):")
+    w(d + 1, "Ma[x] = Mo[x]")
 
 
 def _undriven_steps(w: Any, exact: bool) -> None:
@@ -413,7 +461,7 @@ def ht_step(M, R, a, w, gammas, t, dt, N, work, {args}):
 '''
 
 
-def _driven_steps(w: Any, exact: bool) -> None:
+def _driven_steps(w: Any, exact: bool, watch_flow: Any, watch_kick: Any) -> None:
     """The steps of one call ``stepper.step(n, dt)`` of a single driven run
     (:class:`dirac.flows.methods.torqued.TorquedStepper`), observed after each step.
 
@@ -423,7 +471,12 @@ def _driven_steps(w: Any, exact: bool) -> None:
     impulse inside a step cuts it in two (``rest`` to the impulse, ``dt - rest`` after); one
     on a step boundary (within ``1e-9 dt``) acts between two steps, or after the call's last;
     further impulses inside the same step cut it again, each from the last.
-    A kick whose Newton iteration fails fails the member."""
+    A kick whose Newton iteration fails fails the member.
+
+    The reductions observe every piece and every kick: ``watch_flow(depth, ta, h, tb)`` the
+    flow of a piece (:func:`_observe_flow`), ``watch_kick(depth, t)`` the jump of an impulse
+    (:func:`_observe_kick`); the step's last piece is observed after the step, from ``at``
+    over ``h_obs``."""
     step_args = "p, em, en" if exact else "axes, rates, fractions, casimir_rate"
     w(3, "t0 = t_call")
     w(3, "target = t0 + n * dt")
@@ -433,6 +486,8 @@ def _driven_steps(w: Any, exact: bool) -> None:
     w(3, "for step in range(n):")
     w(4, "cut = False")
     w(4, "t_imp = 0.0")
+    w(4, "at = 0.0")
+    w(4, "h_obs = dt")
     w(4, "while q < IMP_T.shape[0] and IMP_T[q] <= target + slack:")
     w(5, "if min(n, int(math.floor((IMP_T[q] - t0 + slack) / dt))) > step:")
     w(6, "break  # it comes in a later step")
@@ -441,6 +496,7 @@ def _driven_steps(w: Any, exact: bool) -> None:
     w(6, "cut = True")
     w(6, "break")
     w(5, "q = ht_impulses(M, a, work, q, t_imp)")
+    watch_kick(5, "t_imp")
     w(5, "first = step")
     w(5, "start = t0 + step * dt")
     w(4, "if cut:")
@@ -451,16 +507,25 @@ def _driven_steps(w: Any, exact: bool) -> None:
     w(5, "covered = rest")
     w(5, "at = t_imp")
     w(5, "if not failed:")
+    w(6, "for x in range(3):")
+    w(7, "Mo[x] = M[x]")
+    watch_flow(6, "t_k + (done + step) * dt", "rest", "t_imp")
     w(6, "q = ht_impulses(M, a, work, q, t_imp)")
+    watch_kick(6, "t_imp")
     w(5, "while not failed and q < IMP_T.shape[0] and IMP_T[q] < step_end - slack:  # more in this step")
     w(6, "following = IMP_T[q]")
     w(6, f"failed = ht_step(M, R, a, w, gammas, at, following - at, N, work, {step_args}) < 0")
     w(6, "if not failed:")
+    w(7, "for x in range(3):")
+    w(8, "Mo[x] = M[x]")
+    watch_flow(7, "at", "following - at", "following")
     w(7, "q = ht_impulses(M, a, work, q, following)")
+    watch_kick(7, "following")
     w(7, "covered += following - at")
     w(7, "at = following")
     w(5, "if not failed:")
     w(6, f"failed = ht_step(M, R, a, w, gammas, at, dt - covered, N, work, {step_args}) < 0")
+    w(5, "h_obs = dt - covered")
     w(5, "first = step + 1")
     w(5, "start = t0 + (step + 1) * dt")
     w(4, "else:")

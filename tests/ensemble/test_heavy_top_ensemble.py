@@ -515,3 +515,32 @@ def test_a_driven_free_body_runs_as_a_heavy_top_without_weight(tmp_path):
         problem = RigidBodyProblem([1.0, 2.0, 3.0], [0.1, float(m2), 0.1], torque=["0", "0", "-0.1*Omega_3"])
         single = integrate(problem, "lie-poisson-4", t_end=1.0, dt=0.01, samples=3, outputs=["M"])
         assert np.array_equal(single.outputs["M"][-1], stored["final_M"][i])
+
+
+def test_reductions_see_an_impulse_as_a_jump(tmp_path):
+    """A sphere (I = 1, no weight) keeps M between impulses (dM/dt = M x Omega = 0): M_3 = 1,
+    then -1 after the blow (0, 0, -2) at t = 0.2537 (inside a step of 0.01), then 1 after
+    (0, 0, 2) at t = 0.6 (on a step boundary). By hand: M_3 first changes sign at the first
+    blow, so its first crossing is at t = 0.2537 exactly (a line across the jump would put it
+    at 0.25 + 0.5 * 0.01 for the middle of the step); its `when` M_1 > 0 holds after the blow
+    (M_1 = 0.3 throughout); no state of the flow lies on the section M_3 = 0 (both crossings are
+    jumps), so the Poincare section is empty; max M_3 = 1 and min M_3 = -1 (the states before and
+    after each blow)."""
+    scene = ('[system]\nname = "heavy_top"\ninertia = [1.0, 1.0, 1.0]\nmass_gravity = 0.0\n\n[initial]\n'
+             'M = [0.3, "m2", 1.0]\n\n[run]\nmethod = "lie-poisson-4"\ndt = 0.01\nt_end = 1.0\nsamples = 3\n\n'
+             '[[impulses]]\nt = 0.2537\nangular_impulse = [0.0, 0.0, -2.0]\n\n'
+             '[[impulses]]\nt = 0.6\nangular_impulse = [0.0, 0.0, 2.0]\n\n'
+             '[ensemble]\ngrid = { m2 = [0.0, 0.0, 1] }\nreductions = [\n'
+             '  { kind = "first_crossing", name = "flip", expr = "M_3", when = "M_1 > 0" },\n'
+             '  { kind = "poincare", name = "section", expr = "M_3", count = 2 },\n'
+             '  { kind = "max", name = "high", expr = "M_3" },\n  { kind = "min", name = "low", expr = "M_3" },\n'
+             '  "final",\n]\n')
+    path = tmp_path / "jumps.toml"
+    path.write_text(scene)
+    assert run_ensemble(path, tmp_path / "out").complete
+    stored = _arrays(tmp_path / "out")
+    assert stored["flip"][0] == 0.2537
+    assert np.all(np.isnan(stored["section_t"][0]))
+    assert stored["high"][0] == pytest.approx(1.0, abs=1e-12) and stored["low"][0] == pytest.approx(-1.0, abs=1e-12)
+    # the splitting of a sphere is exact up to its O(dt^4) error (each sub-flow turns M about one axis)
+    assert stored["final_M"][0] == pytest.approx([0.3, 0.0, 1.0], abs=1e-8)
