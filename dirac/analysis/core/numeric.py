@@ -18,18 +18,21 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from functools import partial
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
+from dirac.analysis.core.graphs import issparse
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.analysis.core.scaled_function import ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function
 from dirac.errors import AnalysisError
+
+if TYPE_CHECKING:  # scipy.sparse is imported where it is used (large systems)
+    import scipy.sparse as sp
 
 __all__ = ["Numerics", "RankTest", "SingularSurface", "numeric_rank", "independent_rows"]
 
@@ -175,7 +178,7 @@ def independent_rows(
     in one orthogonalisation pass per point
     (:func:`~dirac.analysis.core.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
     """
-    if len(matrices) and sp.issparse(matrices[0]):
+    if len(matrices) and issparse(matrices[0]):
         eliminated = independent_rows_eliminated(matrices, order, base)
         if eliminated is not None:
             return eliminated
@@ -185,7 +188,7 @@ def independent_rows(
                 "independent at a sample point, so that choice was made on the dense path (orthogonalisation)"
             )
         matrices = [m.toarray() for m in matrices]
-        base = [b.toarray() if sp.issparse(b) else b for b in base] if base is not None else None
+        base = [b.toarray() if issparse(b) else b for b in base] if base is not None else None
     if len(matrices) and matrices[0].ndim == 2 and (
         len(order) + (len(base[0]) if base is not None else 0) >= LARGE_ROWS or matrices[0].shape[1] >= LARGE_SYSTEM
     ):
