@@ -25,7 +25,7 @@ import sympy
 
 from dirac.analysis.core.graphs import issparse
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.core.scaled_function import ScaledFunction, scaled_function, terms_of
+from dirac.analysis.core.scaled_function import BOTH, ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function
@@ -36,6 +36,8 @@ if TYPE_CHECKING:  # scipy.sparse is imported where it is used (large systems)
 
 __all__ = ["Numerics", "RankTest", "SingularSurface", "numeric_rank", "independent_rows"]
 
+#: values of scaled batches kept from their term-size calls (:meth:`Numerics._call`)
+KEPT_VALUES = 256
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
 #: residual (relative to the constraint's own term sizes) of a converged surface point
@@ -260,6 +262,9 @@ class Numerics:
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
         self._jacobians: dict[tuple, _DenseJacobian] = {}
+        #: (batch, arguments) -> values of a scaled batch computed together with its term sizes
+        #: (:meth:`_call`): the values asked next at the same point are not computed again
+        self._values_with_sizes: dict[tuple, Any] = {}
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
@@ -342,10 +347,28 @@ class Numerics:
             self._index[e] = (batch, i)
 
     def _call(self, batch: int, z: np.ndarray, sizes: bool = False) -> np.ndarray:
-        """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes."""
-        args = [*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist()]
+        """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes.
+
+        Term sizes are computed together with the values (one pass through the batch's
+        body, :data:`~dirac.analysis.core.scaled_function.BOTH`); the values are kept for
+        the last few points, so that a caller asking for the sizes and then the values at
+        the same points (:meth:`term_scale`, then :meth:`evaluate`) pays for the body once.
+        The values are the same numbers either way (the same code).
+        """
+        z = np.asarray(z, dtype=float)
+        args = [*z.tolist(), *self.parameter_vector.tolist()]
         if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
-            out = self._scaled[batch](True, *args) if sizes else self._batches[batch](*args)
+            key = (batch, z.tobytes(), self.parameter_vector.tobytes())  # bit-exact (0.0 and -0.0 differ)
+            if sizes:
+                values, out = self._scaled[batch](BOTH, *args)
+                kept = self._values_with_sizes
+                if len(kept) >= KEPT_VALUES:
+                    kept.clear()
+                kept[key] = values
+            else:
+                out = self._values_with_sizes.get(key)
+                if out is None:
+                    out = self._batches[batch](*args)
             try:
                 return np.array(out, dtype=float)
             except TypeError:  # a complex value: its real part, below
@@ -491,8 +514,8 @@ class Numerics:
         ``|e(z)| <= AVOID_TOLERANCE * (1 + sum of |terms of e| at z)``: a point on (or next to)
         the excluded set ``e = 0``, where the ranks are not those of the part assumed.
         """
+        scales = self.term_scale(self.avoid, [z])[0]  # first: the values below come with the sizes
         values = self.evaluate(self.avoid, [z])[0]
-        scales = self.term_scale(self.avoid, [z])[0]
         return bool(np.any(np.abs(values) <= AVOID_TOLERANCE * scales))
 
     def _held_variables(self, free: np.ndarray) -> np.ndarray:
