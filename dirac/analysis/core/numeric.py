@@ -36,8 +36,8 @@ if TYPE_CHECKING:  # scipy.sparse is imported where it is used (large systems)
 
 __all__ = ["Numerics", "RankTest", "SingularSurface", "numeric_rank", "independent_rows"]
 
-#: values of scaled batches kept from their term-size calls (:meth:`Numerics._call`)
-KEPT_VALUES = 256
+#: values of scaled batches kept from their term-size calls (:meth:`Numerics._call`), at most this many numbers
+KEPT_VALUES = 100_000
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
 #: residual (relative to the constraint's own term sizes) of a converged surface point
@@ -265,6 +265,7 @@ class Numerics:
         #: (batch, arguments) -> values of a scaled batch computed together with its term sizes
         #: (:meth:`_call`): the values asked next at the same point are not computed again
         self._values_with_sizes: dict[tuple, Any] = {}
+        self._kept = 0  # numbers held in it
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
@@ -362,9 +363,11 @@ class Numerics:
             if sizes:
                 values, out = self._scaled[batch](BOTH, *args)
                 kept = self._values_with_sizes
-                if len(kept) >= KEPT_VALUES:
+                if self._kept + len(values) > KEPT_VALUES:
                     kept.clear()
+                    self._kept = 0
                 kept[key] = values
+                self._kept += len(values)
             else:
                 out = self._values_with_sizes.get(key)
                 if out is None:
