@@ -30,16 +30,19 @@ from __future__ import annotations
 import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy
-from scipy.sparse import csc_matrix, csr_matrix
 
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics
 from dirac.analysis.core.phase_space import PhaseSpace
 from dirac.codegen import scalar_function
 from dirac.errors import InputError
+
+if TYPE_CHECKING:  # scipy.sparse is imported when a numeric bracket is first taken
+    from scipy.sparse import csc_matrix, csr_matrix
 
 __all__ = ["DiracBracket"]
 
@@ -492,6 +495,8 @@ class _Pattern:
 
     def assemble(self, values: np.ndarray) -> tuple[csr_matrix, csc_matrix]:
         """``A`` (CSR) and ``C = A J A^T`` (CSC) from the values of ``A``'s entries."""
+        from scipy.sparse import csc_matrix, csr_matrix  # imported when used: exact analyses never need it
+
         A = csr_matrix((values[self.order_A], self.indices_A, self.indptr_A), shape=self.shape_A)
         data = np.bincount(self.target, weights=self.sign * values[self.first] * values[self.second],
                            minlength=self.count)

@@ -18,13 +18,14 @@ import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.sparse_numeric import components, independent_rows_eliminated
 from dirac.analysis.legendre.regularity import IRREGULAR_GRADIENT, ROUND_OFF
 
 if TYPE_CHECKING:
+    import scipy.sparse as sp
+
     from dirac.analysis.core.numeric import Numerics
     from dirac.analysis.core.phase_space import PhaseSpace
 
@@ -71,6 +72,7 @@ def _normal_norms(base: sp.csr_matrix, rows: sp.csr_matrix) -> np.ndarray | None
     refinement (Björck, "Numerical Methods for Least Squares Problems", Sect. 2.9).
     ``None`` when a choice or a factorisation is not clear (the caller takes the dense path).
     """
+    import scipy.sparse as sp  # imported when used: small systems never need it
     from scipy.sparse.linalg import MatrixRankWarning, splu  # with scipy.linalg: imported when used
 
     norms = np.sqrt(np.asarray(rows.multiply(rows).sum(axis=1)).ravel())

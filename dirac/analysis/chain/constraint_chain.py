@@ -439,8 +439,8 @@ class ConstraintChain:
             self._legendre_divisors = [d.divisor for d in divisions_of([self.canonical_hamiltonian], 1, "", self.phase_space.variables)]
         if not self._legendre_divisors:
             return
+        scales = self.numerics.term_scale(self._legendre_divisors, points)  # first: the values below come with the sizes
         values = np.abs(self.numerics.evaluate(self._legendre_divisors, points))
-        scales = self.numerics.term_scale(self._legendre_divisors, points)
         for k, f in enumerate(self._legendre_divisors):
             hit = values[:, k] <= ROUND_OFF * scales[:, k]  # NaN (undefined) is left to the rank checks
             if np.any(hit):

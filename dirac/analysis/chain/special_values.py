@@ -528,8 +528,8 @@ class _Scanner:
                 return None
         else:
             points = [numerics.random_point() for _ in range(SCAN_POINTS)]
+        scales = numerics.term_scale(self.entries, points)  # first: the values below come with the sizes
         values = numerics.evaluate(self.entries, points)
-        scales = numerics.term_scale(self.entries, points)
         ranks = []
         for v, sc in zip(values, scales):
             if not (np.all(np.isfinite(v)) and np.all(np.isfinite(sc))):
@@ -661,8 +661,8 @@ def _rank_at(
     else:
         points = [numerics.random_point() for _ in range(4)]
     entries = list(matrix)
+    scales = numerics.term_scale(entries, points)  # first: the values below come with the sizes
     values = numerics.evaluate(entries, points)
-    scales = numerics.term_scale(entries, points)
     ranks = []
     for v, sc in zip(values, scales):
         if not np.all(np.isfinite(v)):

@@ -15,7 +15,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.algebra import negated
@@ -80,18 +79,31 @@ def _rank_by_blocks(m: int, rows: np.ndarray, cols: np.ndarray, values: np.ndarr
     keep = values != 0.0
     if not np.any(keep):
         return 0
-    pattern = sp.coo_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m)).tocsr()
-    matrix = sp.csr_matrix((values[keep], (rows[keep], cols[keep])), shape=(m, m))
-    singular = [
-        np.linalg.svd(matrix[block][:, block].toarray(), compute_uv=False)
-        for block in components(pattern + pattern.T)
-        if len(block) > 1 or matrix[block[0], block[0]] != 0.0
-    ]
+    if m < SPARSE_BRACKETS:  # the same blocks and singular values from dense arrays (no scipy.sparse import)
+        dense = np.zeros((m, m))
+        np.add.at(dense, (rows[keep], cols[keep]), values[keep])  # duplicates summed, as a CSR matrix does
+        linked = np.zeros((m, m), dtype=bool)
+        linked[rows[keep], cols[keep]] = True
+        singular = [
+            np.linalg.svd(dense[np.ix_(block, block)], compute_uv=False)
+            for block in components(linked | linked.T)
+            if len(block) > 1 or dense[block[0], block[0]] != 0.0
+        ]
+    else:
+        import scipy.sparse as sp  # imported when used: large constraint sets only
+
+        pattern = sp.coo_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m)).tocsr()
+        matrix = sp.csr_matrix((values[keep], (rows[keep], cols[keep])), shape=(m, m))
+        singular = [
+            np.linalg.svd(matrix[block][:, block].toarray(), compute_uv=False)
+            for block in components(pattern + pattern.T)
+            if len(block) > 1 or matrix[block[0], block[0]] != 0.0
+        ]
     if not singular:
         return 0
     pooled = np.concatenate(singular)
     if not np.all(np.isfinite(pooled)):
-        return numeric_rank(matrix.toarray())  # raises the error about non-finite entries
+        return numeric_rank(dense if m < SPARSE_BRACKETS else matrix.toarray())  # raises the error about non-finite entries
     return int(np.sum(pooled > 1e-8 * np.max(pooled))) if np.max(pooled) > 0 else 0
 
 

@@ -4,6 +4,9 @@
 (about 0.1-0.2 s of a fresh process), while the patterns of an analysis of a few
 coordinates have tens of rows. Here both searches run in Python up to :data:`SMALL_EDGES`
 edges and give the results of the scipy functions exactly; larger patterns go to scipy.
+Both take a sparse matrix or a dense array (its non-zero entries are the edges): the
+analysis of a few coordinates then never imports ``scipy.sparse`` at all (about 0.13 s of
+a fresh process, through scipy's array-API layer and ``numpy.f2py``).
 
 * :func:`connected_components`: the components of the undirected graph, labelled in the
   order of their smallest vertex (the labels scipy's search gives: a new label at each
@@ -18,27 +21,62 @@ edges and give the results of the scipy functions exactly; larger patterns go to
 
 from __future__ import annotations
 
-import numpy as np
-import scipy.sparse as sp
+import sys
+from typing import TYPE_CHECKING, Any
 
-__all__ = ["SMALL_EDGES", "connected_components", "maximum_bipartite_matching"]
+import numpy as np
+
+if TYPE_CHECKING:  # scipy.sparse is imported where it is used
+    import scipy.sparse as sp
+
+__all__ = ["SMALL_EDGES", "connected_components", "issparse", "maximum_bipartite_matching"]
 
 #: patterns with at most this many stored entries are searched in Python
 SMALL_EDGES = 4096
 
 
-def connected_components(graph: sp.spmatrix) -> tuple[int, np.ndarray]:
-    """``(count, labels)`` of the undirected graph of the square sparse ``graph`` (entries are edges).
+def issparse(matrix: Any) -> bool:
+    """Whether ``matrix`` is a ``scipy.sparse`` matrix, without importing ``scipy.sparse`` when it was never imported.
+
+    No sparse matrix can exist before ``scipy.sparse`` is imported, so the answer is then ``False``.
+    """
+    module = sys.modules.get("scipy.sparse")
+    return module is not None and bool(module.issparse(matrix))
+
+
+def _edges(graph: sp.spmatrix | np.ndarray) -> tuple[tuple[int, int], list[int], list[int]] | None:
+    """``(shape, rows, columns)`` of the non-zero entries of a dense ``graph``, row by row in column order.
+
+    The order of a CSR matrix with sorted indices (what :func:`maximum_bipartite_matching`
+    walks). ``None`` for a sparse matrix or for more than :data:`SMALL_EDGES` entries.
+    """
+    if issparse(graph):
+        return None
+    dense = np.asarray(graph)
+    rows, cols = np.nonzero(dense)  # row-major: by row, then by column
+    if len(rows) > SMALL_EDGES:
+        return None
+    return (int(dense.shape[0]), int(dense.shape[1])), rows.tolist(), cols.tolist()
+
+
+def connected_components(graph: sp.spmatrix | np.ndarray) -> tuple[int, np.ndarray]:
+    """``(count, labels)`` of the undirected graph of the square ``graph`` (sparse or dense; non-zero entries are edges).
 
     The same result as ``scipy.sparse.csgraph.connected_components(graph, directed=False)``.
     """
-    graph = sp.csr_matrix(graph)
-    if graph.nnz > SMALL_EDGES:
-        from scipy.sparse.csgraph import connected_components as scipy_components
+    edges = _edges(graph)
+    if edges is None:
+        import scipy.sparse as sp  # imported when used: a dense pattern of a small system never needs it
 
-        count, labels = scipy_components(graph, directed=False)
-        return int(count), labels
-    n = graph.shape[0]
+        graph = sp.csr_matrix(graph)
+        if graph.nnz > SMALL_EDGES:
+            from scipy.sparse.csgraph import connected_components as scipy_components
+
+            count, labels = scipy_components(graph, directed=False)
+            return int(count), labels
+        coo = graph.tocoo()
+        edges = graph.shape, coo.row.tolist(), coo.col.tolist()
+    (n, _), edge_rows, edge_cols = edges
     parent = list(range(n))
 
     def root(v: int) -> int:
@@ -47,8 +85,7 @@ def connected_components(graph: sp.spmatrix) -> tuple[int, np.ndarray]:
             v = parent[v]
         return v
 
-    coo = graph.tocoo()
-    for i, j in zip(coo.row.tolist(), coo.col.tolist()):
+    for i, j in zip(edge_rows, edge_cols):
         a, b = root(i), root(j)
         if a != b:
             parent[max(a, b)] = min(a, b)  # each root is the smallest vertex of its set
@@ -59,21 +96,30 @@ def connected_components(graph: sp.spmatrix) -> tuple[int, np.ndarray]:
     return len(label_of), labels
 
 
-def maximum_bipartite_matching(graph: sp.spmatrix) -> np.ndarray:
-    """The column matched to each row of the sparse ``graph`` (``-1``: unmatched).
+def maximum_bipartite_matching(graph: sp.spmatrix | np.ndarray) -> np.ndarray:
+    """The column matched to each row of ``graph`` (sparse or dense; ``-1``: unmatched).
 
     The same result as ``scipy.sparse.csgraph.maximum_bipartite_matching(graph,
     perm_type="column")``.
     """
-    graph = sp.csr_matrix(graph)
-    if graph.nnz > SMALL_EDGES:
-        from scipy.sparse.csgraph import maximum_bipartite_matching as scipy_matching
+    edges = _edges(graph)
+    if edges is None:
+        import scipy.sparse as sp  # imported when used: a dense pattern of a small system never needs it
 
-        return np.asarray(scipy_matching(graph, perm_type="column"))
-    graph.sort_indices()
-    rows, cols = graph.shape
-    indptr, indices = graph.indptr.tolist(), graph.indices.tolist()
-    neighbours = [indices[indptr[v]: indptr[v + 1]] for v in range(rows)]
+        graph = sp.csr_matrix(graph)
+        if graph.nnz > SMALL_EDGES:
+            from scipy.sparse.csgraph import maximum_bipartite_matching as scipy_matching
+
+            return np.asarray(scipy_matching(graph, perm_type="column"))
+        graph.sort_indices()
+        indptr, indices = graph.indptr.tolist(), graph.indices.tolist()
+        rows, cols = graph.shape
+        neighbours = [indices[indptr[v]: indptr[v + 1]] for v in range(rows)]
+    else:
+        (rows, cols), edge_rows, edge_cols = edges
+        neighbours = [[] for _ in range(rows)]
+        for i, j in zip(edge_rows, edge_cols):
+            neighbours[i].append(j)
     free = rows  # a column matched to this extra vertex is unmatched
     row_match = [-1] * rows
     col_match = [free] * cols

@@ -21,7 +21,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import sympy
-from scipy.sparse import csr_matrix
 
 from dirac.analysis.core.algebra import prints_shorter, tidy
 from dirac.analysis.core.graphs import maximum_bipartite_matching
@@ -70,7 +69,7 @@ def block_order(pattern: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
         sets in solving order (each block only needs unknowns of earlier blocks).
     """
     k = pattern.shape[0]
-    matching = maximum_bipartite_matching(csr_matrix(pattern.astype(np.int8)))
+    matching = maximum_bipartite_matching(pattern.astype(np.int8))  # dense: no scipy.sparse import
     if np.any(matching < 0):
         raise AnalysisError("a matrix that must be invertible on the constraint surface is structurally singular")
     match = np.asarray(matching)

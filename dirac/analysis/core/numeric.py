@@ -18,21 +18,26 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from functools import partial
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
+from dirac.analysis.core.graphs import issparse
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.core.scaled_function import ScaledFunction, scaled_function, terms_of
+from dirac.analysis.core.scaled_function import BOTH, ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
 from dirac.codegen import UnsupportedExpression, array_function
 from dirac.errors import AnalysisError
 
+if TYPE_CHECKING:  # scipy.sparse is imported where it is used (large systems)
+    import scipy.sparse as sp
+
 __all__ = ["Numerics", "RankTest", "SingularSurface", "numeric_rank", "independent_rows"]
 
+#: values of scaled batches kept from their term-size calls (:meth:`Numerics._call`), at most this many numbers
+KEPT_VALUES = 100_000
 #: relative size below which a value counts as zero
 ZERO_TOLERANCE = 1e-8
 #: residual (relative to the constraint's own term sizes) of a converged surface point
@@ -175,7 +180,7 @@ def independent_rows(
     in one orthogonalisation pass per point
     (:func:`~dirac.analysis.core.sparse_numeric.independent_rows_one_pass`), not one SVD per row.
     """
-    if len(matrices) and sp.issparse(matrices[0]):
+    if len(matrices) and issparse(matrices[0]):
         eliminated = independent_rows_eliminated(matrices, order, base)
         if eliminated is not None:
             return eliminated
@@ -185,7 +190,7 @@ def independent_rows(
                 "independent at a sample point, so that choice was made on the dense path (orthogonalisation)"
             )
         matrices = [m.toarray() for m in matrices]
-        base = [b.toarray() if sp.issparse(b) else b for b in base] if base is not None else None
+        base = [b.toarray() if issparse(b) else b for b in base] if base is not None else None
     if len(matrices) and matrices[0].ndim == 2 and (
         len(order) + (len(base[0]) if base is not None else 0) >= LARGE_ROWS or matrices[0].shape[1] >= LARGE_SYSTEM
     ):
@@ -257,6 +262,10 @@ class Numerics:
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
         self._jacobians: dict[tuple, _DenseJacobian] = {}
+        #: (batch, arguments) -> values of a scaled batch computed together with its term sizes
+        #: (:meth:`_call`): the values asked next at the same point are not computed again
+        self._values_with_sizes: dict[tuple, Any] = {}
+        self._kept = 0  # numbers held in it
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
@@ -339,10 +348,30 @@ class Numerics:
             self._index[e] = (batch, i)
 
     def _call(self, batch: int, z: np.ndarray, sizes: bool = False) -> np.ndarray:
-        """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes."""
-        args = [*np.asarray(z, dtype=float).tolist(), *self.parameter_vector.tolist()]
+        """The values of one compiled batch at ``z`` (real parts of complex values), or with ``sizes`` its term sizes.
+
+        Term sizes are computed together with the values (one pass through the batch's
+        body, :data:`~dirac.analysis.core.scaled_function.BOTH`); the values are kept for
+        the last few points, so that a caller asking for the sizes and then the values at
+        the same points (:meth:`term_scale`, then :meth:`evaluate`) pays for the body once.
+        The values are the same numbers either way (the same code).
+        """
+        z = np.asarray(z, dtype=float)
+        args = [*z.tolist(), *self.parameter_vector.tolist()]
         if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
-            out = self._scaled[batch](True, *args) if sizes else self._batches[batch](*args)
+            key = (batch, z.tobytes(), self.parameter_vector.tobytes())  # bit-exact (0.0 and -0.0 differ)
+            if sizes:
+                values, out = self._scaled[batch](BOTH, *args)
+                kept = self._values_with_sizes
+                if self._kept + len(values) > KEPT_VALUES:
+                    kept.clear()
+                    self._kept = 0
+                kept[key] = values
+                self._kept += len(values)
+            else:
+                out = self._values_with_sizes.get(key)
+                if out is None:
+                    out = self._batches[batch](*args)
             try:
                 return np.array(out, dtype=float)
             except TypeError:  # a complex value: its real part, below
@@ -488,8 +517,8 @@ class Numerics:
         ``|e(z)| <= AVOID_TOLERANCE * (1 + sum of |terms of e| at z)``: a point on (or next to)
         the excluded set ``e = 0``, where the ranks are not those of the part assumed.
         """
+        scales = self.term_scale(self.avoid, [z])[0]  # first: the values below come with the sizes
         values = self.evaluate(self.avoid, [z])[0]
-        scales = self.term_scale(self.avoid, [z])[0]
         return bool(np.any(np.abs(values) <= AVOID_TOLERANCE * scales))
 
     def _held_variables(self, free: np.ndarray) -> np.ndarray:

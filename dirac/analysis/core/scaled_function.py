@@ -5,8 +5,9 @@ with the size of the terms it was computed from (``1 + sum |term|``, a relative 
 test). Compiling the terms as expressions of their own prints and compiles every term's
 sub-expressions a second time, although they are already named in the straight-line code
 of the expression (``sharing="dag"``: one assignment per distinct sub-expression). Here
-one function computes both: the shared straight-line body, then either the values or,
-on request, the term sizes, each summed in the order of the terms
+one function computes both: the shared straight-line body, then the values, or on
+request the term sizes, or both from one pass (a caller that needs both at a point pays
+for the body once), each size summed in the order of the terms
 (``((1 + |t_1|) + |t_2|) + ...``, the same floating-point sums as adding the terms' values
 one by one). Higham, *Accuracy and Stability of Numerical Algorithms* (2nd ed., 2002),
 Sect. 4.2: recursive summation, whose result depends only on the order of the terms.
@@ -22,10 +23,13 @@ import sympy
 
 from dirac.codegen import straight_line
 
-__all__ = ["ScaledFunction", "scaled_function", "terms_of"]
+__all__ = ["BOTH", "ScaledFunction", "scaled_function", "terms_of"]
 
-#: ``f(flag, *arguments) -> list``: values (``flag`` false) or term sizes (``flag`` true)
-ScaledFunction = Callable[..., list[Any]]
+#: ``f(flag, *arguments)``: values (``flag`` false), term sizes (``flag`` true) or both (``flag == BOTH``)
+ScaledFunction = Callable[..., Any]
+
+#: the ``flag`` of a :data:`ScaledFunction` that returns ``(values, term sizes)`` from one pass
+BOTH = 2
 
 
 def terms_of(expr: sympy.Expr) -> tuple[sympy.Expr, ...]:
@@ -39,11 +43,11 @@ def _literal(value: float) -> str:
 
 
 def _nan_on_error(fn: ScaledFunction, n: int) -> ScaledFunction:
-    def wrapped(flag: bool, *args: float) -> list[Any]:
+    def wrapped(flag: int, *args: float) -> Any:
         try:
             return fn(flag, *args)
         except (ValueError, ZeroDivisionError, OverflowError):
-            return [math.nan] * n
+            return ([math.nan] * n, [math.nan] * n) if flag == BOTH else [math.nan] * n
 
     return wrapped
 
@@ -64,7 +68,9 @@ def scaled_function(arguments: Sequence[sympy.Symbol], expressions: Sequence[sym
         ``f(False, a_0, a_1, ...)``: the values of the expressions;
         ``f(True, a_0, a_1, ...)``: ``1 + |t_1| + |t_2| + ...`` for each expression, its
         terms ``t_i`` (:func:`terms_of`) added in their order, a term that is a number as
-        ``|float(t)|``, of a complex value its real part. Every value is NaN when the point
+        ``|float(t)|``, of a complex value its real part;
+        ``f(BOTH, a_0, a_1, ...)``: ``(values, sizes)``, the same numbers as the two calls
+        above, from one pass through the body. Every value is NaN when the point
         is outside the domain (a math domain error, a division by zero, an overflow).
 
     Raises
@@ -85,10 +91,12 @@ def scaled_function(arguments: Sequence[sympy.Symbol], expressions: Sequence[sym
         return " + ".join(["1.0", *parts])
 
     signature = ", ".join(["flag", *(f"a{k}" for k in range(len(arguments)))])
+    values = f"[{', '.join(code.outputs[: len(expressions)])}]"
     source = (
         f"def _f({signature}):\n" + "\n".join(code.body())
-        + f"\n    if flag:\n        return [{', '.join(size(terms) for terms in owned)}]"
-        + f"\n    return [{', '.join(code.outputs[: len(expressions)])}]\n"
+        + f"\n    if flag:\n        sizes = [{', '.join(size(terms) for terms in owned)}]"
+        + f"\n        return ({values}, sizes) if flag == {BOTH} else sizes"
+        + f"\n    return {values}\n"
     )
     namespace: dict[str, Any] = {"math": math}
     exec(compile(source, "<dirac codegen>", "exec"), namespace)

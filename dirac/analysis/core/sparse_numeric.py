@@ -27,12 +27,14 @@ from __future__ import annotations
 import heapq
 import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import scipy.sparse as sp
 
-from dirac.analysis.core.graphs import connected_components
+from dirac.analysis.core.graphs import connected_components, issparse
+
+if TYPE_CHECKING:  # scipy.sparse is imported where it is used
+    import scipy.sparse as sp
 
 __all__ = ["independent_rows_one_pass", "independent_rows_eliminated", "Undecided", "CLEAR", "minimum_norm_step", "full_row_rank", "components", "ZERO"]
 
@@ -209,6 +211,7 @@ class _Echelon:
 
 def _sparse_rows(matrix: sp.spmatrix | np.ndarray) -> list[dict[int, float]]:
     """The rows of ``matrix`` as ``{column: value}`` of their non-zero entries."""
+    import scipy.sparse as sp  # imported when used: small systems never need it
     M = sp.csr_matrix(matrix, dtype=float)
     M.eliminate_zeros()
     return [
@@ -265,9 +268,14 @@ def independent_rows_eliminated(
         return None
 
 
-def components(pattern: sp.spmatrix) -> list[np.ndarray]:
-    """Row sets of the connected components of the sparsity graph of a square ``pattern``."""
-    count, labels = connected_components(sp.csr_matrix(pattern != 0))
+def components(pattern: sp.spmatrix | np.ndarray) -> list[np.ndarray]:
+    """Row sets of the connected components of the sparsity graph of a square ``pattern`` (sparse or dense)."""
+    if issparse(pattern):
+        import scipy.sparse as sp  # imported when used: a dense pattern never needs it
+
+        count, labels = connected_components(sp.csr_matrix(pattern != 0))
+    else:
+        count, labels = connected_components(np.asarray(pattern) != 0)
     order = np.argsort(labels, kind="stable")
     cuts = np.flatnonzero(np.diff(labels[order])) + 1
     return [np.sort(block) for block in np.split(order, cuts)] if count else []
@@ -282,6 +290,7 @@ def full_row_rank(jacobian: sp.spmatrix, tolerance: float) -> bool:
     the connected components of its sparsity graph; each block's eigenvalues are taken
     densely.
     """
+    import scipy.sparse as sp  # imported when used: small systems never need it
     J = sp.csr_matrix(jacobian, dtype=float)
     if J.shape[0] == 0:
         return True
@@ -349,6 +358,7 @@ def minimum_norm_step(jacobian: sp.spmatrix, residual: np.ndarray) -> np.ndarray
     minimum-norm solution, also for a rank-deficient ``J`` (reducible constraints): the
     step ``numpy.linalg.lstsq`` gives, without a dense factorisation.
     """
+    import scipy.sparse as sp  # imported when used: small systems never need it
     from scipy.sparse.linalg import MatrixRankWarning, lsqr, splu  # with scipy.linalg: imported when used
 
     J = sp.csr_matrix(jacobian, dtype=float)

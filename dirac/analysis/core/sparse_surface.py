@@ -14,13 +14,15 @@ of non-zeros times the LSQR iterations.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.sparse_numeric import full_row_rank, minimum_norm_step
+
+if TYPE_CHECKING:  # scipy.sparse is imported where it is used
+    import scipy.sparse as sp
 
 __all__ = ["SparseJacobian", "LARGE_SYSTEM"]
 
@@ -48,6 +50,7 @@ class SparseJacobian:
         self._singular_gradient = singular_gradient
 
     def __call__(self, z: np.ndarray) -> sp.csr_matrix:
+        import scipy.sparse as sp  # imported when used: small systems never need it
         return sp.csr_matrix((self._values(z), (self.rows, self.cols)), shape=self.shape)
 
     @staticmethod

@@ -20,13 +20,16 @@ Gradients are evaluated from the non-zero partial derivatives only
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.graphs import connected_components
 from dirac.analysis.core.phase_space import PhaseSpace
+
+if TYPE_CHECKING:  # scipy.sparse is imported where it is used
+    import scipy.sparse as sp
 
 __all__ = ["BlockBasis", "sparse_gradients", "in_span_by_blocks", "gradient_sizes"]
 
@@ -36,6 +39,7 @@ def sparse_gradients(space: PhaseSpace, numerics, exprs: Sequence[sympy.Expr], p
 
     Only the non-zero partial derivatives are compiled and evaluated.
     """
+    import scipy.sparse as sp  # imported when used: small systems never need it
     variables = space.variables
     rows, cols, entries = space.gradient_entries(exprs)
     values = numerics.evaluate(entries, points) if entries else np.zeros((len(points), 0))
@@ -60,6 +64,7 @@ class BlockBasis:
     """
 
     def __init__(self, basis: Sequence[sp.spmatrix]) -> None:
+        import scipy.sparse as sp  # imported when used: small systems never need it
         self.matrices: list[sp.csr_matrix] = []
         self.row_label: list[np.ndarray] = []
         self.col_label: list[np.ndarray] = []
@@ -103,6 +108,7 @@ def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatri
     projection onto the span. Each vector is projected on the basis blocks it touches
     (module docstring); vectors touching the same blocks share one least-squares solve.
     """
+    import scipy.sparse as sp  # imported when used: small systems never need it
     blocks = basis if isinstance(basis, BlockBasis) else BlockBasis(basis)
     k = vectors[0].shape[0] if len(vectors) else 0
     inside = np.ones(k, dtype=bool)

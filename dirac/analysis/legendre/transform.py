@@ -37,7 +37,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 import sympy
 
 from dirac.analysis.core.algebra import tidy
@@ -208,6 +207,8 @@ def legendre_transform(lagrangian: Lagrangian, rng: np.random.Generator, paramet
             with np.errstate(all="ignore"):
                 values = np.array(w_fn(*z, *pvals), dtype=float).reshape(-1)
         if n >= SPARSE_HESSIAN:  # sparse rows: the independent ones chosen by sparse elimination
+            import scipy.sparse as sp  # imported when used: many velocities only
+
             samples.append(sp.csr_matrix((values, (rows_w, cols_w)), shape=(n, n)))
         else:
             sample = np.zeros((n, n))

@@ -73,3 +73,26 @@ def test_rank_by_connected_blocks_equals_the_dense_rank():
         rows, cols = np.nonzero(dense)
         assert _rank_by_blocks(dense.shape[0], rows, cols, dense[rows, cols]) == numeric_rank(dense) == expected
     assert _rank_by_blocks(5, np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0)) == 0
+
+
+def test_rank_by_blocks_is_the_same_on_the_sparse_path():
+    """From SPARSE_BRACKETS constraints the blocks are found on scipy.sparse matrices: the same rank as the dense SVD.
+
+    A block-diagonal antisymmetric matrix of 40 blocks of size 2 (each of rank 2: a 2 x 2
+    antisymmetric block with a non-zero entry is invertible), permuted: rank 80 of 80.
+    """
+    from dirac.analysis.classes.classification import SPARSE_BRACKETS, _rank_by_blocks
+    from dirac.analysis.core.numeric import numeric_rank
+
+    rng = np.random.default_rng(11)
+    m = 80
+    assert m >= SPARSE_BRACKETS
+    dense = np.zeros((m, m))
+    for k in range(0, m, 2):
+        a = rng.uniform(0.5, 2.0)
+        dense[k, k + 1], dense[k + 1, k] = a, -a
+    dense[-2:, -2:] = 0.0  # the last block zero: rank 78
+    perm = rng.permutation(m)
+    dense = dense[np.ix_(perm, perm)]
+    rows, cols = np.nonzero(dense)
+    assert _rank_by_blocks(m, rows, cols, dense[rows, cols]) == numeric_rank(dense) == 78

@@ -78,3 +78,27 @@ def test_large_patterns_go_to_scipy() -> None:
     assert ours.tolist() == np.asarray(csgraph.maximum_bipartite_matching(sp.csr_matrix(dense), perm_type="column")).tolist()
     count, labels = connected_components(sp.csr_matrix(dense))
     assert (count, labels.tolist()) == tuple((c if i == 0 else c.tolist()) for i, c in enumerate(csgraph.connected_components(sp.csr_matrix(dense), directed=False)))
+
+
+@pytest.mark.parametrize("seed", [8, 9])
+def test_dense_patterns_give_scipys_results(seed: int) -> None:
+    """A dense array (its non-zero entries the edges) gives scipy's matching and components, on 300 random patterns each."""
+    for dense in _patterns(300, seed):
+        theirs = csgraph.maximum_bipartite_matching(sp.csr_matrix(dense), perm_type="column")
+        assert maximum_bipartite_matching(dense).tolist() == np.asarray(theirs).tolist()
+    rng = np.random.default_rng(seed)
+    for _ in range(300):
+        n = int(rng.integers(1, 20))
+        dense = rng.random((n, n)) < rng.uniform(0.0, 0.3)  # a boolean pattern
+        count, labels = connected_components(dense)
+        ref_count, ref_labels = csgraph.connected_components(sp.csr_matrix(dense), directed=False)
+        assert (count, labels.tolist()) == (ref_count, ref_labels.tolist())
+
+
+def test_large_dense_pattern_goes_to_scipy() -> None:
+    """A dense array with more than SMALL_EDGES non-zeros is searched by scipy (the same matching)."""
+    n = 200
+    dense = (np.random.default_rng(10).random((n, n)) < (SMALL_EDGES + 2000) / n**2).astype(np.int8)
+    assert np.count_nonzero(dense) > SMALL_EDGES
+    theirs = csgraph.maximum_bipartite_matching(sp.csr_matrix(dense), perm_type="column")
+    assert maximum_bipartite_matching(dense).tolist() == np.asarray(theirs).tolist()

@@ -64,3 +64,31 @@ def test_term_scale_before_and_after_compilation_agree() -> None:
     hand = [[1.0 + 6.0 + 4.0 + 3.0, 1.0 + 2.0 + 7.0]]
     assert numerics.term_scale(exprs, [z]).tolist() == hand  # compiled here
     assert numerics.term_scale(exprs, [z]).tolist() == hand  # from the compiled function
+
+
+def test_both_from_one_pass_by_hand() -> None:
+    """flag BOTH: (values, sizes) of x*y - 3, x**2 at (2, 0.5): (-2, 4) and (1 + 1 + 3, 1 + 4) by hand; NaN pairs off the domain."""
+    from dirac.analysis.core.scaled_function import BOTH
+
+    fn = scaled_function([x, y], [x * y - 3, x**2])
+    assert fn(BOTH, 2.0, 0.5) == ([-2.0, 4.0], [5.0, 5.0])
+    values, sizes = scaled_function([x], [sympy.log(x) + 1])(BOTH, -1.0)
+    assert math.isnan(values[0]) and math.isnan(sizes[0])
+
+
+def test_values_after_sizes_at_the_same_point_and_at_another() -> None:
+    """Numerics: sizes then values at a point, then values at another point and with another parameter value, by hand.
+
+    f = a*x - y with a = 2: at (1, 3) the value -1 (size 1 + 2 + 3 = 6); at (1, -0.0) the
+    value 2; with a = 5 at (1, 3) the value 2 (values kept with the sizes belong to their
+    point and parameters only).
+    """
+    space = PhaseSpace((x,), (y,), (a,))
+    numerics = Numerics(space, {a: 2.0})
+    f = a * x - y
+    z = np.array([1.0, 3.0])
+    assert numerics.term_scale([f], [z]).tolist() == [[6.0]]
+    assert numerics.evaluate([f], [z]).tolist() == [[-1.0]]
+    assert numerics.evaluate([f], [np.array([1.0, -0.0])]).tolist() == [[2.0]]
+    numerics.parameter_vector = np.array([5.0])
+    assert numerics.evaluate([f], [z]).tolist() == [[2.0]]
