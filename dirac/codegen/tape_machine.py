@@ -31,7 +31,7 @@ import numpy as np
 
 from dirac.codegen.tape_source import Tape
 
-__all__ = ["TapeFunction", "TapeError", "machine", "machine_ready", "machine_source", "machine_compile_seconds", "ERRORS"]
+__all__ = ["TapeFunction", "TapeError", "machine", "machine_loaded", "machine_ready", "machine_source", "machine_compile_seconds", "ERRORS"]
 
 #: error codes of the machine
 ERRORS = {1: "division by zero", 2: "index out of range (or negative)", 3: "math domain or range error",
@@ -157,6 +157,11 @@ def machine_source() -> str:
     body = inspect.getsource(_execute).replace("def _execute(", "def run_tape(", 1)
     return ('"""The tape machine of dirac.codegen.tape_machine -- do not edit."""\n'
             "import math\nimport numpy as np\nimport numba\n\n\n" + _DECORATOR + "\n" + body)
+
+
+def machine_loaded() -> bool:
+    """Whether the machine is compiled or loaded in this process."""
+    return _MACHINE is not None
 
 
 def machine_ready() -> bool:

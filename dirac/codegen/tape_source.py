@@ -215,7 +215,7 @@ class _Translator:
 
     def assign(self, target: ast.expr, value: ast.expr) -> None:
         if isinstance(target, ast.Name):
-            if _is_allocation(value):
+            if isinstance(value, ast.Call) and _is_allocation(value):
                 self.allocate(target.id, value)
                 return
             if isinstance(value, ast.Name) and value.id in self.array_names:
