@@ -38,6 +38,7 @@ ERRORS = {1: "division by zero", 2: "index out of range (or negative)", 3: "math
           4: "unknown operation"}
 
 _MACHINE: Any = None
+_SOURCE: str | None = None
 _COMPILE_SECONDS: float | None = None
 
 
@@ -152,11 +153,14 @@ def machine_source() -> str:
     """The machine's module: :func:`_execute` as ``run_tape`` under numba's decorator. Written
     to the cache of generated code like a kernel module (:func:`~dirac.codegen.numba_backend.import_source`),
     so numba's on-disk cache of it sits there too and the folder's safety checks apply."""
-    import inspect
+    global _SOURCE
+    if _SOURCE is None:
+        import inspect
 
-    body = inspect.getsource(_execute).replace("def _execute(", "def run_tape(", 1)
-    return ('"""The tape machine of dirac.codegen.tape_machine -- do not edit."""\n'
-            "import math\nimport numpy as np\nimport numba\n\n\n" + _DECORATOR + "\n" + body)
+        body = inspect.getsource(_execute).replace("def _execute(", "def run_tape(", 1)
+        _SOURCE = ('"""The tape machine of dirac.codegen.tape_machine -- do not edit."""\n'
+                   "import math\nimport numpy as np\nimport numba\n\n\n" + _DECORATOR + "\n" + body)
+    return _SOURCE
 
 
 def machine_loaded() -> bool:

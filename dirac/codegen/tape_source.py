@@ -569,15 +569,20 @@ class _Lengths(ast.NodeTransformer):
         return node
 
 
-def translate(source: str, name: str) -> Tape | None:
+def translate(source: str, name: str, reasons: list[str] | None = None) -> Tape | None:
     """The tape of function ``name`` of ``source`` (Python text), or None when the function
-    uses a construct the tape does not translate (the other tiers then run it)."""
+    uses a construct the tape does not translate (the other tiers then run it; the reason is
+    appended to ``reasons`` when given)."""
     try:
         module = ast.parse(source)
     except SyntaxError:
+        if reasons is not None:
+            reasons.append("not Python source")
         return None
     functions = [n for n in module.body if isinstance(n, ast.FunctionDef) and n.name == name]
     if len(functions) != 1:
+        if reasons is not None:
+            reasons.append(f"no one function {name}")
         return None
     function = functions[0]
     lengths = _Lengths()
@@ -591,6 +596,8 @@ def translate(source: str, name: str) -> Tape | None:
             if array not in translator.array_names or tape.arrays[translator.array_names[array]] != (-1, -1):
                 raise Decline(f"{array}.shape of a local array")
             tape.lengths[translator.array_names[array]] = translator.names[f"_len_{array}"]
-    except (Decline, RecursionError):
+    except (Decline, RecursionError) as error:
+        if reasons is not None:
+            reasons.append(str(error) or type(error).__name__)
         return None
     return tape

@@ -356,6 +356,7 @@ class TieredFunction:
         self._marker: Path | None = None
         self._chars: int | None = None
         self.on_tape = False
+        self._tape_compile_estimate: float | None = None
         self.tape_failed = False
         self.tape_seconds = 0.0
         self.tape_steps = 0
@@ -576,7 +577,9 @@ class TieredFunction:
                 self.compile("DIRAC_KERNELS=compiled", args)
                 return
             tape = self.tape_estimate(planned, args)
-            estimate = self.compile_estimate()
+            if self._tape_compile_estimate is None:  # read once: the history of the cache is a file
+                self._tape_compile_estimate = self.compile_estimate()
+            estimate = self._tape_compile_estimate
             if tape is None or tape > WAIT_FACTOR * estimate:  # a longer run than the tape was taken for
                 self.on_tape = False
                 self.compile(f"about {planned} steps to go, {tape or math.inf:.1f} s on the tape machine, about "
