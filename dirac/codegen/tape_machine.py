@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -178,9 +179,10 @@ def machine_ready() -> bool:
     return ready_marker(source_path(machine_source()), "run_tape").exists()
 
 
-def machine(why: str = "a run on the tape machine") -> Any:
-    """The compiled machine (compiled, or loaded from numba's cache, on first use; a
-    compilation is announced on stderr like a kernel's)."""
+def machine(why: str = "a run on the tape machine", announce: Callable[[str, str], None] | None = None) -> Any:
+    """The compiled machine (compiled, or loaded from numba's cache, on first use); a
+    compilation is first announced by ``announce(what, why)`` when given (the tiers' one
+    stderr line, :func:`dirac.codegen.tiers.announce_compilation`)."""
     global _MACHINE, _COMPILE_SECONDS
     if _MACHINE is None:
         start = time.process_time()
@@ -191,10 +193,8 @@ def machine(why: str = "a run on the tape machine") -> Any:
 
         source = machine_source()
         marker = ready_marker(source_path(source), "run_tape")
-        if not marker.exists():
-            from dirac.codegen.tiers import announce_compilation
-
-            announce_compilation("the tape machine (once for every system)", why)
+        if not marker.exists() and announce is not None:
+            announce("the tape machine (once for every system)", why)
         dispatcher = import_source(source).run_tape
         ints = numba.int64[::1]
         floats = numba.float64[::1]

@@ -612,7 +612,7 @@ class TieredFunction:
         road = choose_road(remaining, estimate, background, self.tape_estimate(planned, args))
         if road == "tape":
             machine(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to compile "
-                    f"{self.name}")
+                    f"{self.name}", announce_compilation)
             self.on_tape = True
         elif road == "compile":
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
