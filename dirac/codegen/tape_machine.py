@@ -246,19 +246,25 @@ class TapeFunction:
         return self._layout  # type: ignore[return-value]
 
     def accepts(self, args: tuple[Any, ...]) -> bool:
-        """Whether the machine can take these arguments (float64 vectors for the arrays,
-        real numbers exactly representable for the scalars)."""
+        """Whether the machine can take these arguments: float64 vectors for the arrays, not
+        sharing memory (the machine copies them); Python or numpy doubles and integers exact
+        in a double for the scalars (floats where the tape asks for them)."""
         if len(args) != len(self.tape.parameters):
             return False
-        for (kind, _), value in zip(self.tape.parameters, args):
+        arrays = []
+        for position, ((kind, _), value) in enumerate(zip(self.tape.parameters, args)):
             if kind == "array":
                 if not (isinstance(value, np.ndarray) and value.dtype == np.float64 and value.ndim == 1):
                     return False
-            elif isinstance(value, np.ndarray) or not isinstance(value, (int, float, np.integer, np.floating)):
-                return False
-            elif isinstance(value, (int, np.integer)) and abs(int(value)) > 2 ** 53:
-                return False
-        return True
+                arrays.append(value)
+            elif isinstance(value, (float, np.float64)):
+                continue
+            elif position in self.tape.float_parameters:
+                return False  # an integer where a unary minus would give Python's 0, not -0.0
+            elif not isinstance(value, (int, np.integer)) or abs(int(value)) > 2 ** 53:
+                return False  # float32 arithmetic, or an integer not exact in a double
+        # arrays sharing memory: writes through one would be seen in the other, not in the copies
+        return not any(np.may_share_memory(a, b) for i, a in enumerate(arrays) for b in arrays[i + 1:])
 
     def __call__(self, *args: Any) -> None:
         run = machine()

@@ -76,6 +76,9 @@ class Tape:
         Array slot -> the register holding its length (``a.shape[0]``), filled at the call.
     written : set of int
         Argument slots the function writes to (copied back after a run).
+    float_parameters : set of int
+        Positions of scalar parameters whose value reaches a unary minus: they must be floats at
+        the call (Python's ``-0`` is the integer 0, the machine's ``-0.0`` a negative zero).
     """
 
     name: str
@@ -86,6 +89,7 @@ class Tape:
     arrays: list[tuple[int, int]] = field(default_factory=list)
     lengths: dict[int, int] = field(default_factory=dict)
     written: set[int] = field(default_factory=set)
+    float_parameters: set[int] = field(default_factory=set)
 
 
 class _Translator:
@@ -140,6 +144,8 @@ class _Translator:
         if arguments.vararg or arguments.kwarg or arguments.kwonlyargs or arguments.defaults or arguments.posonlyargs:
             raise Decline("only plain positional parameters")
         used_as_array = _array_names(self.function)
+        negated = _negated_parameters(self.function, used_as_array)
+        self.tape.float_parameters = {i for i, a in enumerate(arguments.args) if a.arg in negated}
         for argument in arguments.args:
             if argument.arg in used_as_array:
                 slot = len(self.tape.arrays)
@@ -540,6 +546,80 @@ def _constant(node: ast.expr) -> object:
             return {ast.Add: lambda: left + right, ast.Sub: lambda: left - right,  # type: ignore[operator]
                     ast.Mult: lambda: left * right, ast.Div: lambda: left / right}[type(node.op)]()  # type: ignore[operator]
     return None
+
+
+def _value_names(node: ast.expr) -> set[str]:
+    """The names whose values flow into the value of ``node`` (not through indices: an array
+    element is a float whatever its index), with ``"#int"`` where an integer constant or a
+    truth value does; a superset (what is not known to be a float counts)."""
+    constant = _constant(node)
+    if isinstance(constant, (bool, int)) and not isinstance(constant, float):
+        return {"#int"}
+    if isinstance(constant, float) or isinstance(node, ast.Subscript):
+        return set()
+    if isinstance(node, ast.Name):
+        return {node.id}
+    if isinstance(node, ast.Call):
+        name = _attribute(node.func)
+        if isinstance(node.func, ast.Attribute) and node.func.attr == "item":
+            return set()
+        if name == ("float",) or (name is not None and name[0] == "math"):
+            return set()
+        return set().union(*(_value_names(a) for a in node.args)) if node.args else set()
+    if isinstance(node, ast.BinOp):
+        if isinstance(node.op, ast.Div) or isinstance(_constant(node.left), float) \
+                or isinstance(_constant(node.right), float):
+            return set()  # a true division, or an operand a float: a float
+        return _value_names(node.left) | _value_names(node.right)
+    if isinstance(node, ast.UnaryOp):
+        return {"#int"} if isinstance(node.op, ast.Not) else _value_names(node.operand)
+    if isinstance(node, ast.IfExp):
+        return _value_names(node.body) | _value_names(node.orelse)
+    if isinstance(node, (ast.Compare, ast.BoolOp)):
+        return {"#int"}
+    names: set[str] = set()
+    for child in ast.iter_child_nodes(node):
+        if isinstance(child, ast.expr):
+            names |= _value_names(child)
+    return names
+
+
+def _negated_parameters(function: ast.FunctionDef, arrays: set[str]) -> set[str]:
+    """The scalar parameters whose value reaches a unary minus (they must be floats at the
+    call); raises :class:`Decline` when a value that may be an integer does (``-k`` of an
+    integer ``k = 0`` is ``0`` in Python, ``-0.0`` on the machine, and a later product
+    would carry the sign)."""
+    flows: dict[str, set[str]] = {}  # name -> names flowing into it over its assignments
+    suspects: set[str] = set()  # names that may hold an integer
+    negated: set[str] = set()
+    for node in ast.walk(function):
+        if isinstance(node, ast.Assign) and len(node.targets) == 1:
+            target, value = node.targets[0], node.value
+            pairs = list(zip(target.elts, value.elts)) if isinstance(target, ast.Tuple) and \
+                isinstance(value, ast.Tuple) else [(target, value)]
+            for left, right in pairs:
+                if isinstance(left, ast.Name):
+                    flows.setdefault(left.id, set()).update(_value_names(right))
+        elif isinstance(node, ast.AugAssign) and isinstance(node.target, ast.Name):
+            flows.setdefault(node.target.id, set()).update(_value_names(node.value))
+        elif isinstance(node, ast.For) and isinstance(node.target, ast.Name):
+            suspects.add(node.target.id)
+        elif isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub) and _constant(node) is None:
+            negated |= _value_names(node.operand)
+    changed = True
+    while changed:
+        changed = False
+        for name, sources in flows.items():
+            if name not in suspects and sources & (suspects | {"#int"}):
+                suspects.add(name)
+                changed = True
+            if name in negated and not sources <= negated:
+                negated |= sources
+                changed = True
+    if negated & (suspects | {"#int"}):
+        raise Decline("a unary minus of a value that may be an integer")
+    parameters = {a.arg for a in function.args.args} - arrays
+    return negated & parameters
 
 
 def _array_names(function: ast.FunctionDef) -> set[str]:

@@ -198,3 +198,34 @@ def test_the_operation_table_is_the_machines() -> None:
             assert f"op == {number}:\n                y = math.{name.lower()}(x)" in text
         else:
             assert f"op == {number}:  # {name}" in text
+
+
+def test_a_unary_minus_of_a_value_that_may_be_an_integer_is_declined() -> None:
+    """Python's -k of an integer k = 0 is the integer 0, and x * -k is then -0.0 for a
+    negative x; the machine holds k as the double 0.0, its minus is -0.0 and x * -0.0 is
+    +0.0: a sign apart. A unary
+    minus reached by an integer (a loop counter, an integer constant) is declined; of a
+    float it is translated, and a negated parameter must be a float at the call."""
+    python = _python("def kernel(x, out):\n    k = 0\n    out[0] = x.item(0) * -k\n", "kernel")
+    out = np.zeros(1)
+    python(np.array([-1.5]), out)
+    assert math.copysign(1.0, out[0]) == -1.0  # -1.5 * 0: -0.0 (the integer's minus is 0)
+    reasons: list[str] = []
+    assert translate("def kernel(x, out):\n    k = 0\n    out[0] = x.item(0) * -k\n", "kernel", reasons) is None
+    assert "integer" in reasons[0]
+    assert translate("def kernel(x, out):\n    for k in range(2):\n        out[k] = -k\n", "kernel") is None
+    tape = translate("def kernel(x, out, h):\n    g = h * 2.0\n    out[0] = -g\n", "kernel")
+    assert tape is not None and tape.float_parameters == {2}
+    function = TapeFunction(tape)
+    assert function.accepts((np.zeros(1), np.zeros(1), 0.0)) and not function.accepts((np.zeros(1), np.zeros(1), 0))
+
+
+def test_arrays_sharing_memory_are_not_taken() -> None:
+    """The machine copies its arrays in and out: two arguments that are views of one array
+    would not see each other's writes, as they do in Python, so such a call is not taken."""
+    tape = translate("def kernel(x, out):\n    out[0] = x[0] + 1.0\n    out[1] = x[0]\n", "kernel")
+    assert tape is not None
+    function = TapeFunction(tape)
+    base = np.zeros(3)
+    assert not function.accepts((base[:2], base[1:]))
+    assert function.accepts((np.zeros(2), np.zeros(2)))
