@@ -214,10 +214,12 @@ def test_a_unary_minus_of_a_value_that_may_be_an_integer_is_declined() -> None:
     assert translate("def kernel(x, out):\n    k = 0\n    out[0] = x.item(0) * -k\n", "kernel", reasons) is None
     assert "integer" in reasons[0]
     assert translate("def kernel(x, out):\n    for k in range(2):\n        out[k] = -k\n", "kernel") is None
-    tape = translate("def kernel(x, out, h):\n    g = h * 2.0\n    out[0] = -g\n", "kernel")
-    assert tape is not None and tape.float_parameters == {2}
+    tape = translate("def kernel(out, h):\n    g = h\n    out[0] = -g\n", "kernel")
+    assert tape is not None and tape.float_parameters == {1}
     function = TapeFunction(tape)
-    assert function.accepts((np.zeros(1), np.zeros(1), 0.0)) and not function.accepts((np.zeros(1), np.zeros(1), 0))
+    assert function.accepts((np.zeros(1), 0.0)) and not function.accepts((np.zeros(1), 0))
+    doubled = translate("def kernel(out, h):\n    out[0] = -(h * 2.0)\n", "kernel")  # a float whatever h is
+    assert doubled is not None and doubled.float_parameters == set()
 
 
 def test_arrays_sharing_memory_are_not_taken() -> None:
