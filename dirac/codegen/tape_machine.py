@@ -269,7 +269,8 @@ class TapeFunction:
     def __call__(self, *args: Any) -> None:
         run = machine()
         arrays = [value for (kind, _), value in zip(self.tape.parameters, args) if kind == "array"]
-        mem, base, rows, cols = self._memory(arrays)
+        layout, base, rows, cols = self._memory(arrays)
+        mem = np.zeros_like(layout)  # one per call: calls from two threads share nothing
         reg = self.registers.copy()
         slot = 0
         for (kind, where), value in zip(self.tape.parameters, args):

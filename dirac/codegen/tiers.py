@@ -15,6 +15,12 @@ like a tiered JIT, when to switch:
   the steps still planned against the estimated compilation, in this process or in a
   child beside it: :func:`choose_road`).
 
+A step loop has a third road between the two (:mod:`dirac.codegen.tape_machine`): its
+source translated to a register tape (:mod:`dirac.codegen.tape_source`) and run by one
+loop that numba compiles once for every system, several times faster than the interpreter,
+with the same operations in the same order; :func:`choose_road` takes it when it ends a run
+before both the interpreter and the compiler (``DIRAC_TAPE=0`` turns it off).
+
 ``DIRAC_KERNELS=compiled`` in the environment (or :func:`set_policy` ``("compiled")``,
 which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
 
