@@ -15,6 +15,12 @@ like a tiered JIT, when to switch:
   the steps still planned against the estimated compilation, in this process or in a
   child beside it: :func:`choose_road`).
 
+A step loop has a third road between the two (:mod:`dirac.codegen.tape_machine`): its
+source translated to a register tape (:mod:`dirac.codegen.tape_source`) and run by one
+loop that numba compiles once for every system, several times faster than the interpreter,
+with the same operations in the same order; :func:`choose_road` takes it when it ends a run
+before both the interpreter and the compiler (``DIRAC_TAPE=0`` turns it off).
+
 ``DIRAC_KERNELS=compiled`` in the environment (or :func:`set_policy` ``("compiled")``,
 which ``dirac bench`` uses: it times compiled kernels) skips the interpreted tier.
 
@@ -56,13 +62,30 @@ from dirac.codegen.numba_backend import (
     write_source,
 )
 from dirac.codegen.scalar_arrays import scalar_function
+from dirac.codegen.tape_machine import TapeError, TapeFunction, machine, machine_loaded, machine_ready
+from dirac.codegen.tape_source import translate
 from dirac.errors import inform
 
-__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "SHARED_CORE_FACTOR",
+__all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TAPE_SPEEDUP", "TAPE_MACHINE_SECONDS", "TAPE_LOAD_SECONDS",
+           "TAPE_PROBE_STEPS", "TAPE_RATE_STEPS", "tape_enabled", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "SHARED_CORE_FACTOR",
            "CHECK_SECONDS",
            "WARM_UP_STEPS", "WARM_UP_UNTIMED_STEPS", "WAIT_FACTOR", "choose_road", "background_enabled", "spare_core",
            "TieredModule", "TieredFunction", "announce_compilation", "is_compiled_or_cached", "tiered", "tiered_module"]
 
+#: how many times faster the tape machine runs a step loop than the interpreter, assumed before
+#: the tape's own rate is measured: 5.9-7.1 measured on the RATTLE loops of the double and triple
+#: pendulums and the tops in Euler angles (2-7 us a step against 12-41 us), taken low
+TAPE_SPEEDUP = 5.0
+#: CPU seconds to compile the tape machine on a cold cache, numba's import apart (about 0.9 s
+#: measured: numba's first compilation in a process and the machine's loop), and to load it
+#: from numba's on-disk cache (about 0.3 s)
+TAPE_MACHINE_SECONDS = 0.9
+TAPE_LOAD_SECONDS = 0.3
+#: steps of the first part a loop runs on the tape, which measures the tape's own rate
+TAPE_PROBE_STEPS = 256
+#: parts of fewer steps do not count in the tape's rate (each call costs some microseconds of
+#: copies, about a step of the triple pendulum)
+TAPE_RATE_STEPS = 32
 #: interpreted seconds after which a function is compiled (about one cold compilation of
 #: a small kernel; ``dirac bench`` measures the actual figures)
 COMPILE_SECONDS = 1.0
@@ -100,8 +123,10 @@ WARM_UP_STEPS = 64
 WARM_UP_UNTIMED_STEPS = 32
 
 
-def choose_road(interpreted: float, compile_seconds: float, background: float | None) -> str:
+def choose_road(interpreted: float, compile_seconds: float, background: float | None,
+                tape: float | None = None) -> str:
     """The road of a step loop that runs interpreted: ``"interpreted"`` (to its end),
+    ``"tape"`` (the rest on the tape machine, :mod:`dirac.codegen.tape_machine`),
     ``"compile"`` (wait for the compiler in this process) or ``"background"`` (a child process
     compiles while the loop goes on interpreted).
 
@@ -118,6 +143,9 @@ def choose_road(interpreted: float, compile_seconds: float, background: float | 
         child's start-up, its compilation and the parent's load of the result (numba's import,
         :data:`CACHE_LOAD_SECONDS`); None when no background road is open (no idle core, or
         turned off, or failed before, or a loop that cannot be split).
+    tape
+        ``T``: estimated seconds of the remainder on the tape machine, the machine's compilation
+        or load included (:meth:`TieredFunction.tape_estimate`); None when the loop has no tape.
 
     Returns
     -------
@@ -125,7 +153,9 @@ def choose_road(interpreted: float, compile_seconds: float, background: float | 
         The road, by this table (with ``c`` = :data:`COMPILE_SECONDS`, ``W`` = :data:`WAIT_FACTOR`):
 
         ================================  ==============
-        ``I <= max(c, E)``                interpreted
+        ``I <= c``                        interpreted
+        ``T < I``, ``T <= E``             tape
+        ``I <= E``                        interpreted
         ``I > W E``                       compile
         ``E < I <= W E``, ``B < I``       background
         ``E < I <= W E``, otherwise       compile
@@ -146,8 +176,16 @@ def choose_road(interpreted: float, compile_seconds: float, background: float | 
     than the interpreted run) and the child can still end the run sooner than the interpreter
     (``B < I``); it then never waits longer than the interpreted run (Paleczny, Vick & Click,
     "The Java HotSpot server compiler", JVM '01, for background compilation in a tiered JIT).
+    The tape is taken when it ends the run before both the interpreter and the compiler: its
+    wait (the machine, compiled once for every system) is part of ``T < I``, so it never
+    waits longer than the interpreted run either. Without a tape the table is the one of
+    two roads: ``I <= max(c, E)`` interpreted.
     """
-    if interpreted <= max(COMPILE_SECONDS, compile_seconds):
+    if interpreted <= COMPILE_SECONDS:
+        return "interpreted"
+    if tape is not None and tape < interpreted and tape <= compile_seconds:
+        return "tape"
+    if interpreted <= compile_seconds:
         return "interpreted"
     if interpreted > WAIT_FACTOR * compile_seconds:
         return "compile"
@@ -165,6 +203,12 @@ def spare_core() -> bool:
         return usable - os.getloadavg()[0] >= 1.0
     except OSError:
         return False
+
+
+def tape_enabled() -> bool:
+    """Whether step loops may run on the tape machine (``$DIRAC_TAPE``, default on; ``0``
+    leaves the interpreted and compiled tiers only)."""
+    return os.environ.get("DIRAC_TAPE", "1") != "0"
 
 
 def background_enabled() -> bool:
@@ -237,6 +281,8 @@ class TieredModule:
         self._compiled: ModuleType | None = None
         self._interpreted: ModuleType | None = None
         self._specialised: set[str] = set()
+        self._texts: dict[str, str] = {}
+        self._tapes: dict[str, TapeFunction | None] = {}
         self._functions: dict[str, TieredFunction] = {}
 
     @property
@@ -272,9 +318,20 @@ class TieredModule:
                 text = scalar if scalar is not None else text
             if text is not None:
                 exec(compile(text, f"<dirac generated {module.__name__} {name}>", "exec"), module.__dict__)
+            self._texts[name] = text if text is not None else (plain or "")
             self._specialised.add(name)
         function: Callable[..., Any] = getattr(module, name)
         return function
+
+    def tape_function(self, name: str) -> TapeFunction | None:
+        """Function ``name`` on the tape machine: the text :meth:`interpreted_function` runs,
+        translated (:func:`~dirac.codegen.tape_source.translate`); None when it uses a
+        construct the tape does not translate (the other tiers then run it)."""
+        if name not in self._tapes:
+            self.interpreted_function(name)
+            tape = translate(self._texts.get(name) or "", name)
+            self._tapes[name] = TapeFunction(tape) if tape is not None else None
+        return self._tapes[name]
 
     def function(self, name: str) -> TieredFunction:
         """The :class:`TieredFunction` of ``name`` (one per name, so time adds up)."""
@@ -304,10 +361,15 @@ class TieredFunction:
         self._split: tuple[int, int, int, int] | None | bool = False  # not looked at yet
         self._marker: Path | None = None
         self._chars: int | None = None
+        self.on_tape = False
+        self._tape_compile_estimate: float | None = None
+        self.tape_failed = False
+        self.tape_seconds = 0.0
+        self.tape_steps = 0
 
     @property
     def tier(self) -> str:
-        """``"compiled"`` or ``"interpreted"``: the form the next call uses. Without the
+        """``"compiled"``, ``"tape"`` or ``"interpreted"``: the form the next call uses. Without the
         marker of a finished compilation (:func:`~dirac.codegen.numba_backend.ready_marker`)
         the cache is cold, and neither numba nor the compiled module is imported to find out."""
         if self._compiled is None and (self.module._compiled is not None or self.ready_marker().exists()) \
@@ -315,7 +377,9 @@ class TieredFunction:
             self._compiled = getattr(self.module.compiled, self.name)
             if self.background is not None and self.background.poll() is not None:
                 self.background = None  # its work is done (or another process's was)
-        return "interpreted" if self._compiled is None else "compiled"
+        if self._compiled is not None:
+            return "compiled"
+        return "tape" if self.on_tape else "interpreted"
 
     def ready_marker(self) -> Path:
         """The marker file of this function's machine code in the cache (found once)."""
@@ -368,6 +432,33 @@ class TieredFunction:
         numba_import = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
         child = estimate_child_start_seconds() + self.compile_estimate() - numba_import
         return SHARED_CORE_FACTOR * child + numba_import + CACHE_LOAD_SECONDS
+
+    def tape_estimate(self, planned: int | None, args: tuple[Any, ...]) -> float | None:
+        """Estimated CPU seconds of ``planned`` steps on the tape machine, the machine's wait
+        included: its compilation (:data:`TAPE_MACHINE_SECONDS`) or load from the cache
+        (:data:`TAPE_LOAD_SECONDS`), numba's import while not imported, then the steps at the
+        tape's measured rate (before it is measured: the interpreted rate over
+        :data:`TAPE_SPEEDUP`). None when the loop has no tape (turned off, not translated,
+        failed before, arguments it does not take, or a run of unknown length)."""
+        import sys
+
+        if planned is None or not tape_enabled() or self.tape_failed or self._split_positions() is None:
+            return None
+        tape = self.module.tape_function(self.name)
+        if tape is None or not tape.accepts(args):
+            return None
+        if self.tape_steps:
+            rate = self.tape_seconds / self.tape_steps
+        else:
+            interpreted = self.seconds_per_step()
+            if interpreted is None:
+                return None
+            rate = interpreted / TAPE_SPEEDUP
+        wait = 0.0
+        if not machine_loaded():
+            wait = TAPE_LOAD_SECONDS if machine_ready() else TAPE_MACHINE_SECONDS
+            wait += 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
+        return wait + rate * planned
 
     def kernel_chars(self) -> int:
         """The size of what numba compiles for this function (:func:`kernel_chars`)."""
@@ -423,14 +514,32 @@ class TieredFunction:
             self._split = tuple(names.index(w) for w in wanted) if all(w in names for w in wanted) else None  # type: ignore[assignment]
         return self._split  # type: ignore[return-value]
 
-    def _part(self, args: tuple[Any, ...], done: int, count: int, compiled: bool) -> tuple[float, bool]:
-        """Steps ``done .. done + count`` of the loop ``args``: (evaluations, failed)."""
+    def _part(self, args: tuple[Any, ...], done: int, count: int, compiled: bool | str) -> tuple[float, bool]:
+        """Steps ``done .. done + count`` of the loop ``args`` on the road ``compiled``
+        (True or ``"compiled"``, ``"tape"``, False or ``"interpreted"``): (evaluations, failed).
+        A tape machine that stops on an error (a division by zero, a math domain error: where
+        Python raises) leaves the arguments as they were; the part is then run interpreted,
+        which does what it always does there, and the tape is not used again."""
         t, dt, n, info = self._split_positions()  # type: ignore[misc]
         part = list(args)
         part[t] = args[t] + done * args[dt] if done else args[t]
         part[n] = count
-        if compiled:
+        if compiled is True or compiled == "compiled":
             self._compiled(*part)  # type: ignore[misc]
+        elif compiled == "tape":
+            tape = self.module.tape_function(self.name)
+            assert tape is not None
+            start = time.process_time()
+            try:
+                tape(*part)
+            except TapeError:
+                self.on_tape = False
+                self.tape_failed = True
+                self._interpreted_call(count, tuple(part))
+            else:
+                if count >= TAPE_RATE_STEPS:  # a call's own cost (the copies in and out) would swamp a shorter part's rate
+                    self.tape_seconds += time.process_time() - start
+                    self.tape_steps += count
         else:
             self._interpreted_call(count, tuple(part))
         return float(args[info][2]), bool(args[info][1] != 0.0)
@@ -446,14 +555,16 @@ class TieredFunction:
             if self._compiled is None:
                 self._decide(planned if planned is None else max(planned - done, steps - done), args)
             count = steps - done
-            compiled = self._compiled is not None
-            if not compiled:
+            road = self.tier
+            if road == "interpreted":
                 per_step = self.seconds_per_step()
                 if per_step is None:
                     count = 1
                 elif self.background is not None:
                     count = max(1, min(count, int(CHECK_SECONDS / max(per_step, 1e-9))))
-            used, failed = self._part(args, done, count, compiled)
+            elif road == "tape" and self.tape_steps < TAPE_PROBE_STEPS:
+                count = min(count, TAPE_PROBE_STEPS)  # a first part measures the tape's rate
+            used, failed = self._part(args, done, count, road)
             evaluations += used
             if failed:
                 info[0] += done
@@ -464,8 +575,21 @@ class TieredFunction:
         info[2] = evaluations
 
     def _decide(self, planned: int | None, args: tuple[Any, ...]) -> None:
-        """Switch to the compiled form when it is ready or pays (see :meth:`run_steps`)."""
+        """Switch to the tape or the compiled form when it is ready or pays (see :meth:`run_steps`)."""
         if self.tier == "compiled":
+            return
+        if self.on_tape:
+            if current_policy() == "compiled":
+                self.compile("DIRAC_KERNELS=compiled", args)
+                return
+            tape = self.tape_estimate(planned, args)
+            if self._tape_compile_estimate is None:  # read once: the history of the cache is a file
+                self._tape_compile_estimate = self.compile_estimate()
+            estimate = self._tape_compile_estimate
+            if tape is None or tape > WAIT_FACTOR * estimate:  # a longer run than the tape was taken for
+                self.on_tape = False
+                self.compile(f"about {planned} steps to go, {tape or math.inf:.1f} s on the tape machine, about "
+                             f"{estimate:.1g} s to compile", args)
             return
         if current_policy() == "compiled":
             self.compile("DIRAC_KERNELS=compiled", args)
@@ -491,8 +615,12 @@ class TieredFunction:
         if estimate < remaining <= WAIT_FACTOR * estimate and background_enabled() and not self.background_failed \
                 and spare_core():
             background = self.background_estimate()
-        road = choose_road(remaining, estimate, background)
-        if road == "compile":
+        road = choose_road(remaining, estimate, background, self.tape_estimate(planned, args))
+        if road == "tape":
+            machine(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to compile "
+                    f"{self.name}", announce_compilation)
+            self.on_tape = True
+        elif road == "compile":
             self.compile(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to "
                          "compile", args)
         elif road == "background":
@@ -525,7 +653,7 @@ class TieredFunction:
         ``DIRAC_BACKGROUND_COMPILE=0``, compile in this process when the interpreted time
         still to come exceeds ``E``.
         """
-        if self.tier == "interpreted" and self._split_positions() is not None:
+        if self.tier != "compiled" and self._split_positions() is not None:
             return self._split_run(steps, planned, args)
         if self.tier == "interpreted":
             per_step = self.seconds_per_step()

@@ -129,6 +129,9 @@ def _hand_loop(x: float, steps: int) -> float:
 
 
 def _loop_module(tmp_path, monkeypatch) -> tiers.TieredFunction:
+    # the roads of a loop without a tape (one the tape declines, or DIRAC_TAPE=0): the tape's
+    # rows of the table are tested in test_tape_tiers.py
+    monkeypatch.setenv("DIRAC_TAPE", "0")
     monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(tiers, "_announced", False)
     monkeypatch.setattr(tiers, "_policy", "auto")

@@ -1,0 +1,209 @@
+"""The tape machine as a road of the tier rule: the same numbers as the interpreted and the
+compiled tiers to the last bit, on step loops of different shapes; taken when it ends a run
+before both; a run it cannot finish (an error where Python raises) goes on as the interpreted
+tier would; a loop it declines keeps the two other roads."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from dirac.codegen import tiers
+from dirac.flows.integration import integrate
+from dirac.flows.problems import ConstrainedProblem
+
+
+def _captured_loop(model_name: str, monkeypatch) -> tuple[tiers.TieredModule, str, tuple]:
+    """The generated module of a latency-corpus system, the name of the step loop its
+    ``rattle-2`` run calls, and that call's arguments (copied at its first call)."""
+    from dirac_systems.latency_models import MODELS
+
+    model = MODELS[model_name]()
+    n = len(model.state) // 2
+    problem = ConstrainedProblem(model.system, q0=model.state[:n], p0=model.state[n:])
+    captured: list[tuple[tiers.TieredModule, str, tuple]] = []
+    original = tiers.TieredFunction.run_steps
+
+    def spy(self, steps, planned, *args):  # whatever the tier (the kernel may be in the cache already)
+        if not captured and self._split_positions() is not None:
+            captured.append((self.module, self.name, tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args)))
+        return original(self, steps, planned, *args)
+
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", spy)
+    monkeypatch.setenv("DIRAC_TAPE", "0")
+    integrate(problem, "rattle-2", dt=1e-3, t_end=0.005)
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", original)
+    return captured[0]
+
+
+def _fresh(args: tuple, steps: int) -> list:
+    fresh = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+    fresh[6] = steps  # n_steps of every RATTLE loop (q, p, t, c, fractions, dt, n_steps, ...)
+    return fresh
+
+
+@pytest.mark.parametrize("model_name", ["triple_pendulum_angles", "symmetric_top_euler", "double_pendulum_cartesian"])
+def test_tape_interpreted_and_compiled_end_a_thousand_steps_on_the_same_bits(model_name: str, monkeypatch) -> None:
+    """1000 RATTLE steps of three shapes of system: a triple pendulum in angles (a 3 x 3
+    configuration-dependent mass), the heavy symmetric top in Euler angles (Goldstein eq.
+    5.59; the mass singular at theta = 0), the double pendulum in Cartesian coordinates (two
+    holonomic constraints, a constant mass: RATTLE's constrained loop). The three tiers run
+    the same operations in the same order, so the final states, the evaluation counts and
+    the last residual are equal with ``==``."""
+    module, name, args = _captured_loop(model_name, monkeypatch)
+    tape = module.tape_function(name)
+    assert tape is not None, f"{name} of {model_name} should translate"
+    runs = {"interpreted": module.interpreted_function(name), "tape": tape, "compiled": getattr(module.compiled, name)}
+    finals = {}
+    for tier, function in runs.items():
+        state = _fresh(args, 1000)
+        function(*state)
+        finals[tier] = state
+    for tier in ("tape", "compiled"):
+        for position in (0, 1, 9):  # q, p, info
+            assert np.array_equal(finals[tier][position], finals["interpreted"][position]), (tier, position)
+    assert finals["tape"][9][0] == 1000 and finals["tape"][9][1] == 0.0  # all steps done, none failed
+
+
+def test_a_time_dependent_system_runs_on_the_tape_with_the_interpreters_bits(monkeypatch) -> None:
+    """The bead on a hoop turning at a constant rate (a Lagrangian with explicit time: the
+    loop reads t, dt and the sub-steps' times): tape and interpreter agree to the last bit."""
+    module, name, args = _captured_loop("bead_on_rotating_hoop", monkeypatch)
+    tape = module.tape_function(name)
+    assert tape is not None
+    interpreted, on_tape = _fresh(args, 1000), _fresh(args, 1000)
+    module.interpreted_function(name)(*interpreted)
+    tape(*on_tape)
+    for position in (0, 1, 9):
+        assert np.array_equal(on_tape[position], interpreted[position])
+
+
+_LOOP = '''"""loop -- generated for a tape test"""
+import math
+import numpy as np
+import numba
+
+
+@numba.njit(cache=True)
+def run(x, t, dt, n_steps, info):
+    """n_steps of x <- x + sin(x) / 8 from time t (a step loop with the arguments a tier may split)."""
+    evals = 0.0
+    for step in range(n_steps):
+        x[0] = x[0] + math.sin(x[0]) / 8.0
+        evals += 1.0
+    info[0] = n_steps
+    info[1] = 0.0
+    info[2] = evals
+    info[3] = 0.0
+'''
+
+
+def _hand_loop(x: float, steps: int) -> float:
+    for _ in range(steps):
+        x = x + math.sin(x) / 8.0
+    return x
+
+
+def _loop(tmp_path, monkeypatch, source: str = _LOOP) -> tiers.TieredFunction:
+    monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("DIRAC_TAPE", "1")
+    monkeypatch.setattr(tiers, "_announced", False)
+    monkeypatch.setattr(tiers, "_policy", "auto")
+    return tiers.TieredModule(source.replace("for a tape test", f"for a tape test in {tmp_path.name}"),
+                              "a loop").function("run")
+
+
+def test_a_loop_longer_than_a_second_but_shorter_than_its_compilation_goes_on_the_tape(tmp_path, monkeypatch) -> None:
+    """Planned for 10^9 steps (hours interpreted) with a compile estimate of 10^9 s: before the
+    tape it ran interpreted to its end; now the tape machine ends it far sooner, and its
+    iterates are the hand loop's to the last bit."""
+    monkeypatch.setattr(tiers, "spare_core", lambda: False)
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
+    function = _loop(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(3000, 10**9, x, 0.0, 0.1, 3000, info)
+    assert function.tier == "tape" and function.background is None
+    assert function.tape_steps >= tiers.TAPE_PROBE_STEPS
+    assert x[0] == _hand_loop(0.5, 3000) and (info[0], info[1], info[2]) == (3000, 0.0, 3000)
+
+
+def test_a_short_loop_stays_interpreted_without_the_machine(tmp_path, monkeypatch) -> None:
+    """40 steps: far below a second interpreted; neither the tape nor the compiler is asked for."""
+    function = _loop(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
+    assert function.tier == "interpreted" and function.tape_steps == 0
+    assert x[0] == _hand_loop(0.5, 40)
+
+
+def test_a_run_of_unknown_length_on_the_tape_compiles(tmp_path, monkeypatch) -> None:
+    """Once on the tape, a run whose length is unknown has no tape estimate: it compiles (a
+    long run ends on the compiled tier)."""
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
+    roads: list[str] = []
+    monkeypatch.setattr(tiers.TieredFunction, "compile", lambda self, why, args=None: roads.append(why))
+    function = _loop(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(3000, 10**9, x, 0.0, 0.1, 3000, info)
+    assert function.tier == "tape" and not roads
+    function._decide(None, (x, 0.0, 0.1, 1, info))
+    assert len(roads) == 1 and function.tier == "interpreted"  # compile() (faked here) takes over
+
+
+def test_a_division_by_zero_on_the_tape_behaves_as_on_the_interpreted_tier(tmp_path, monkeypatch) -> None:
+    """x <- x - 1, then 1 / x, from x = 3000 reaches x = 0 exactly at step 3000: the interpreted
+    tier raises ZeroDivisionError there (with the steps before it done in place).
+    On the tape the machine stops at the division, the part is rerun interpreted from the
+    state it was given, and the same error comes with the same state."""
+    source = _LOOP.replace("x[0] = x[0] + math.sin(x[0]) / 8.0", "x[0] = x[0] - 1.0\n        evals += x[1] / x[0]")
+    outcomes = []
+    for tape in ("1", "0"):
+        folder = tmp_path / tape
+        folder.mkdir()
+        monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
+        function = _loop(folder, monkeypatch, source)
+        monkeypatch.setenv("DIRAC_TAPE", tape)
+        x, info = np.array([3000.0, 1.0]), np.zeros(4)
+        with pytest.raises(ZeroDivisionError):
+            function.run_steps(4000, 10**9, x, 0.0, 0.1, 4000, info)
+        outcomes.append((x.tolist(), function.tape_failed))
+    (x_tape, failed), (x_interpreted, _) = outcomes
+    assert x_tape == x_interpreted == [0.0, 1.0] and failed
+
+
+def test_a_loop_the_tape_declines_keeps_the_two_other_roads(tmp_path, monkeypatch) -> None:
+    """x ** 2 is not translated (CPython's and numba's powers are not the machine's
+    multiplication): no tape, and the rule of two roads decides (here: interpreted to the end
+    of a loop shorter than its compilation)."""
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
+    source = _LOOP.replace("x[0] + math.sin(x[0]) / 8.0", "x[0] + math.sin(x[0]) ** 2 / 8.0")
+    function = _loop(tmp_path, monkeypatch, source)
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(3000, 10**9, x, 0.0, 0.1, 3000, info)
+    assert function.module.tape_function("run") is None
+    assert function.tier == "interpreted" and function.tape_steps == 0
+
+
+@pytest.mark.parametrize(("interpreted", "compile_seconds", "background", "tape", "road"), [
+    # the triple pendulum's 1e5-step study, by hand: 50 us a step interpreted (I = 5 s), E = 4.19 s,
+    # the tape at a fifth of the interpreted rate (1 s) after the machine's 1.4 s: T = 2.4 s
+    (5.0, 4.19, None, 2.4, "tape"),
+    # the same loop for 1e6 steps: I = 50 s, T = 1.4 + 10 = 11.4 s > E: it compiles
+    (50.0, 4.19, None, 11.4, "compile"),
+    # 3e4 steps: I = 1.5 s, T = 1.4 + 0.3 = 1.7 s > I: interpreted (the machine would not pay)
+    (1.5, 4.19, None, 1.7, "interpreted"),
+    # I below a second: interpreted whatever the tape
+    (0.9, 4.19, None, 0.2, "interpreted"),
+    # no tape: the table of two roads, unchanged
+    (5.0, 4.19, None, None, "compile"),
+    (6.0, 4.19, 5.0, None, "background"),
+    (3.0, 4.19, None, None, "interpreted"),
+    # T = E: the tape (no wait for a compiler, the same numbers)
+    (6.0, 4.19, 5.0, 4.19, "tape"),
+])
+def test_choose_road_with_a_tape_follows_its_table(interpreted, compile_seconds, background, tape, road) -> None:
+    """choose_road against its table, worked by hand with COMPILE_SECONDS = 1 and WAIT_FACTOR = 2."""
+    assert tiers.COMPILE_SECONDS == 1.0 and tiers.WAIT_FACTOR == 2.0
+    assert tiers.choose_road(interpreted, compile_seconds, background, tape) == road
