@@ -86,7 +86,7 @@ def run_plan(starts: np.ndarray, per_interval: int, dt: float,
             plan, taken = plan_call(now, n, dt, times[used:])
             for piece in plan:
                 if isinstance(piece, Advance):
-                    steps = piece.count if piece.count > 0 and piece.size > 0.0 else 0  # as _advance skips
+                    steps = piece.steps if piece.steps > 0 and piece.size > 0.0 else 0  # as _advance skips
                     kind.append(ADVANCE)
                     time.append(piece.base)
                     count.append(steps)
@@ -95,7 +95,7 @@ def run_plan(starts: np.ndarray, per_interval: int, dt: float,
                 else:
                     kind.append(KICK)
                     time.append(piece.time)
-                    count.append(used + piece.index)
+                    count.append(used + piece.impulse)
                     size.append(0.0)
                     adjust.append(0)
             used += taken

@@ -138,7 +138,7 @@ def test_a_kick_applied_at_the_start_of_its_step_is_caught(tmp_path, monkeypatch
         for piece in plan:
             if isinstance(piece, Kick) and moved and isinstance(moved[-1], Advance) and moved[-1].size < dt:
                 cut = moved.pop()
-                moved += [Kick(piece.index, cut.base), cut]
+                moved += [Kick(piece.impulse, cut.base), cut]
             else:
                 moved.append(piece)
         return moved, used

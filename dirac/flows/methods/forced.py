@@ -42,20 +42,20 @@ _GRID_SLACK = 1e-9
 
 
 class Advance(NamedTuple):
-    """``count`` steps of size ``size`` from the time ``base`` (the kernel's step times are
+    """``steps`` steps of size ``size`` from the time ``base`` (the kernel's step times are
     ``base + k size``), then ``adjust`` added to the step count (the pieces of a cut step
     count as one step of the grid)."""
 
     base: float
-    count: int
+    steps: int
     size: float
     adjust: int = 0
 
 
 class Kick(NamedTuple):
-    """The impulse ``index`` (of the times given to :func:`plan_call`) acting at ``time``."""
+    """The impulse ``impulse`` (an index into the times given to :func:`plan_call`) acting at ``time``."""
 
-    index: int
+    impulse: int
     time: float
 
 
@@ -143,10 +143,10 @@ class ImpulsesBetweenSteps:
         for piece in plan:
             if isinstance(piece, Kick):
                 self.time = piece.time
-                self._kick(impulses[piece.index])
+                self._kick(impulses[piece.impulse])
             else:
                 self.time = piece.base
-                self._advance(piece.count, piece.size)
+                self._advance(piece.steps, piece.size)
                 self.steps += piece.adjust
         self.time = start + n_steps * dt
 
