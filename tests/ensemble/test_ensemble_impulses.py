@@ -242,3 +242,25 @@ def test_impulses_on_a_system_run_on_its_analysis_are_refused(tmp_path):
     assert result.returncode == 2, result.stderr
     assert result.stderr.startswith("error: forces and impulses are integrated for L = 1/2 q_dot^T M(q) q_dot - V(q) only")
     assert not (tmp_path / "out").exists()
+
+
+def test_conformal_members_with_impulses_equal_single_runs(tmp_path):
+    """Under linear damping the conformal splitting (exact damping, RATTLE, damping) is cut at the
+    impulses as forced RATTLE is: members equal single conformal-2 runs to the last bit."""
+    from dirac.flows import ForcedProblem, MechanicalSystem, integrate
+    from dirac.model.systems import load_system
+
+    (tmp_path / "damped.toml").write_text(DAMPED.replace(' + F*cos(w*t)"', '"'))
+    kicks = [(0.3001, {"th": 0.7}), (0.5, {"th": -0.4}), (0.61, {"th": 0.2}), (0.6133, {"th": 0.1})]
+    path = _scene(tmp_path, '[system]\nfile = "damped.toml"\n', 'q = { th = 0.3 }\nq_dot = { th = "s" }',
+                  'method = "conformal-2"\ndt = 0.01\nt_end = 1.0\nsamples = 5',
+                  'grid = { s = [0.0, 1.0, 3] }\nreductions = ["final"]' + _impulse_tables(kicks), name="conformal.toml")
+    assert run_ensemble(path, tmp_path / "out").complete
+    stored = _arrays(tmp_path / "out")
+    mechanics = MechanicalSystem.from_lagrangian(load_system(tmp_path / "damped.toml"), with_forces=True)
+    assert mechanics.conformal_rate == 0.5
+    for i, s in enumerate(stored["s"]):
+        single = integrate(ForcedProblem(mechanics, np.array([0.3]), np.array([s]), impulses=kicks), "conformal-2",
+                           t_end=1.0, dt=0.01, samples=5, outputs=["q", "p"])
+        assert np.array_equal(single.outputs["q"][-1], stored["final_q"][i])
+        assert np.array_equal(single.outputs["p"][-1], stored["final_p"][i])
