@@ -199,16 +199,20 @@ def test_a_blow_on_a_hanging_pendulum_gives_its_kinetic_energy(tmp_path):
     assert np.all(stored["energy_error"] < 1e-5)
 
 
-def test_kicked_ensemble_identical_local_and_dask(tmp_path):
+def test_kicked_ensemble_identical_local_and_dask(tmp_path, run_cli):
     """The store of a scene with impulses does not depend on where it is computed: the same
-    arrays, bit for bit, locally and on a two-worker dask cluster."""
+    arrays, bit for bit, from dirac ensemble run locally and with --cluster local --workers 2
+    (two worker processes)."""
     path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}",
                   "dt = 0.01\nt_end = 1.0\nsamples = 3",
                   'grid = { a = [-2.0, 2.0, 4], b = [0.5, 1.0, 2] }\nchunk_size = 3\nreductions = ["final", '
                   '"energy_error", { kind = "first_crossing", name = "swing", expr = "x2_dot" }]'
                   + _impulse_tables(IMPULSES[:4]))
-    assert run_ensemble(path, tmp_path / "local").complete
-    assert run_ensemble(path, tmp_path / "dask", cluster="local", n_workers=2).complete
+    status, _, stderr = run_cli("ensemble", str(path), "--out", str(tmp_path / "local"), "--no-progress")
+    assert status == 0, stderr
+    status, stdout, stderr = run_cli("ensemble", str(path), "--out", str(tmp_path / "dask"), "--cluster", "local",
+                                     "--workers", "2", "--no-progress")
+    assert status == 0 and "computed 3 chunks" in stdout, stderr
     local, dask = _arrays(tmp_path / "local"), _arrays(tmp_path / "dask")
     assert set(local) == set(dask)
     for name in local:
