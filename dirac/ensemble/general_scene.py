@@ -41,6 +41,11 @@ Reductions (each stores arrays indexed by member; a failed member is NaN, its re
   two steps where ``expr = 0`` (arrays ``<name>_t`` (count,), ``<name>_q``, ``<name>_p``
   (count, n)); NaN where fewer crossings happened.
 
+``[[impulses]]`` tables (``t = 0.5``, ``Q = { x2 = 1.0 }``: numbers, the same for every
+member) are read as a single scene reads them and make the system a forced one; each
+member's steps are cut at their times as a single run's are
+(:mod:`dirac.ensemble.impulse_plan`, which also says what the reductions see at a kick).
+
 Expressions of reductions use the coordinates, their velocities ``<q>_dot``, momenta
 ``p_<q>``, the parameters and ``t``. A member whose reductions are all decided (its
 crossings found) stops early when the scene asks for nothing that needs the rest of the
