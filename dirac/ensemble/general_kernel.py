@@ -13,10 +13,9 @@ source
   decided): step by step, each step the module's own step loop (its body pasted in, or the
   loop called for one step) at the time a single run gives that step (``t_k + j dt`` on the sample grid ``t_k`` of
   :func:`dirac.flows.integration.sample_times`), so a member's state equals a single
-  run's to the last bit;
-  With ``[[impulses]]`` the steps of each sample interval follow a single run's plan of
-  pieces and kicks instead (:mod:`dirac.ensemble.impulse_plan`, module constants
-  ``ENS_OP_*`` and the kick ``impulse_kick``);
+  run's to the last bit (with ``[[impulses]]``, the steps of each sample interval follow a
+  single run's plan of pieces and kicks instead: :mod:`dirac.ensemble.impulse_plan`, module
+  constants ``ENS_OP_*`` and the kick ``impulse_kick``);
 * ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``;
 * ``ens_momenta`` / ``ens_surface`` -- ``p = M(q) q_dot`` and the constraint residuals of
   many initial states.
