@@ -11,7 +11,6 @@ reductions are NaN; the others complete.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 
@@ -38,13 +37,9 @@ _PROJECTED_LIMIT = 16_000_000
 
 def step_grid(scene: GeneralEnsembleScene) -> tuple[np.ndarray, np.ndarray, int, float]:
     """``(starts, ends, steps per interval, dt)`` exactly as :func:`dirac.flows.integrate` cuts
-    ``[0, t_end]`` (its sample grid and step), so members step at the times a single run does."""
-    from dirac.flows.integration import sample_times
-
-    times = sample_times(scene.t_end, scene.samples)
-    spacing = float(times[1] - times[0])
-    per_interval = max(1, int(math.ceil(spacing / scene.dt_requested * (1.0 - 1e-12))))
-    return np.ascontiguousarray(times[:-1]), np.ascontiguousarray(times[1:]), per_interval, spacing / per_interval
+    ``[0, t_end]`` (its sample grid and step), so members step at the times a single run does
+    (:meth:`GeneralEnsembleScene.step_grid`)."""
+    return scene.step_grid()
 
 
 def initial_states(scene: GeneralEnsembleScene, compiled: CompiledEnsemble, values: np.ndarray,

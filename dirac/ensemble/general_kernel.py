@@ -13,7 +13,9 @@ source
   decided): step by step, each step the module's own step loop (its body pasted in, or the
   loop called for one step) at the time a single run gives that step (``t_k + j dt`` on the sample grid ``t_k`` of
   :func:`dirac.flows.integration.sample_times`), so a member's state equals a single
-  run's to the last bit;
+  run's to the last bit (with ``[[impulses]]``, the steps of each sample interval follow a
+  single run's plan of pieces and kicks instead: :mod:`dirac.ensemble.impulse_plan`, module
+  constants ``ENS_OP_*`` and the kick ``impulse_kick``);
 * ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``;
 * ``ens_momenta`` / ``ens_surface`` -- ``p = M(q) q_dot`` and the constraint residuals of
   many initial states.
@@ -145,9 +147,15 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         # the midpoint rule's time t + (step + 1/2) dt is a single run's only with its own step count
         raise InputError("[run] method = 'midpoint' is not available in ensembles of this system (its step loop "
                          "has an unusual form); use rattle-2 or rattle-4")
+    plan = None
+    if scene.impulses:  # a single run's pieces and kicks (dirac.ensemble.impulse_plan)
+        from dirac.ensemble.impulse_plan import run_plan
+
+        starts, _ends, per_interval, dt = scene.step_grid()
+        plan = run_plan(starts, per_interval, dt, scene.impulses)
     source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
                               mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
-                              "constraint_error" in kinds, pasted)
+                              "constraint_error" in kinds, pasted, plan)
     module = import_source(system_source + source)
     variables = {name: sympy.Symbol(name, real=True) for name in scene.source.names}
     parameter_exprs = {k: parse_expression(v, variables, what=f"[system] parameters.{k}")
@@ -206,7 +214,8 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
 
 def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, exprs: list, conditions: list,
                      layout: dict, step: str, n: int, m: int, needs_velocity: bool, energy: bool,
-                     constraint: bool, pasted: tuple[list[str], list[str], list[str]] | None = None) -> str:
+                     constraint: bool, pasted: tuple[list[str], list[str], list[str]] | None = None,
+                     plan: Any = None) -> str:
     from dirac.codegen.kernel_source import emit_function
 
     q = list(lagrangian.coordinates)
@@ -302,6 +311,7 @@ def ens_velocity(q, p, t, c, v, work, piv):
     w(1, "for m_k in range(starts.shape[0]):")
     w(2, "m_a = starts[m_k]")
     w(2, "for m_j in range(per_interval):")
+    body_start = len(lines)  # the step's body, followed op by op when impulses cut the steps
     w(3, f"for m_x in range({n}):")
     w(4, "m_qa[m_x] = q[m_x]")
     w(4, "m_pa[m_x] = p[m_x]")
@@ -377,6 +387,11 @@ def ens_velocity(q, p, t, c, v, work, piv):
         w(3, f"if early and {' and '.join(decided)}:")
         w(4, "m_stop = True")
         w(4, "break")
+    if plan is not None:
+        from dirac.ensemble.impulse_plan import impulse_steps, plan_source
+
+        lines[body_start - 1:] = impulse_steps(lines[body_start:], layout, conditions, n, m, len(exprs), decided)
+        out.append(plan_source(plan))
     w(2, "if m_stop:")
     w(3, "break")
     if energy:

@@ -41,6 +41,11 @@ Reductions (each stores arrays indexed by member; a failed member is NaN, its re
   two steps where ``expr = 0`` (arrays ``<name>_t`` (count,), ``<name>_q``, ``<name>_p``
   (count, n)); NaN where fewer crossings happened.
 
+``[[impulses]]`` tables (``t = 0.5``, ``Q = { x2 = 1.0 }``: numbers, the same for every
+member) are read as a single scene reads them and make the system a forced one; each
+member's steps are cut at their times as a single run's are
+(:mod:`dirac.ensemble.impulse_plan`, which also says what the reductions see at a kick).
+
 Expressions of reductions use the coordinates, their velocities ``<q>_dot``, momenta
 ``p_<q>``, the parameters and ``t``. A member whose reductions are all decided (its
 crossings found) stops early when the scene asks for nothing that needs the rest of the
@@ -179,6 +184,7 @@ class GeneralEnsembleScene:
     outputs: tuple[str, ...] = field(default=())
     system_digest: str = ""
     analysed: bool = False
+    impulses: tuple[tuple[float, tuple[float, ...]], ...] = ()
 
     general = True
 
@@ -200,6 +206,14 @@ class GeneralEnsembleScene:
         from dirac.flows.integration import sample_times
 
         return sample_times(self.t_end, self.samples)
+
+    def step_grid(self) -> tuple[np.ndarray, np.ndarray, int, float]:
+        """``(starts, ends, steps per interval, dt)`` exactly as :func:`dirac.flows.integrate` cuts
+        ``[0, t_end]`` (its sample grid and step), so members step at the times a single run does."""
+        times = self.times()
+        spacing = float(times[1] - times[0])
+        per_interval = max(1, int(math.ceil(spacing / self.dt_requested * (1.0 - 1e-12))))
+        return np.ascontiguousarray(times[:-1]), np.ascontiguousarray(times[1:]), per_interval, spacing / per_interval
 
     def array_layout(self) -> dict[str, tuple[int, ...]]:
         """Array name -> shape of one member's entry, for every array the store holds."""
@@ -232,6 +246,7 @@ class GeneralEnsembleScene:
             "reductions": [r.describe() for r in self.reductions],
             # only when set: the fingerprints of stores written before analysed systems stay
             **({"analysed": True} if self.analysed else {}),
+            **({"impulses": [[t, list(vector)] for t, vector in self.impulses]} if self.impulses else {}),
         }
 
     def fingerprint(self) -> str:
@@ -355,10 +370,7 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
             raise InputError(f"an ensemble scene needs a [{section}] table; see docs/ensembles.md")
     if is_heavy_top_scene(data):
         return parse_heavy_top_scene(data, base_dir, path)
-    if "impulses" in data:
-        raise InputError("[[impulses]] are not available in ensembles yet (a member's steps would be cut at each "
-                         "impulse time); run the members with impulses one by one with dirac run")
-    reject_unknown_keys(data, {"system", "initial", "run", "ensemble"}, "the scene", kind="section")
+    reject_unknown_keys(data, {"system", "initial", "run", "ensemble", "impulses"}, "the scene", kind="section")
     system, initial, run, ensemble = data["system"], data["initial"], data["run"], data["ensemble"]
     reject_unknown_keys(system, _SYSTEM_KEYS, "[system]")
     reject_unknown_keys(initial, _INITIAL_KEYS, "[initial]")
@@ -408,7 +420,8 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
     if not isinstance(project, bool):
         raise InputError(f"[initial] project = {project!r} must be true or false")
 
-    forced = bool(lagrangian.is_forced)
+    impulses = _impulses(data.get("impulses", []), names, source.names)
+    forced = bool(lagrangian.is_forced) or bool(impulses)  # as a single scene: impulses make the problem forced
     analysed = _analysed_system(lagrangian, forced, parameters, project)
     method, order = _method(run, forced, analysed)
     if "dt" not in run:
@@ -417,6 +430,11 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
     if "t_end" not in run:
         raise InputError("[run] needs 't_end'")
     t_end = scene_number(run["t_end"], "[run] t_end", positive=True)
+    late = [t for t, _ in impulses if t > t_end]
+    if late:  # the words of a single run (dirac.flows.integrate)
+        from dirac.errors import warn
+
+        warn(f"impulses at t = {', '.join(f'{t:g}' for t in late)} come after t_end = {t_end:g}: they are not applied")
     samples = run.get("samples", 101)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
         raise InputError(f"[run] samples = {samples!r} must be an integer >= 2")
@@ -469,8 +487,38 @@ def parse_general_scene(data: dict, base_dir: str | Path = ".", path: str | None
         order=order, dt=spacing / steps_per_sample, dt_requested=dt, t_end=t_end, samples=samples,
         steps_per_sample=steps_per_sample, reductions=reductions, newton_tolerance=tolerance,
         max_newton_iterations=iterations, chunk_size=chunk_size, path=path, system_digest=digest,
-        analysed=analysed,
+        analysed=analysed, impulses=impulses,
     )
+
+
+def _impulses(tables: object, names: tuple[str, ...], variables: tuple[str, ...]
+              ) -> tuple[tuple[float, tuple[float, ...]], ...]:
+    """The scene's ``[[impulses]]`` (``t`` > 0 and ``Q = { x = 1.0 }``, read as a single scene
+    reads them) as ``(t, J)`` with ``J`` one entry per coordinate, sorted by time (those at
+    one time in the order given, as :class:`dirac.flows.problems.ForcedProblem` sorts them).
+    Their times and values are numbers, the same for every member: an expression of the
+    ensemble variables is refused with the way out."""
+    from dirac.io.scene import _impulse_tables
+
+    if isinstance(tables, list):
+        for k, table in enumerate(tables, start=1):
+            entries = [("t", table.get("t"))] if isinstance(table, dict) else []
+            if isinstance(table, dict) and isinstance(table.get("Q"), dict):
+                entries += [(f"Q.{key}", value) for key, value in table["Q"].items()]
+            for key, value in entries:
+                if isinstance(value, str):
+                    raise InputError(
+                        f"[[impulses]] {k} {key} = {value!r}: the impulses of an ensemble are numbers, the same for "
+                        f"every member (expressions of the ensemble variables {', '.join(variables) or '(none)'} are "
+                        "not taken there); give a number, and run one ensemble per value, or vary the initial "
+                        "q_dot instead")
+    result = []
+    for k, (time, values) in enumerate(_impulse_tables(tables, "the scene"), start=1):
+        for key in values:
+            if key not in names:
+                raise unknown_name_error("coordinate", key, names, f"[[impulses]] {k} Q")
+        result.append((time, tuple(float(values.get(name, 0.0)) for name in names)))
+    return tuple(sorted(result, key=lambda impulse: impulse[0]))
 
 
 def _state_names(lagrangian: Any) -> dict[str, Any]:

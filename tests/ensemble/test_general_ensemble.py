@@ -221,16 +221,6 @@ def test_a_forced_system_refuses_a_method_without_forces_naming_those_with(tmp_p
     assert not (tmp_path / "out").exists()
 
 
-def test_impulses_are_refused_by_name(tmp_path):
-    """Impulses cut a single run's steps at their times; ensembles do not do that yet and say so."""
-    path = _scene(tmp_path, '[system]\nname = "double_pendulum"\n', f"q = {CARTESIAN_Q}", "dt = 0.01\nt_end = 0.1",
-                  'grid = { a = [0.0, 1.0, 2], b = [0.0, 1.0, 2] }\nreductions = ["final"]\n'
-                  '[[impulses]]\nt = 0.05\nangular_impulse = [1.0, 0.0, 0.0]')
-    result = _cli(path, tmp_path / "out")
-    assert result.returncode == 2 and result.stderr.startswith("error: [[impulses]] are not available in ensembles")
-    assert not (tmp_path / "out").exists()
-
-
 def test_projection_puts_members_on_the_surface(tmp_path):
     """The same off-surface initial q with project = true runs, and every member starts on the
     surface: its constraint error (max over the samples) is at the Newton tolerance."""

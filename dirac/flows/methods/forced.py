@@ -25,7 +25,7 @@ the remainder of the cut step, so the steps return to the run's grid. The output
 from __future__ import annotations
 
 import math
-from typing import Any, cast
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -35,17 +35,87 @@ from dirac.flows.dirac_field import constrained_outputs
 from dirac.flows.methods.base import Method, Stepper
 from dirac.flows.methods.constrained_stepper import ConstrainedStepper, singular_as_step_failure, tiered
 
-__all__ = ["ForcedStepper", "METHODS", "FORCED_METHOD_NAMES"]
+__all__ = ["ForcedStepper", "METHODS", "FORCED_METHOD_NAMES", "Advance", "Kick", "plan_call"]
 
 #: a cut of a step shorter than this fraction of the step is no cut (the impulse is on the grid)
 _GRID_SLACK = 1e-9
 
 
+class Advance(NamedTuple):
+    """``steps`` steps of size ``size`` from the time ``base`` (the kernel's step times are
+    ``base + k size``), then ``adjust`` added to the step count (the pieces of a cut step
+    count as one step of the grid)."""
+
+    base: float
+    steps: int
+    size: float
+    adjust: int = 0
+
+
+class Kick(NamedTuple):
+    """The impulse ``impulse`` (an index into the times given to :func:`plan_call`) acting at ``time``."""
+
+    impulse: int
+    time: float
+
+
+def plan_call(start: float, n_steps: int, dt: float, times: list[float]) -> tuple[list[Advance | Kick], int]:
+    """The pieces of one call ``step(n_steps, dt)`` of :class:`ImpulsesBetweenSteps` from the
+    time ``start``, with the impulses at ``times`` (sorted) still to come: the advances and
+    kicks in order, and how many of ``times`` they use.
+
+    A step with impulses inside is cut at each of them: pieces from the grid point
+    ``start + done dt`` to the first impulse, between the impulses (none between two at one
+    time) and from the last to the next grid point, counted as one step; an impulse on a grid
+    point (within ``1e-9 dt``) acts between two steps, at that grid point's time. Every time is
+    computed as written here (``start + done dt``, the impulse's own time), so a loop that
+    follows the plan steps at a single run's times to the last bit: the forced steppers and
+    the member loop of a general ensemble (:mod:`dirac.ensemble.impulse_plan`) both do.
+    """
+    end = start + n_steps * dt
+    slack = _GRID_SLACK * dt
+    done = 0
+    used = 0
+    plan: list[Advance | Kick] = []
+    while used < len(times) and times[used] <= end + slack:
+        index, t_impulse = used, times[used]
+        used += 1
+        offset = (t_impulse - (start + done * dt)) / dt  # steps from here to the impulse
+        whole = int(math.floor(offset + _GRID_SLACK))
+        cut = (offset - whole) * dt
+        plan.append(Advance(start + done * dt, whole, dt))
+        done += whole
+        if cut > slack:
+            step_end = start + (done + 1) * dt
+            plan.append(Advance(start + done * dt, 1, cut))
+            plan.append(Kick(index, t_impulse))
+            covered, pieces = cut, 1
+            # further impulses inside the same step: each cut from the last (the step's state is
+            # now at the last impulse's time, not at a grid point)
+            while used < len(times) and times[used] < step_end - slack:
+                following = times[used]
+                piece = following - t_impulse
+                if piece > slack:
+                    plan.append(Advance(t_impulse, 1, piece))
+                    covered += piece
+                    pieces += 1
+                plan.append(Kick(used, following))
+                used += 1
+                t_impulse = following
+            plan.append(Advance(t_impulse, 1, dt - covered, -pieces))
+            done += 1
+        else:
+            plan.append(Kick(index, start + done * dt))
+    plan.append(Advance(start + done * dt, n_steps - done, dt))
+    return plan, used
+
+
 class ImpulsesBetweenSteps:
     """``step(n_steps, dt)`` of a fixed-step method on a forced problem: the steps are cut so
     that one ends on each impulse time, where ``p`` jumps by the projected impulse and its
-    work is added. The stepper provides ``_advance(n_steps, dt)`` (no impulse inside),
-    ``pending`` (the impulses still to come), ``work`` and the state ``q``, ``p``, ``time``."""
+    work is added (the pieces of :func:`plan_call`). The stepper provides ``_advance(n_steps,
+    dt)`` (no impulse inside), ``pending`` (the impulses still to come), ``work`` and the
+    state ``q``, ``p``, ``time``."""
 
     pending: list
     work: Any
@@ -64,49 +134,21 @@ class ImpulsesBetweenSteps:
             self.work[b] += work
 
     def step(self, n_steps: int, dt: float) -> None:
-        """``n_steps`` steps of the grid ``start + k dt``. A step with impulses inside is cut
-        at each of them: pieces from the grid point to the first impulse, between the
-        impulses (none between two at one time) and from the last to the next grid point,
-        counted as one step; an impulse on a grid point (within ``1e-9 dt``) acts between
-        two steps."""
+        """``n_steps`` steps of the grid ``start + k dt``, cut at the impulses inside
+        (:func:`plan_call`)."""
         start = self.time
-        end = start + n_steps * dt
-        slack = _GRID_SLACK * dt
-        done = 0
-        while self.pending and self.pending[0].t <= end + slack:
-            impulse = self.pending.pop(0)
-            offset = (impulse.t - (start + done * dt)) / dt  # steps from here to the impulse
-            whole = int(math.floor(offset + _GRID_SLACK))
-            cut = (offset - whole) * dt
-            self._advance(whole, dt)
-            done += whole
-            self.time = start + done * dt
-            if cut > slack:
-                step_end = start + (done + 1) * dt
-                self._advance(1, cut)
-                self.time = impulse.t
-                self._kick(impulse)
-                covered, pieces = cut, 1
-                # further impulses inside the same step: each cut from the last (the step's
-                # state is now at the last impulse's time, not at a grid point)
-                while self.pending and self.pending[0].t < step_end - slack:
-                    following = self.pending.pop(0)
-                    piece = following.t - impulse.t
-                    if piece > slack:
-                        self._advance(1, piece)
-                        covered += piece
-                        pieces += 1
-                    self.time = following.t
-                    self._kick(following)
-                    impulse = following
-                self._advance(1, dt - covered)
-                self.steps -= pieces  # the pieces of the cut step count as one step of the grid
-                done += 1
-                self.time = start + done * dt
+        plan, used = plan_call(start, n_steps, dt, [impulse.t for impulse in self.pending])
+        impulses = self.pending[:used]
+        del self.pending[:used]
+        for piece in plan:
+            if isinstance(piece, Kick):
+                self.time = piece.time
+                self._kick(impulses[piece.impulse])
             else:
-                self._kick(impulse)
-        self._advance(n_steps - done, dt)
-        self.time = end
+                self.time = piece.base
+                self._advance(piece.steps, piece.size)
+                self.steps += piece.adjust
+        self.time = start + n_steps * dt
 
 
 class ForcedStepper(ImpulsesBetweenSteps, ConstrainedStepper):
