@@ -268,7 +268,8 @@ def _measure_scene(scene: Any, steps: int, repeats: int, baseline: Any) -> dict[
         numba.set_num_threads(threads)
         clock = time.process_time if threads == 1 else time.perf_counter
         start = clock()
-        module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False, *arrays)
+        module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False, *arrays,
+                       threads)
         return clock() - start
 
     def single() -> float:

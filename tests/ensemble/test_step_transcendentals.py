@@ -42,7 +42,7 @@ def _run(compiled: general_kernel.CompiledEnsemble, scene: object) -> list[np.nd
               np.full((count, shapes[2], shapes[3], n), np.nan), np.full((count, shapes[2], shapes[3], n), np.nan),
               np.zeros(count), np.zeros(count)]
     compiled.module.ens_run(0, count, Q, P, C, compiled.fractions, dt, starts, ends, per, scene.newton_tolerance,
-                            scene.max_newton_iterations, compiled.gamma, scene.early_stop, *arrays)
+                            scene.max_newton_iterations, compiled.gamma, scene.early_stop, *arrays, 2)
     return [Q, P, *arrays]
 
 
