@@ -196,6 +196,24 @@ GENERAL_SYSTEMS: dict[str, tuple[dict, dict]] = {
 }
 
 
+#: Further rows of the member-loop table of :func:`measure_general` (not flip maps): a system
+#: of another shape, with the expression of its ``max`` reduction. The triple pendulum of unit
+#: masses and rods in its angles (bobs at ``x_k = sum_{j<=k} (sin th_j, -cos th_j)``): a full
+#: 3 x 3 mass, ``v = M^-1 p`` by its adjugate; the reduction, the last bob's ``x``, reads the
+#: step's sines.
+GENERAL_EXTRA: dict[str, tuple[dict, dict, str]] = {
+    "triple pendulum (th1, th2, th3)": (
+        {"name": "triple_pendulum_angles", "coordinates": ["th1", "th2", "th3"],
+         "parameters": {"m": 1.0, "l": 1.0, "g": 9.81},
+         "lagrangian": "m*l**2*(3/2*th1_dot**2 + th2_dot**2 + 1/2*th3_dot**2 + 2*th1_dot*th2_dot*cos(th1 - th2)"
+                       " + th1_dot*th3_dot*cos(th1 - th3) + th2_dot*th3_dot*cos(th2 - th3))"
+                       " + m*g*l*(3*cos(th1) + 2*cos(th2) + cos(th3))"},
+        {"th1": "a", "th2": "b", "th3": 0.0},
+        "l*(sin(th1) + sin(th2) + sin(th3))",
+    ),
+}
+
+
 def _prange_baseline():
     """The hand-written baseline: ``numba.prange`` over members, each advanced by the
     system's own RATTLE step loop for all its steps in one call (no reductions)."""
@@ -214,8 +232,9 @@ def _prange_baseline():
 def measure_general(members: int = 1024, steps: int = 2000, dt: float = 2e-3, repeats: int = 3) -> list[dict[str, Any]]:
     """Per-member-step cost of a general ensemble against a single long run and a prange loop.
 
-    For each system of :data:`GENERAL_SYSTEMS`, members released at rest from a grid of
-    angles ``[0.2, 0.6]^2`` (none flips: every member runs every step), ``rattle-2``:
+    For each system of :data:`GENERAL_SYSTEMS` and :data:`GENERAL_EXTRA`, members released at
+    rest from a grid of angles ``[0.2, 0.6]^2`` (none flips: every member runs every step),
+    ``rattle-2``:
 
     * *single run*: the system's compiled RATTLE loop (the kernel of ``dirac run``) for
       ``members * steps`` steps of one member, ns per step;
@@ -231,12 +250,14 @@ def measure_general(members: int = 1024, steps: int = 2000, dt: float = 2e-3, re
     side = int(round(members ** 0.5))
     baseline = _prange_baseline()
     rows = []
-    for label, (system, q) in GENERAL_SYSTEMS.items():
+    systems = [(label, system, q, next(iter(q))) for label, (system, q) in GENERAL_SYSTEMS.items()]
+    systems += [(label, system, q, expr) for label, (system, q, expr) in GENERAL_EXTRA.items()]
+    for label, system, q, expr in systems:
         scene = parse_general_scene({
             "system": system, "initial": {"q": q},
             "run": {"method": "rattle-2", "dt": dt, "t_end": steps * dt, "samples": 2},
             "ensemble": {"grid": {"a": [0.2, 0.6, side], "b": [0.2, 0.6, side]},
-                         "reductions": [{"kind": "max", "expr": next(iter(q))}]},
+                         "reductions": [{"kind": "max", "expr": expr}]},
         })
         rows.append({"system": label, **_measure_scene(scene, steps, repeats, baseline)})
     return rows
@@ -268,7 +289,8 @@ def _measure_scene(scene: Any, steps: int, repeats: int, baseline: Any) -> dict[
         numba.set_num_threads(threads)
         clock = time.process_time if threads == 1 else time.perf_counter
         start = clock()
-        module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False, *arrays)
+        module.ens_run(0, count, q, p, C, compiled.fractions, step_dt, starts, ends, per, 1e-12, 50, 0.0, False, *arrays,
+                       threads)
         return clock() - start
 
     def single() -> float:

@@ -186,9 +186,11 @@ def compute_general_chunk(scene: GeneralEnsembleScene, start: int, stop: int,
     arguments = (Q, P, C, compiled.fractions, dt, starts, ends, per_interval, scene.newton_tolerance,
                  scene.max_newton_iterations, compiled.gamma, scene.early_stop,
                  CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS)
+    import numba
+
     with KERNEL_LOCK:
         try:
-            compiled.module.ens_run(0, count, *arguments)
+            compiled.module.ens_run(0, count, *arguments, numba.get_num_threads())
         except ZeroDivisionError:
             # a singular Newton matrix in some member: redo the members one by one to find it
             Q[:], P[:] = Q0, P0

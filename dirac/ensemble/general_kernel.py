@@ -16,7 +16,8 @@ source
   run's to the last bit (with ``[[impulses]]``, the steps of each sample interval follow a
   single run's plan of pieces and kicks instead: :mod:`dirac.ensemble.impulse_plan`, module
   constants ``ENS_OP_*`` and the kick ``impulse_kick``);
-* ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``;
+* ``ens_run`` -- ``numba.prange`` over the members of a chunk calling ``ens_member``
+  (interleaved over the threads: its last argument is numba's thread count);
 * ``ens_momenta`` / ``ens_surface`` -- ``p = M(q) q_dot`` and the constraint residuals of
   many initial states.
 
@@ -34,6 +35,7 @@ import numpy as np
 
 from dirac.ensemble.crossing_source import locate_source
 from dirac.ensemble.general_scene import GeneralEnsembleScene, load_lagrangian
+from dirac.ensemble.step_transcendentals import step_transcendentals, substitute_transcendentals
 from dirac.errors import InputError
 
 __all__ = ["CompiledEnsemble", "compiled_ensemble", "FAILURES"]
@@ -46,6 +48,20 @@ FAILURES: dict[int, str] = {
 }
 
 _CACHE: dict[str, CompiledEnsemble] = {}
+
+#: Whether the reductions evaluated after a step read the transcendental functions of ``q``
+#: the step has just evaluated (:mod:`dirac.ensemble.step_transcendentals`); off, they compute
+#: them again (the same bits: tests compare both).
+REUSE_STEP_TRANSCENDENTALS = True
+
+
+@dataclass(frozen=True)
+class _Reuse:
+    """What a member loop may read from the step's ``w`` after a step: the expression of each
+    entry (``entries``) and whether the module has ``velocity_w`` (``v = M^{-1} p`` from ``w``)."""
+
+    entries: list
+    velocity: bool
 
 #: The step loops a member loop calls (one step at a time).
 _STEP_KERNELS = ("rattle_constant_mass", "rattle_general", "forced_rattle_run", "conformal_run", "midpoint_run")
@@ -153,9 +169,15 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
 
         starts, _ends, per_interval, dt = scene.step_grid()
         plan = run_plan(starts, per_interval, dt, scene.impulses)
+    reuse = None
+    if REUSE_STEP_TRANSCENDENTALS and pasted is not None and step.startswith("rattle_general(") and any(
+            line.strip().startswith("w = np.empty(") for line in pasted[0]):
+        # the step leaves w = transcendentals(q) at its final q: the reductions read their sines
+        entries = step_transcendentals(system_source, lagrangian.coordinates, lagrangian.parameters, sympy.Dummy("t"))
+        reuse = _Reuse(entries, "\ndef velocity_w(q, p, w, t, c, out, work, piv):" in system_source) if entries else None
     source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
                               mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
-                              "constraint_error" in kinds, pasted, plan)
+                              "constraint_error" in kinds, pasted, plan, reuse)
     module = import_source(system_source + source)
     variables = {name: sympy.Symbol(name, real=True) for name in scene.source.names}
     parameter_exprs = {k: parse_expression(v, variables, what=f"[system] parameters.{k}")
@@ -215,7 +237,7 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
 def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, exprs: list, conditions: list,
                      layout: dict, step: str, n: int, m: int, needs_velocity: bool, energy: bool,
                      constraint: bool, pasted: tuple[list[str], list[str], list[str]] | None = None,
-                     plan: Any = None) -> str:
+                     plan: Any = None, reuse: _Reuse | None = None) -> str:
     from dirac.codegen.kernel_source import emit_function
 
     q = list(lagrangian.coordinates)
@@ -229,6 +251,20 @@ def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, 
                              (len(exprs),), params))
     out.append(emit_function("ens_conditions", "the when conditions (lhs - rhs)", arrays, scalars,
                              [c for c, _ in conditions], (len(conditions),), params))
+    # after a step: the reductions read the sines and cosines of q the step left in w (the
+    # same bits; module docstring of dirac.ensemble.step_transcendentals), and v = M^-1 p too
+    # when no entry of w depends on the time
+    fixed = {*q, *params}
+    substituted = substitute_transcendentals(exprs, reuse.entries, fixed) if reuse is not None else None
+    after_values = "ens_values(q, p, m_v, tb, c, m_f)"
+    if substituted is not None:
+        out.append(emit_function("ens_values_w", "the reductions' expressions after a step, reading w", [*arrays, ("w", substituted[1])],
+                                 scalars, substituted[0], (len(exprs),), params))
+        after_values = "ens_values_w(q, p, m_v, w, tb, c, m_f)"
+    after_velocity = "ens_velocity(q, p, tb, c, m_v, m_vw, m_vpiv)"
+    if (needs_velocity and reuse is not None and reuse.velocity
+            and all(entry.free_symbols <= fixed for entry in reuse.entries)):
+        after_velocity = "velocity_w(q, p, w, tb, c, m_v, m_vw, m_vpiv)"
     velocity_body = "    velocity(q, p, t, c, v, work, piv)" if needs_velocity else "    return"
     out.append(f'''
 @numba.njit(cache=True, inline="always")
@@ -352,8 +388,9 @@ def ens_velocity(q, p, t, c, v, work, piv):
     w(4, "m_status = 2.0")
     w(4, "m_stop = True")
     w(4, "break")
-    w(3, "ens_velocity(q, p, tb, c, m_v, m_vw, m_vpiv)")
-    w(3, "ens_values(q, p, m_v, tb, c, m_f)")
+    if needs_velocity:
+        w(3, after_velocity)
+    w(3, after_values)
     for x, (_, kind, e) in enumerate(layout["ext"]):
         op = ">" if kind == "max" else "<"
         w(3, f"if m_f[{e}] {op} EXT[m_i, {x}]:")
@@ -410,11 +447,18 @@ def ens_velocity(q, p, t, c, v, work, piv):
 
 @numba.njit(cache=True, parallel=True)
 def ens_run(lo, hi, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
-            CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS):
-    """ens_member for members lo .. hi-1, in parallel over members (numba.prange)."""
-    for i in numba.prange(lo, hi):
-        ens_member(i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
-                   CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS)
+            CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS, threads):
+    """ens_member for members lo .. hi-1, in parallel over members (numba.prange): with
+    ``threads`` = numba's thread count T, thread k runs members lo + k, lo + k + T, ...
+    (neighbouring members cost alike, so the threads' shares cost alike even where many members
+    stop early; halves of the range did not: the 256 x 256 flip map's threads idled 4 % of the
+    wall time). The count is an argument: numba.get_num_threads() here would keep numba from
+    caching this function."""
+    stripes = max(1, min(threads, hi - lo))
+    for k in numba.prange(stripes):
+        for i in range(lo + k, hi, stripes):
+            ens_member(i, Q, P, C, fractions, dt, starts, ends, per_interval, tol, max_iter, gamma, early,
+                       CROSS, EXT, EERR, CERR, PT, PQ, PP, STATUS, STEPS)
 
 
 @numba.njit(cache=True)
