@@ -311,18 +311,24 @@ HT_SHAPES = ({max(1, n_cross)}, {max(1, n_ext)}, {max(1, n_poin)}, {k_max})
     return "\n".join(lines) + "\n"
 
 
+def _new_values(w: Any, depth: int, layout: dict, n_exprs: int, t: str) -> None:
+    """The expressions' values ``fa`` kept, ``f`` at the new state ``(Mo, R)`` at time ``t``,
+    and the extremes updated with them."""
+    w(depth, f"for x in range({n_exprs}):")
+    w(depth + 1, "fa[x] = f[x]")
+    w(depth, f"ht_values(Mo, R, {t}, c, f)")
+    for x, (_, kind, e) in enumerate(layout["ext"]):
+        w(depth, f"if f[{e}] {'>' if kind == 'max' else '<'} EXT[i, {x}]:")
+        w(depth + 1, f"EXT[i, {x}] = f[{e}]")
+
+
 def _observe_flow(w: Any, depth: int, layout: dict, conditions: list, n_exprs: int, ta: str, h: str, tb: str) -> None:
     """Observe the flow from ``(Ma, Ra)`` at ``ta`` to ``(Mo, R)`` at ``tb = ta + h``: the
     expressions at the new state, extremes, crossings and Poincare points located on the
     straight line between the two states (regula falsi, ``ht_locate``); the new state then
     becomes the start of the next piece."""
     d = depth
-    w(d, f"for x in range({n_exprs}):")
-    w(d + 1, "fa[x] = f[x]")
-    w(d, f"ht_values(Mo, R, {tb}, c, f)")
-    for x, (_, kind, e) in enumerate(layout["ext"]):
-        w(d, f"if f[{e}] {'>' if kind == 'max' else '<'} EXT[i, {x}]:")
-        w(d + 1, f"EXT[i, {x}] = f[{e}]")
+    _new_values(w, d, layout, n_exprs, tb)
     locate = f"Ma, Ra, Mo, R, {ta}, {h}, c, Ms, Rs, fs"
     for gi, (_, group) in enumerate(layout["cross"]):
         w(d, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
@@ -362,12 +368,7 @@ def _observe_kick(w: Any, depth: int, layout: dict, conditions: list, n_exprs: i
     d = depth
     w(d, "for x in range(3):")
     w(d + 1, "Mo[x] = M[x]")
-    w(d, f"for x in range({n_exprs}):")
-    w(d + 1, "fa[x] = f[x]")
-    w(d, f"ht_values(Mo, R, {t}, c, f)")
-    for x, (_, kind, e) in enumerate(layout["ext"]):
-        w(d, f"if f[{e}] {'>' if kind == 'max' else '<'} EXT[i, {x}]:")
-        w(d + 1, f"EXT[i, {x}] = f[{e}]")
+    _new_values(w, d, layout, n_exprs, t)
     for gi, (_, group) in enumerate(layout["cross"]):
         w(d, f"if CROSS[i, {gi}] != CROSS[i, {gi}]:")
         w(d + 1, "best = np.inf")

@@ -5,10 +5,9 @@ tier would; a loop it declines keeps the two other roads."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
+from sine_loop import SINE_LOOP, hand_loop
 
 from dirac.codegen import tiers
 from dirac.flows.integration import integrate
@@ -80,38 +79,14 @@ def test_a_time_dependent_system_runs_on_the_tape_with_the_interpreters_bits(mon
         assert np.array_equal(on_tape[position], interpreted[position])
 
 
-_LOOP = '''"""loop -- generated for a tape test"""
-import math
-import numpy as np
-import numba
 
 
-@numba.njit(cache=True)
-def run(x, t, dt, n_steps, info):
-    """n_steps of x <- x + sin(x) / 8 from time t (a step loop with the arguments a tier may split)."""
-    evals = 0.0
-    for step in range(n_steps):
-        x[0] = x[0] + math.sin(x[0]) / 8.0
-        evals += 1.0
-    info[0] = n_steps
-    info[1] = 0.0
-    info[2] = evals
-    info[3] = 0.0
-'''
-
-
-def _hand_loop(x: float, steps: int) -> float:
-    for _ in range(steps):
-        x = x + math.sin(x) / 8.0
-    return x
-
-
-def _loop(tmp_path, monkeypatch, source: str = _LOOP) -> tiers.TieredFunction:
+def _loop(tmp_path, monkeypatch, source: str = SINE_LOOP) -> tiers.TieredFunction:
     monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
     monkeypatch.setenv("DIRAC_TAPE", "1")
     monkeypatch.setattr(tiers, "_announced", False)
     monkeypatch.setattr(tiers, "_policy", "auto")
-    return tiers.TieredModule(source.replace("for a tape test", f"for a tape test in {tmp_path.name}"),
+    return tiers.TieredModule(source.replace("for a test", f"for a tape test in {tmp_path.name}"),
                               "a loop").function("run")
 
 
@@ -126,7 +101,7 @@ def test_a_loop_longer_than_a_second_but_shorter_than_its_compilation_goes_on_th
     function.run_steps(3000, 10**9, x, 0.0, 0.1, 3000, info)
     assert function.tier == "tape" and function.background is None
     assert function.tape_steps >= tiers.TAPE_PROBE_STEPS
-    assert x[0] == _hand_loop(0.5, 3000) and (info[0], info[1], info[2]) == (3000, 0.0, 3000)
+    assert x[0] == hand_loop(0.5, 3000) and (info[0], info[1], info[2]) == (3000, 0.0, 3000)
 
 
 def test_a_short_loop_stays_interpreted_without_the_machine(tmp_path, monkeypatch) -> None:
@@ -135,7 +110,7 @@ def test_a_short_loop_stays_interpreted_without_the_machine(tmp_path, monkeypatc
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
     assert function.tier == "interpreted" and function.tape_steps == 0
-    assert x[0] == _hand_loop(0.5, 40)
+    assert x[0] == hand_loop(0.5, 40)
 
 
 def test_a_run_of_unknown_length_on_the_tape_compiles(tmp_path, monkeypatch) -> None:
@@ -157,7 +132,7 @@ def test_a_division_by_zero_on_the_tape_behaves_as_on_the_interpreted_tier(tmp_p
     tier raises ZeroDivisionError there (with the steps before it done in place).
     On the tape the machine stops at the division, the part is rerun interpreted from the
     state it was given, and the same error comes with the same state."""
-    source = _LOOP.replace("x[0] = x[0] + math.sin(x[0]) / 8.0", "x[0] = x[0] - 1.0\n        evals += x[1] / x[0]")
+    source = SINE_LOOP.replace("x[0] = x[0] + math.sin(x[0]) / 8.0", "x[0] = x[0] - 1.0\n        evals += x[1] / x[0]")
     outcomes = []
     for tape in ("1", "0"):
         folder = tmp_path / tape
@@ -178,7 +153,7 @@ def test_a_loop_the_tape_declines_keeps_the_two_other_roads(tmp_path, monkeypatc
     multiplication): no tape, and the rule of two roads decides (here: interpreted to the end
     of a loop shorter than its compilation)."""
     monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", lambda self: 1e9)
-    source = _LOOP.replace("x[0] + math.sin(x[0]) / 8.0", "x[0] + math.sin(x[0]) ** 2 / 8.0")
+    source = SINE_LOOP.replace("x[0] + math.sin(x[0]) / 8.0", "x[0] + math.sin(x[0]) ** 2 / 8.0")
     function = _loop(tmp_path, monkeypatch, source)
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(3000, 10**9, x, 0.0, 0.1, 3000, info)

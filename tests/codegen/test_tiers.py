@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 import pytest
+from sine_loop import SINE_LOOP, hand_loop
 
 from dirac import Lagrangian
 from dirac.codegen import tiers
@@ -102,30 +103,6 @@ def test_policy_names_are_checked(monkeypatch) -> None:
         assert tiers.current_policy() == "auto"
 
 
-_LOOP = '''"""loop -- generated for a test"""
-import math
-import numpy as np
-import numba
-
-
-@numba.njit(cache=True)
-def run(x, t, dt, n_steps, info):
-    """n_steps of x <- x + sin(x) / 8 from time t (a step loop with the arguments a tier may split)."""
-    evals = 0.0
-    for step in range(n_steps):
-        x[0] = x[0] + math.sin(x[0]) / 8.0
-        evals += 1.0
-    info[0] = n_steps
-    info[1] = 0.0
-    info[2] = evals
-    info[3] = 0.0
-'''
-
-
-def _hand_loop(x: float, steps: int) -> float:
-    for _ in range(steps):
-        x = x + math.sin(x) / 8.0
-    return x
 
 
 def _loop_module(tmp_path, monkeypatch) -> tiers.TieredFunction:
@@ -135,7 +112,7 @@ def _loop_module(tmp_path, monkeypatch) -> tiers.TieredFunction:
     monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(tiers, "_announced", False)
     monkeypatch.setattr(tiers, "_policy", "auto")
-    return tiers.TieredModule(_LOOP.replace("for a test", f"for a test in {tmp_path.name}"), "a loop").function("run")
+    return tiers.TieredModule(SINE_LOOP.replace("for a test", f"for a test in {tmp_path.name}"), "a loop").function("run")
 
 
 def test_a_long_loop_compiles_in_the_background_and_switches_at_a_step_boundary(tmp_path, monkeypatch, capsys) -> None:
@@ -155,7 +132,7 @@ def test_a_long_loop_compiles_in_the_background_and_switches_at_a_step_boundary(
     assert function.finish_background(timeout=300) is True
     function.run_steps(200, 10**9, x, 30.0, 0.1, 200, info)
     assert function.tier == "compiled" and function.background is None
-    assert x[0] == _hand_loop(0.5, 500)
+    assert x[0] == hand_loop(0.5, 500)
     assert function.ready_marker().exists()
     history = (tmp_path / "compile_history.json").read_text()
     assert '"chars"' in history and "background" in history
@@ -170,7 +147,7 @@ def test_a_long_loop_on_a_busy_machine_compiles_in_the_process(tmp_path, monkeyp
     function.run_steps(50, 10**12, x, 0.0, 0.1, 50, info)
     assert function.background is None and function.tier == "compiled"
     assert function.interpreted_steps == 1
-    assert x[0] == _hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
+    assert x[0] == hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
 
 
 def test_a_loop_far_longer_than_its_compilation_waits_for_it_even_with_an_idle_core(tmp_path, monkeypatch) -> None:
@@ -183,7 +160,7 @@ def test_a_loop_far_longer_than_its_compilation_waits_for_it_even_with_an_idle_c
     function.run_steps(50, 10**12, x, 0.0, 0.1, 50, info)
     assert function.background is None and function.tier == "compiled"
     assert function.interpreted_steps == 1
-    assert x[0] == _hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
+    assert x[0] == hand_loop(0.5, 50) and info[0] == 50 and info[2] == 50
 
 
 def test_kernel_size_counts_the_function_and_what_it_calls_not_the_module() -> None:
@@ -211,7 +188,7 @@ def test_a_loop_shorter_than_its_compilation_starts_none_even_with_an_idle_core(
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(300, 10**9, x, 0.0, 0.1, 300, info)
     assert function.background is None and function.tier == "interpreted"
-    assert x[0] == _hand_loop(0.5, 300) and info[0] == 300 and info[2] == 300
+    assert x[0] == hand_loop(0.5, 300) and info[0] == 300 and info[2] == 300
 
 
 def test_a_short_loop_stays_interpreted_and_starts_no_compilation(tmp_path, monkeypatch) -> None:
@@ -220,7 +197,7 @@ def test_a_short_loop_stays_interpreted_and_starts_no_compilation(tmp_path, monk
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
     assert function.background is None and function.tier == "interpreted"
-    assert x[0] == _hand_loop(0.5, 40) and info[0] == 40
+    assert x[0] == hand_loop(0.5, 40) and info[0] == 40
 
 
 def test_the_rattle_loop_of_a_configuration_dependent_mass_gives_the_same_numbers_on_both_tiers(monkeypatch) -> None:
@@ -310,7 +287,7 @@ def test_the_cold_first_call_does_not_count_in_the_rate_that_decides_the_tier(tm
     x, info = np.array([0.5]), np.zeros(4)
     function.run_steps(1000, 1000, x, 0.0, 0.1, 1000, info)
     assert function.background is None and function.tier == "interpreted"
-    assert x[0] == _hand_loop(0.5, 1000) and info[0] == 1000 and info[2] == 1000
+    assert x[0] == hand_loop(0.5, 1000) and info[0] == 1000 and info[2] == 1000
 
 
 @pytest.mark.parametrize(("interpreted", "compile_seconds", "background", "road"), [
