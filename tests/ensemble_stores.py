@@ -11,6 +11,18 @@ import numpy as np
 import zarr
 
 
+def damped_pendulum(forcing: float) -> str:
+    """The system file of a damped pendulum driven by ``F cos(w t)`` with ``F = forcing``
+    (``th'' = -g sin th - c th' + F cos(w t)``; ``g = 9.81``, ``c = 0.5``, ``w = 1``)."""
+    return f"""[system]
+name = "damped_pendulum_angle"
+coordinates = ["th"]
+parameters = {{ g = 9.81, c = 0.5, F = {forcing!r}, w = 1.0 }}
+lagrangian = "th_dot**2/2 + g*cos(th)"
+forces = {{ th = "-c*th_dot + F*cos(w*t)" }}
+"""
+
+
 def scene_file(tmp_path: Path, system: str, initial: str, run: str, ensemble: str, name: str = "scene.toml") -> Path:
     """``name`` in ``tmp_path`` holding ``system`` (with its header) and the other tables' bodies."""
     path = tmp_path / name

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from ensemble_stores import damped_pendulum
 from ensemble_stores import run_ensemble_cli as _cli
 from ensemble_stores import scene_file as _scene
 from ensemble_stores import stored_arrays as _arrays
@@ -20,13 +21,7 @@ CARTESIAN_Q = '{ x1 = "sin(a)", y1 = "-cos(a)", x2 = "sin(a) + sin(b)", y2 = "-c
 IMPULSES = [(0.3001, {"x2": 0.5}), (0.25, {"y1": 0.4}), (0.5, {"x1": -0.3}), (0.70001, {"x1": 0.1}),
             (0.70003, {"x2": -0.2}), (0.8101, {"y2": 0.2}), (0.8101, {"x2": 0.3}), (1.0, {"x1": 0.3})]
 
-DAMPED = """[system]
-name = "damped_pendulum_angle"
-coordinates = ["th"]
-parameters = { g = 9.81, c = 0.5, F = 1.2, w = 1.0 }
-lagrangian = "th_dot**2/2 + g*cos(th)"
-forces = { th = "-c*th_dot + F*cos(w*t)" }
-"""
+DAMPED = damped_pendulum(1.2)
 
 PARTICLE = """[system]
 name = "particle"

@@ -10,6 +10,7 @@ import sys
 import numpy as np
 import pytest
 import zarr
+from ensemble_stores import damped_pendulum
 from ensemble_stores import run_ensemble_cli as _cli
 from ensemble_stores import scene_file as _scene
 from ensemble_stores import stored_arrays as _arrays
@@ -24,13 +25,7 @@ parameters = { m1 = 1.0, m2 = 1.0, g = 9.81, l1 = 1.0, l2 = 1.0 }
 lagrangian = "(m1 + m2)/2*l1**2*th1_dot**2 + m2/2*l2**2*th2_dot**2 + m2*l1*l2*th1_dot*th2_dot*cos(th1 - th2) + (m1 + m2)*g*l1*cos(th1) + m2*g*l2*cos(th2)"
 """
 
-DAMPED = """[system]
-name = "damped_pendulum_angle"
-coordinates = ["th"]
-parameters = { g = 9.81, c = 0.5, F = 0.0, w = 1.0 }
-lagrangian = "th_dot**2/2 + g*cos(th)"
-forces = { th = "-c*th_dot + F*cos(w*t)" }
-"""
+DAMPED = damped_pendulum(0.0)
 
 CARTESIAN_Q = '{ x1 = "sin(a)", y1 = "-cos(a)", x2 = "sin(a) + sin(b)", y2 = "-cos(a) - cos(b)" }'
 FLIP = ('{ kind = "first_crossing", name = "flip_time", expr = ["x1", "x2 - x1"], '
