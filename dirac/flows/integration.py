@@ -440,7 +440,9 @@ class _Loop:
             if not is_domain_error(exc):
                 raise
             self.cpu = time.process_time() - start
-            message = f"a step left the real domain of the system's expressions ({exc}) {self._where()}: {DOMAIN_HINT}"
+            # the loop's time is that of the last finished call: the step that failed is in the call after it
+            message = (f"a step left the real domain of the system's expressions ({exc}) in the steps after "
+                       f"t = {self.t_now:.6g} (step {self.stepper.steps}) with method {self.method.name}: {DOMAIN_HINT}")
             raise IntegrationError(message, partial=self._solution(False, message)) from None
         except KeyboardInterrupt:
             self.cpu = time.process_time() - start
