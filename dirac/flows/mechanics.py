@@ -35,7 +35,10 @@ from dirac.validate import unknown_name_error, validate_finite
 if TYPE_CHECKING:
     from dirac.analysis.constraint_analysis import ConstraintAnalysis
 
-__all__ = ["MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
+__all__ = ["DIRAC_FLOW_ROAD", "MechanicalSystem", "NotMechanicalError", "resolve_parameters"]
+
+#: the way out named by :class:`NotMechanicalError` for terms linear in the velocities (a scene takes it by itself)
+DIRAC_FLOW_ROAD = 'use method = "midpoint" on the Dirac flow instead'
 
 
 class NotMechanicalError(InputError):
@@ -272,7 +275,7 @@ class MechanicalSystem:
             raise NotMechanicalError(
                 f"the Lagrangian of {lagrangian.name!r} has terms linear in the velocities "
                 f"({', '.join(offending)}, e.g. magnetic or gyroscopic terms): RATTLE needs "
-                "L = 1/2 q_dot^T M(q) q_dot - V(q); use method = \"midpoint\" on the Dirac flow instead"
+                f"L = 1/2 q_dot^T M(q) q_dot - V(q); {DIRAC_FLOW_ROAD}"
             )
         potential = sympy.expand(-potential_terms)
         mass = sympy.Matrix(hessian)

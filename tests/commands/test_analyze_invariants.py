@@ -121,6 +121,15 @@ def _solvable(b: np.ndarray, A: np.ndarray) -> bool:
     return numeric_rank(augmented / scale) == numeric_rank(A / scale, scale=1.0)
 
 
+def _off_poles(numerics, poles, points) -> list:
+    """The points where no divisor in ``poles`` is round-off of its terms (``|f| > 1e-8 * term scale``)."""
+    if not poles or not points:
+        return list(points)
+    values = np.abs(numerics.evaluate(poles, points))
+    scales = numerics.term_scale(poles, points)
+    return [z for z, v, sc in zip(points, values, scales) if np.all(v > 1e-8 * sc)]
+
+
 def chain_violations(analysis) -> list[str]:
     """Stage ``s + 1`` constraints that do not vanish at a regular solvable point of stages ``1..s`` (module docstring)."""
     from dirac.analysis.core.numeric import numeric_rank
@@ -128,15 +137,24 @@ def chain_violations(analysis) -> list[str]:
     chain = analysis._chain
     if analysis.reducible_constraints or chain.imposed or len(analysis.stages) < 1:
         return []  # reducible sets: a stage's surface is not its kept constraints alone
+    from dirac.analysis.core.divisors import LEGENDRE_SINGULAR
+
     numerics = analysis._numerics
-    divisors = [d.divisor for d in chain.divisions] + [locus.expression for locus in analysis.singular_loci]
+    # On a locus where the Legendre map is singular H_c has a pole: the consistency conditions
+    # b + A u = 0 are not defined there (the analysis reports the locus and holds off it), and
+    # their value at a sampled point is the round-off of cancelling 1/divisor terms. Those zero
+    # sets are not sampled, and points of the other zero sets lying on them are no regular points.
+    poles = [locus.expression for locus in analysis.singular_loci if locus.what == LEGENDRE_SINGULAR]
+    divisors = [d.divisor for d in chain.divisions] + [
+        locus.expression for locus in analysis.singular_loci if locus.what != LEGENDRE_SINGULAR
+    ]
     problems = []
     stages = list(analysis.stages)
     for s in range(1, len(stages) + 1):
         surface = [c for stage in stages[:s] for c in stage]
         following = stages[s] if s < len(stages) else []
         try:
-            generic = numerics.surface_points(surface, CHAIN_POINTS, regular=len(surface))
+            generic = _off_poles(numerics, poles, numerics.surface_points(surface, CHAIN_POINTS, regular=len(surface)))
         except DiracError:
             continue
         generic_rows = [A for A in chain._numeric_rows(surface, generic)[1] if np.all(np.isfinite(A))]
@@ -146,7 +164,9 @@ def chain_violations(analysis) -> list[str]:
         points = list(generic)
         for f in dict.fromkeys(divisors):
             try:
-                points += numerics.surface_points([*surface, f], CHAIN_POINTS, regular=len(surface), attempts=12)
+                points += _off_poles(
+                    numerics, poles, numerics.surface_points([*surface, f], CHAIN_POINTS, regular=len(surface), attempts=12)
+                )
             except DiracError:
                 continue
         b_num, A_num = chain._numeric_rows(surface, points)
@@ -228,3 +248,28 @@ def test_the_invariant_check_sees_a_wrong_class():
     a = dirac.analyze(dirac.load_system("pendulum", m=1.0, g=9.81, l=1.0))
     a.first_class = [a.second_class[1]]
     assert any("does not commute weakly" in p for p in check_invariants(a))
+
+
+def test_the_chain_invariant_keeps_off_the_poles_of_the_canonical_hamiltonian():
+    """A random Lagrangian the long run drew: ``L = q2 q1' q2'/2 - q2 q2' q3'/2 - 2 q2 q3 q1' - q3^2 q2'``.
+
+    By hand: ``p1 = q2 q2'/2 - 2 q2 q3``, ``p2 = q2 (q1' - q3')/2 - q3^2``, ``p3 = -q2 q2'/2``, so
+    ``phi = p1 + p3 + 2 q2 q3 = 0`` is primary and, where ``q2 != 0``, ``q2' = -2 p3/q2``,
+    ``q1' - q3' = 2 (p2 + q3^2)/q2`` and ``H_c = 2 (p1 + 2 q2 q3)(p2 + q3^2)/q2`` (the quadratic part
+    ``q2 q2' (q1' - q3')/2`` in momenta, ``p3 = -p1 - 2 q2 q3`` on the surface). Then
+    ``{phi, H_c} = 2 q3 dH/dp2 - dH/dq3 = -4 (p2 + q3^2)`` exactly (the ``4 q3 (p1 + 2 q2 q3)/q2`` terms
+    cancel), the secondary constraint. On ``q2 = 0`` (the rank of the Hessian drops from 2 to 0, which
+    the analysis reports as a singular locus) ``H_c`` has a pole, and a point sampled there gave
+    ``b = 0`` from cancelling round-off while ``p2 + q3^2 != 0``: the chain invariant must not count it.
+    """
+    L = dirac.Lagrangian.from_strings(
+        "drawn", ["q1", "q2", "q3"], "q2*q1_dot*q2_dot/2 - q2*q2_dot*q3_dot/2 - 2*q2*q3*q1_dot - q3**2*q2_dot", []
+    )
+    a = dirac.analyze(L)
+    q1, q2, q3, p1, p2, p3 = a._space.variables
+    (primary,), (secondary,) = a.stages
+    assert sympy.simplify(primary - (p1 + p3 + 2 * q2 * q3)) == 0
+    assert sympy.simplify(secondary / (p2 + q3**2)).is_constant()
+    assert [locus.expression for locus in a.singular_loci] == [q2]
+    assert chain_violations(a) == []
+    assert check_invariants(a) == []

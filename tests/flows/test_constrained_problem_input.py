@@ -47,3 +47,29 @@ def test_scene_off_surface_advice_names_the_scene_option(tmp_path, run_cli):
                      encoding="utf-8")
     status, _, stderr = run_cli("run", str(scene), "--no-progress")
     assert status == 2 and "set project = true in [initial]" in stderr and "project=True" not in stderr
+
+
+def test_a_velocity_linear_lagrangian_is_refused_with_the_python_road_that_runs_it():
+    """A charged particle in a uniform field, ``L = m v^2/2 + B (x y' - y x')/2``: ``ConstrainedProblem``
+    refuses it naming the Python road (a scene takes it by itself), and that road runs it. By hand,
+    ``m x'' = B y'``, ``m y'' = -B x'``: from ``(1, 0)`` with velocity ``(0, 2)``, ``m = 1``, ``B = 2``,
+    ``x = 2 - cos 2t``, ``y = sin 2t``. The forced variant names no road that cannot take its forces."""
+    import re
+
+    from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
+    from dirac.flows.mechanics import NotMechanicalError
+
+    text = "m*(x_dot**2 + y_dot**2)/2 + B*(x*y_dot - y*x_dot)/2"
+    L = dirac.Lagrangian.from_strings("cyclotron", ["x", "y"], text, [], parameters={"m": 1.0, "B": 2.0})
+    with pytest.raises(NotMechanicalError, match="linear in the velocities") as caught:
+        dirac.ConstrainedProblem(L, q0=[1.0, 0.0], qdot0=[0.0, 2.0])
+    road = re.search(r"from dirac\.flows\.analysed import AnalysedProblem, AnalysedSystem", str(caught.value))
+    assert road is not None and '"midpoint"' in str(caught.value)
+    system = AnalysedSystem.from_lagrangian(L)
+    problem = AnalysedProblem(system, system.initial_state({"x": 1.0, "y": 0.0}, q_dot={"x": 0.0, "y": 2.0}))
+    x, y = dirac.integrate(problem, "midpoint", t_end=1.0, dt=1e-3, samples=2)["z"][-1][:2]
+    assert abs(x - (2 - np.cos(2.0))) < 1e-5 and abs(y - np.sin(2.0)) < 1e-5
+    F = dirac.Lagrangian.from_strings("cyclotron", ["x", "y"], text, [], parameters={"m": 1.0, "B": 2.0}, forces={"x": "-x_dot"})
+    with pytest.raises(NotMechanicalError, match="forces and impulses are integrated for that form only") as caught:
+        dirac.ForcedProblem(F, q0=[1.0, 0.0], qdot0=[0.0, 2.0])
+    assert "midpoint" not in str(caught.value)

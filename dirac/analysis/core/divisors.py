@@ -73,9 +73,11 @@ LOCUS_ATTEMPTS = 8
 
 #: what happens on the locus of a divisor of the Legendre map
 LEGENDRE_SINGULAR = (
-    "the Legendre map is singular (det W = 0, W = d^2 L/dq_dot^2): a coordinate singularity; the velocities and "
-    "H_c divide by zero there, so describe the motion near it in another chart (Cartesian coordinates with a "
-    "constraint, or a rotation matrix for a rigid body)"
+    "the Legendre map is singular (det W = 0, W = d^2 L/dq_dot^2, or for a singular Lagrangian the rank of W "
+    "drops below its generic rank): the velocities and H_c divide by zero there and the analysis holds off the "
+    "locus; a coordinate singularity (sin(theta) = 0 of Euler or polar angles) is cured by another chart "
+    "(Cartesian coordinates with a constraint, or a rotation matrix for a rigid body), otherwise the system on "
+    "the locus is another system: analyse it with the locus as a constraint"
 )
 #: what happens on the locus of a divisor of the multiplier solution
 MULTIPLIERS_SINGULAR = "the multiplier solution divides by zero"
