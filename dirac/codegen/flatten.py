@@ -387,6 +387,18 @@ def _prune(statements: list[ast.stmt]) -> list[ast.stmt]:
     return out
 
 
+class _FoldConstantChoice(ast.NodeTransformer):
+    """``a if True else b`` -> ``a`` (``if False``: ``b``), the choice of an inlined helper on a
+    literal argument (``report(info, step, True, ...)``): numba makes three blocks of each
+    conditional expression; the value is the one the test picks."""
+
+    def visit_IfExp(self, node: ast.IfExp) -> ast.expr:
+        self.generic_visit(node)
+        if isinstance(node.test, ast.Constant) and isinstance(node.test.value, bool):
+            return node.body if node.test.value else node.orelse
+        return node
+
+
 def _written_arrays(tree: ast.Module) -> set[str]:
     """Names written through a subscript (``a[...] = ``, ``a[...] += ``) anywhere in the module."""
     return {node.value.id for node in walk(tree) if isinstance(node, ast.Subscript)
@@ -399,10 +411,12 @@ def tidy_function(function: ast.FunctionDef, written: set[str]) -> None:
     read-only argument once (see the module docstring); ``written`` are the names the
     module writes through a subscript (such an argument's entries are loaded where they are).
 
-    The values are the same: a branch left out could not run, a load nobody reads changes
+    The values are the same: a branch left out could not run (nor the side of a conditional
+    expression whose test is a literal ``True`` or ``False``), a load nobody reads changes
     nothing, and an entry of an argument no function writes cannot change while the function runs. A name assigned such a load is
     replaced only when it is assigned nowhere else in the function."""
     function.body = _prune(function.body) or [ast.Pass()]
+    _FoldConstantChoice().visit(function)
     used = {node.id for node in walk(function) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load)}
 
     def unused_load(statement: ast.stmt) -> bool:  # ``x = a[k]`` or ``x = np.empty(...)``, x never read

@@ -495,7 +495,8 @@ def rattle_general(q, p, t, c, fractions, dt, n_steps, tol, max_iter, info):
                         bound += ph[i] * ph[i] if stage == 1 else x[i] * x[i]
                     if stage == 2:
                         size = bound - 1.0
-                        bound = 1.0 + extra + min(size, math.sqrt(size))
+                        root = math.sqrt(size)  # min(size, root) as min takes it (numba compiles min apart)
+                        bound = 1.0 + extra + (root if root < size else size)
                     if residual <= tol * bound:
                         if stage == 1:
                             # ph = M v0 at the converged v0; (2) with its Jacobian from x = q (its

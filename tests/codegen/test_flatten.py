@@ -201,3 +201,42 @@ def test_the_square_blocks_of_one_allocation_are_unrolled_too() -> None:
         np.testing.assert_allclose(b, [-1.0, 1.0], rtol=1e-15)
         np.testing.assert_allclose(c, [18.0 / 17.0, -8.0 / 17.0], rtol=1e-15)
     assert results[0] == results[1]
+
+
+_CHOICE = '''"""choice -- generated for a test"""
+import numpy as np
+import numba
+
+
+@numba.njit(cache=True, inline="always")
+def note(info, flag, value):
+    """info = [1 if flag else 0, value]."""
+    info[0] = 1.0 if flag else 0.0
+    info[1] = value
+
+
+@numba.njit(cache=True)
+def run(x, info):
+    """Notes failure (True) when x < 0, else success (False)."""
+    if x < 0.0:
+        note(info, True, x)
+        return
+    note(info, False, 2.0 * x)
+'''
+
+
+def test_a_choice_on_a_literal_argument_is_folded_to_its_value() -> None:
+    """The helper's ``1.0 if flag else 0.0``, inlined with ``flag`` a literal ``True`` or
+    ``False``, becomes ``1.0`` or ``0.0`` (numba would make three blocks of each choice), and
+    the flattened ``run`` still computes by hand: x = -3 gives info = (1, -3), x = 2.5 gives
+    (0, 5)."""
+    flat = flatten_source(_CHOICE)
+    run = _function(flat, "run")
+    assert not any(isinstance(node, ast.IfExp) for node in ast.walk(run))
+    for source in (_CHOICE, flat):
+        module = interpret_source(source)
+        info = np.zeros(2)
+        module.run(-3.0, info)
+        assert info.tolist() == [1.0, -3.0]
+        module.run(2.5, info)
+        assert info.tolist() == [0.0, 5.0]
