@@ -11,15 +11,16 @@ A plain module (not a conftest), so that its test imports it by one name.
 
 from __future__ import annotations
 
-#: Test files of few tests that take long (tens of seconds of CPU in kernel compilations,
-#: measured with ``pytest -n 0 --durations``), longest first.
+#: Test files of few tests that take long (kernel compilations; seconds of CPU of each file,
+#: its tests and their child processes on a cold cache of generated code, in the comments), longest first.
 LONG_FILES = (
-    "tests/ensemble/test_heavy_top_driven_ensemble.py",
-    "tests/docs/test_page_ensembles_general.py",
-    "tests/ensemble/test_heavy_top_impulse_ensemble.py",
-    "tests/ensemble/test_heavy_top_ensemble.py",
-    "tests/docs/test_docs_examples.py",
+    "tests/ensemble/test_heavy_top_impulse_ensemble.py",  # about 125 s
+    "tests/ensemble/test_heavy_top_driven_ensemble.py",  # about 100 s
+    "tests/docs/test_docs_examples.py",  # about 75 s
+    "tests/docs/test_page_ensembles_general.py",  # about 70 s
+    "tests/ensemble/test_heavy_top_ensemble.py",  # about 40 s
     "tests/docs/test_page_field_theories.py",
+    "tests/docs/test_docs_build.py",  # about 18 s (sphinx in a child process)
 )
 
 
