@@ -10,6 +10,10 @@ worker, so a module-scoped fixture (an analysis, compiled kernels) is still buil
 the kernels a file's tests share are compiled once. The workers share the cache of
 generated code (``$DIRAC_CACHE_DIR``, else ``~/.cache/dirac/generated``) as a user's
 parallel runs do: every writer of it uses file names of its own before an atomic rename.
+xdist hands the files to the workers largest first by their number of tests; a file of few
+but long tests (``LONG_FILES``: each compiles kernels of its own for a minute or more) would
+then start last and keep one worker busy after the other has finished, so
+``pytest_xdist_make_scheduler`` starts those files first (``xdist_order.py``).
 
 Property tests (hypothesis) draw the same examples in every bounded run (``derandomize``,
 no example database): a run of the suite is reproducible, and a rare draw that is slow or
@@ -28,6 +32,13 @@ from hypothesis import settings
 settings.register_profile("bounded", derandomize=True, database=None)
 settings.register_profile("exploring")
 settings.load_profile("exploring" if os.environ.get("DIRAC_FULL_STRESS") == "1" else "bounded")
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` with the long files handed out first (:mod:`xdist_order`)."""
+    from xdist_order import long_files_first_scheduler
+
+    return long_files_first_scheduler(config, log)
 
 
 @pytest.fixture
