@@ -1,0 +1,321 @@
+"""A guard that stops a run whose motion reaches or steps across a pole of its equations of motion.
+
+The equations of motion of ``L = q_dot^T M(q, t) q_dot / 2 - V(q, t)`` with holonomic
+constraints ``chi(q, t) = 0`` and generalized forces ``Q(q, q_dot, t)`` evaluate the force
+``-dV/dq``, the entries of ``M`` and their derivatives, the constraints' first and second
+derivatives and ``Q``. Where a denominator of these expressions vanishes (``x = 0`` of the
+force ``-1/x`` of ``V = log(x)``; ``cos(q) = 0`` of ``V = tan(q)``; ``x - a = 0`` of a force
+``1/(x - a)``) the vector field has a pole. Such a pole is a singularity of the physics, not
+of the chart (Arnold, "Mathematical Methods of Classical Mechanics", Sect. 4 on motion in
+a potential: with ``v^2/2 + V(x) = E`` the speed is infinite where ``V -> -infinity``, and
+the motion reaches that point at a finite time when ``integral dx / sqrt(2 (E - V(x)))``
+converges there). A fixed step is blind to it: the force ``-1/x`` is defined on both sides
+of ``x = 0``, so a step jumps over the pole and the run goes on with an energy that jumped
+(``V = log(x)`` from ``x = 0.5`` at rest with ``dt = 0.01``: a relative energy jump of 1.5,
+and no word). A smaller step only moves the jump.
+
+:class:`PoleGuard` evaluates the irreducible factors ``f`` of those denominators that can
+vanish (:func:`dirac.analysis.core.divisors.denominator_factors`), compiled as one scalar
+function of the coordinates (and the time). The loop of :func:`dirac.flows.integrate`
+reads it between calls of the step loop and stops with :class:`~dirac.errors.PoleError`
+when a factor is zero, or when its sign differs from the last reading: the motion stepped
+across ``f = 0`` between the two readings, even if no reading came near it. The readings
+come at every sample (before the sample is stored, so the partial run ends before the
+crossing) and, in between, at a quarter of the steps in which the factor that falls
+fastest would reach zero at its last rate (:meth:`PoleGuard.next_reading`): every step
+next to a pole, up to :data:`~dirac.flows.chart_guard.MAX_GUARD_STEPS` far away. A factor
+that changes its sign and back between two readings is not seen (the readings' spacing
+makes that unlikely, not impossible). Factors that depend on the velocities (a force
+``-c x_dot/|x_dot|``) are not read. Systems whose expressions hold no denominator (and no
+function whose derivative has one: only sums, products, positive integer powers, ``sin``,
+``cos`` and ``exp``) have no guard and run exactly as before, without a symbolic
+derivative taken.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS
+
+__all__ = ["PoleGuard", "pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH", "REMEDY"]
+
+#: readings per predicted approach: the guard is read again after a quarter of the steps the fastest-falling
+#: factor needs to reach zero at its last rate (the rate grows near an attracting pole: ``x ~ (t* - t)^(2/3)``
+#: for ``V = -1/x``, so the linear prediction is too late by at most a factor 3/2)
+READINGS_PER_APPROACH = 4
+
+REMEDY = (
+    "a smaller step does not cure this: the motion reaches a singularity of its equations (the potential, the "
+    "mass matrix, the constraints or the forces are infinite there) at a finite time; regularise the expression "
+    "near the pole (soften 1/x to x/(x**2 + eps**2), or log(x) to log(x**2 + eps**2)/2), stop the run before "
+    "it (a t_end before the time named), or change the model (a wall: an impulse reversing the velocity)"
+)
+
+
+class PoleCrossing(Exception):
+    """A reading of the guard found a factor at zero or across it (internal; the loop makes a PoleError of it).
+
+    ``turn`` is true when the factor kept its sign but came within a step of zero and went back:
+    the steps did not resolve the motion there (a smaller step resolves a turn before the pole).
+    """
+
+    def __init__(self, text: str, turn: bool = False) -> None:
+        super().__init__(text)
+        self.turn = turn
+
+
+class PoleGuard:
+    """The sign of each factor of the denominators of one system's equations of motion, compiled (module docstring).
+
+    Attributes
+    ----------
+    factors
+        The factors as text (``"x"``), in reading order.
+    origins
+        For each factor, what it is a denominator of (``"the force -dV/dq"``).
+    """
+
+    def __init__(self, values: Callable[..., list[float]], factors: list[str], origins: list[str], time: bool,
+                 params: np.ndarray) -> None:
+        self._values = values  # (f_1, f_2, ...)
+        self.factors = factors
+        self.origins = origins
+        self._time = time
+        self._params = tuple(float(c) for c in params)
+        self._last: np.ndarray | None = None  # (members, factors): the last reading
+        self._last_time = 0.0
+        self._last_step = 0
+        self._rate = np.empty((0, 0))  # approach per step of each factor over the last interval
+        self._eta = np.empty((0, 0))  # steps to zero of each factor at that rate (inf: not approaching)
+        self._accelerating = np.empty((0, 0), dtype=bool)  # whether that approach was as fast as the one before
+        #: steps in which the factor that falls fastest reaches zero at the rate of the last interval (inf: none falls)
+        self.steps_to_pole = math.inf
+        self._nearest = (0, 0, math.nan)
+
+    def read(self, q: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """The factors' values at a batch of configurations ``q`` (shape ``(n,)`` or ``(B, n)``): ``(B, factors)``;
+        NaN where a factor has no real value."""
+        rows = q.tolist() if isinstance(q, np.ndarray) else list(q)
+        if rows and not isinstance(rows[0], list):
+            rows = [rows]
+        extra = (float(t),) if self._time else ()
+        return np.array([self._values(*row, *extra, *self._params) for row in rows], dtype=float).reshape(
+            len(rows), len(self.factors))
+
+    def start(self, q: np.ndarray, t: float = 0.0, step: int = 0) -> None:
+        """The first reading (at the initial state): the signs later readings are compared with.
+
+        Raises
+        ------
+        PoleCrossing
+            The initial state is on a pole (a factor is zero there).
+        """
+        self._last = None
+        self.steps_to_pole = math.inf
+        self.check(q, t, step, GUARD_STEPS)
+
+    def check(self, q: np.ndarray, t: float, step: int, steps: int, at: float | None = None) -> int:
+        """Read the guard after ``steps`` steps that ended at time ``t`` (step ``step``); the steps until the next reading.
+
+        ``t`` is the time the factors are evaluated at (that of the state); ``at``, when given,
+        the time the messages name (the loop's time on the sample grid).
+
+        Raises
+        ------
+        PoleCrossing
+            A factor is zero, or its sign differs from that of the last reading (the motion
+            stepped across the pole between them); its message names the factor, the member
+            of a batch, the values and the interval of time.
+        """
+        now = self.read(q, t)
+        t = t if at is None else float(at)
+        last, last_time, last_step = self._last, self._last_time, self._last_step
+        defined = np.isfinite(now)
+        hit = defined & (now == 0.0)
+        if last is not None:
+            hit |= defined & np.isfinite(last) & (np.sign(now) != np.sign(last))
+        if np.any(hit):
+            member, k = (int(i) for i in np.argwhere(hit)[0])
+            raise PoleCrossing(self._describe(member, k, now, last, last_time, last_step, t, step))
+        if last is None:
+            # the first reading: the initial state has every factor nonzero; NaN (no real value) is left to the loop
+            self._last, self._last_time, self._last_step = now, t, step
+            self._rate = np.full(now.shape, np.nan)
+            self._eta = np.full(now.shape, np.inf)
+            self._accelerating = np.ones(now.shape, dtype=bool)
+            return GUARD_STEPS
+        a, b = np.abs(last), np.abs(now)
+        with np.errstate(invalid="ignore"):
+            rate = (a - b) / max(steps, 1)  # approach per step (positive: nearer to the pole)
+            turned = defined & np.isfinite(last) & (b > a) & (self._eta <= steps) & self._accelerating
+        if np.any(turned):
+            member, k = (int(i) for i in np.argwhere(turned)[0])
+            raise PoleCrossing(self._describe_turn(member, k, now, last, last_time, last_step, t, step), turn=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            self._accelerating = ~(rate < self._rate)  # NaN (no rate before): counted as accelerating
+            self._eta = np.where(rate > 0, b / rate, np.inf)
+        self._rate = rate
+        self._last, self._last_time, self._last_step = now, t, step
+        return self.next_reading(last, now, steps)
+
+    def next_reading(self, last: np.ndarray, now: np.ndarray, steps: int) -> int:
+        """Steps until the next reading, after ``steps`` steps took the factors from ``last`` to ``now``.
+
+        Each factor that came nearer to zero would reach it after ``|f| / rate`` more steps at
+        the rate ``|f_last - f_now| / steps`` of the last interval; the guard is read again after
+        a quarter of the smallest such count (every step next to a pole), at most twice the last
+        interval and :data:`MAX_GUARD_STEPS`.
+        """
+        limit = min(MAX_GUARD_STEPS, 2 * max(steps, GUARD_STEPS // 2))
+        a, b = np.abs(last), np.abs(now)
+        nearer = np.isfinite(a) & np.isfinite(b) & (b < a)
+        if not np.any(nearer):
+            self.steps_to_pole = math.inf
+            return limit
+        with np.errstate(divide="ignore", invalid="ignore"):
+            counts = np.where(nearer, b / (a - b), np.inf)
+        member, k = (int(i) for i in np.unravel_index(int(np.argmin(counts)), counts.shape))
+        to_zero = float(counts[member, k]) * max(steps, 1)
+        self.steps_to_pole, self._nearest = to_zero, (member, k, float(now[member, k]))
+        return max(1, min(limit, int(to_zero / READINGS_PER_APPROACH)))
+
+    def nearest(self) -> str:
+        """The factor that fell fastest towards zero at the last reading, its value and what it is a denominator of."""
+        member, k, value = self._nearest
+        who = f" of member {member}" if self._last is not None and self._last.shape[0] > 1 else ""
+        return f"{self.factors[k]} = {value:.3g}{who}, a denominator of {self.origins[k]}"
+
+    def _describe_turn(self, member: int, k: int, now: np.ndarray, last: np.ndarray, last_time: float,
+                       last_step: int, t: float, step: int) -> str:
+        factor, origin = self.factors[k], self.origins[k]
+        who = f" (member {member} of the batch)" if now.shape[0] > 1 else ""
+        return (f"the motion{who} came within a step of the pole {factor} = 0 of the equations of motion (a "
+                f"denominator of {origin}), faster and faster, and was back at {factor} = {now[member, k]:.3g} "
+                f"after {factor} = {last[member, k]:.3g}, between t = {last_time:.6g} and t = {t:.6g} (steps "
+                f"{last_step} to {step}): the steps do not resolve the motion at the pole (they may have jumped over "
+                "it and back, as the stages of a composition method can)")
+
+    def _describe(self, member: int, k: int, now: np.ndarray, last: np.ndarray | None, last_time: float,
+                  last_step: int, t: float, step: int) -> str:
+        factor, origin = self.factors[k], self.origins[k]
+        who = f" (member {member} of the batch)" if now.shape[0] > 1 else ""
+        value = now[member, k]
+        if last is None:
+            return (f"the initial state{who} is on a pole of the equations of motion, {factor} = 0 (a denominator of "
+                    f"{origin}); start away from it")
+        before = last[member, k]
+        if value == 0.0:
+            what = f"reached the pole {factor} = 0 ({factor} was {before:.3g} at the reading before)"
+        else:
+            what = (f"stepped across the pole {factor} = 0 ({factor} went from {before:.3g} to {value:.3g}: "
+                    "the step jumped over it, so the run after it is not the motion)")
+        return (f"the motion{who} {what}, a pole of the equations of motion (a denominator of {origin}), between "
+                f"t = {last_time:.6g} and t = {t:.6g} (steps {last_step} to {step})")
+
+
+def _nodes(expr: Any) -> Any:
+    import sympy
+
+    return sympy.preorder_traversal(expr)
+
+
+def _may_have_poles(exprs: list[Any]) -> bool:
+    """Whether an expression or one of its derivatives can have a denominator: a power that is not a
+    nonnegative integer, or a function other than ``sin``, ``cos`` and ``exp`` (whose derivatives have none)."""
+    import sympy
+
+    plain = (sympy.sin, sympy.cos, sympy.exp)
+    for expr in exprs:
+        for node in _nodes(expr):
+            if isinstance(node, sympy.Pow) and not (node.exp.is_Integer and node.exp >= 0):
+                return True
+            if isinstance(node, sympy.Function) and not isinstance(node, plain):
+                return True
+    return False
+
+
+def _build(mechanics: Any) -> PoleGuard | None:
+    import sympy  # the mechanics were built with it: importing it costs nothing here
+
+    symbolic = mechanics.symbolic
+    q = list(symbolic.get("coordinates") or ())
+    if not q:
+        return None
+    time = mechanics.time_symbol
+    variables = [*q, *([time] if time is not None else [])]
+    velocities = set(symbolic.get("velocities") or ())
+    V = sympy.sympify(symbolic.get("potential") or 0)
+    M = [sympy.sympify(e) for e in (symbolic.get("mass") or [])]
+    chis = [sympy.sympify(e) for e in (symbolic.get("constraints") or [])]
+    forces = [sympy.sympify(e) for e in (symbolic.get("forces") or [])]
+    if not _may_have_poles([V, *M, *chis, *forces]):
+        return None  # polynomials in the coordinates, sines, cosines and exponentials: no denominator anywhere
+
+    from dirac.analysis.core.divisors import denominator_factors
+
+    sources: list[tuple[str, list[Any]]] = [
+        ("the force -dV/dq", [sympy.diff(V, x) for x in q]),
+        ("the mass matrix or its derivatives", [*M, *(sympy.diff(e, x) for e in M for x in q)]),
+    ]
+    if chis:
+        gradients = [sympy.diff(c, x) for c in chis for x in variables]
+        sources.append(("the constraints' derivatives (the constraint forces)",
+                        [*chis, *gradients, *(sympy.diff(g, x) for g in gradients for x in variables)]))
+    if forces:
+        sources.append(("the applied forces", forces))
+    if time is not None:
+        sources.append(("the time derivative of the potential", [sympy.diff(V, time)]))
+    found: dict[Any, list[str]] = {}
+    for origin, exprs in sources:
+        for e in exprs:
+            for f in denominator_factors(sympy.sympify(e), variables):
+                if f.free_symbols & velocities:
+                    continue  # a factor in the velocities is not read (module docstring)
+                if origin not in found.setdefault(f, []):
+                    found[f].append(origin)
+    if not found:
+        return None
+    from dirac.codegen.scalar_backend import scalar_function
+
+    factors = list(found)
+    params = list(symbolic.get("parameters") or ())
+    try:
+        compiled = scalar_function([*variables, *params], factors)
+    except Exception:  # an unusual function: no guard (the run is as before)  # noqa: BLE001
+        return None
+    return PoleGuard(compiled, [str(f) for f in factors], [" and of ".join(found[f]) for f in factors],
+                     time is not None, mechanics.params)
+
+
+def pole_guard(mechanics: Any) -> PoleGuard | None:
+    """A fresh :class:`PoleGuard` of a :class:`~dirac.flows.mechanics.MechanicalSystem` for one run, or ``None``.
+
+    The factors are found and compiled once per system (kept on it); each call gives a guard
+    with no reading yet.
+    """
+    missing = object()
+    cached = getattr(mechanics, "_pole_guard", missing)
+    if cached is missing:
+        cached = _build(mechanics)
+        try:
+            mechanics._pole_guard = cached
+        except AttributeError:  # a frozen system: build again next time
+            pass
+    if not isinstance(cached, PoleGuard):
+        return None
+    return PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params))
+
+
+def message(system: str, crossing: PoleCrossing, method: str) -> str:
+    """The error text of a :class:`PoleCrossing` of the run of ``system`` with ``method``: what, where and the remedy."""
+    text = f"the run of {system!r} with method {method} stopped: {crossing}; "
+    if crossing.turn:
+        text += ("if the exact motion turns before the pole (a repelling pole, or a close pass such as a periapsis), "
+                 "a smaller dt resolves the turn; if it reaches the pole, ")
+    return text + REMEDY
+
