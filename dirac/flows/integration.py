@@ -28,11 +28,11 @@ import numpy as np
 
 from dirac.errors import CoordinateSingularityError, InputError, IntegrationError, PoleError
 from dirac.flows.chart_guard import GUARD_STEPS, STOP_DISTANCE, ChartGuard, chart_guard
-from dirac.flows.pole_guard import READINGS_PER_APPROACH, PoleCrossing, PoleGuard, pole_guard
-from dirac.flows.pole_guard import message as pole_message
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
 from dirac.flows.methods.torqued import refuse_undriven
+from dirac.flows.pole_guard import READINGS_PER_APPROACH, PoleCrossing, PoleGuard, pole_guard
+from dirac.flows.pole_guard import message as pole_message
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 from dirac.validate import is_real_number, unknown_name_error, validate_integer, validate_positive

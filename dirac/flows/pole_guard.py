@@ -81,10 +81,12 @@ class PoleGuard:
     """
 
     def __init__(self, values: Callable[..., list[float]], factors: list[str], origins: list[str], time: bool,
-                 params: np.ndarray) -> None:
+                 params: np.ndarray, bounds: list[bool] | None = None) -> None:
         self._values = values  # (f_1, f_2, ...)
         self.factors = factors
         self.origins = origins
+        #: for each factor, whether it also bounds the real domain (``x`` of ``log(x)``, ``sqrt(x)``)
+        self.bounds = list(bounds) if bounds is not None else [False] * len(factors)
         self._time = time
         self._params = tuple(float(c) for c in params)
         self._last: np.ndarray | None = None  # (members, factors): the last reading
@@ -213,7 +215,11 @@ class PoleGuard:
             what = f"reached the pole {factor} = 0 ({factor} was {before:.3g} at the reading before)"
         else:
             what = (f"stepped across the pole {factor} = 0 ({factor} went from {before:.3g} to {value:.3g}: "
-                    "the step jumped over it, so the run after it is not the motion)")
+                    "the step jumped over it, so the run after it is not the motion")
+            if self.bounds[k]:
+                what += (f"; {factor} = 0 also bounds the real domain of the system's expressions (a logarithm or a "
+                         "root of it), so the run left the real domain there")
+            what += ")"
         return (f"the motion{who} {what}, a pole of the equations of motion (a denominator of {origin}), between "
                 f"t = {last_time:.6g} and t = {t:.6g} (steps {last_step} to {step})")
 
@@ -239,6 +245,19 @@ def _may_have_poles(exprs: list[Any]) -> bool:
     return False
 
 
+def _quotients(expr: Any) -> Any:
+    """``expr`` with ``tan``, ``cot``, ``sec``, ``csc`` (and ``tanh``, ``coth``) written as quotients of sines
+    and cosines: the same function, whose derivatives show the denominators."""
+    import sympy
+
+    return expr.replace(sympy.tan, lambda u: sympy.sin(u) / sympy.cos(u)).replace(
+        sympy.cot, lambda u: sympy.cos(u) / sympy.sin(u)).replace(
+        sympy.sec, lambda u: 1 / sympy.cos(u)).replace(
+        sympy.csc, lambda u: 1 / sympy.sin(u)).replace(
+        sympy.tanh, lambda u: sympy.sinh(u) / sympy.cosh(u)).replace(
+        sympy.coth, lambda u: sympy.cosh(u) / sympy.sinh(u))
+
+
 def _build(mechanics: Any) -> PoleGuard | None:
     import sympy  # the mechanics were built with it: importing it costs nothing here
 
@@ -255,6 +274,9 @@ def _build(mechanics: Any) -> PoleGuard | None:
     forces = [sympy.sympify(e) for e in (symbolic.get("forces") or [])]
     if not _may_have_poles([V, *M, *chis, *forces]):
         return None  # polynomials in the coordinates, sines, cosines and exponentials: no denominator anywhere
+    # tan(u) = sin(u)/cos(u) and its kin: their derivatives (1 + tan(u)**2) hide the denominator
+    V, M, chis, forces = (_quotients(V), [_quotients(e) for e in M], [_quotients(e) for e in chis],
+                          [_quotients(e) for e in forces])
 
     from dirac.analysis.core.divisors import denominator_factors
 
@@ -280,6 +302,7 @@ def _build(mechanics: Any) -> PoleGuard | None:
                     found[f].append(origin)
     if not found:
         return None
+    bounds = _domain_bounds([V, *M, *chis, *forces], variables)
     from dirac.codegen.scalar_backend import scalar_function
 
     factors = list(found)
@@ -289,7 +312,27 @@ def _build(mechanics: Any) -> PoleGuard | None:
     except Exception:  # an unusual function: no guard (the run is as before)  # noqa: BLE001
         return None
     return PoleGuard(compiled, [str(f) for f in factors], [" and of ".join(found[f]) for f in factors],
-                     time is not None, mechanics.params)
+                     time is not None, mechanics.params, [f in bounds for f in factors])
+
+
+def _domain_bounds(exprs: list[Any], variables: list[Any]) -> set[Any]:
+    """The factors of the arguments of ``log`` and of the bases of fractional powers in ``exprs``: where
+    the real domain of the expressions ends (``x`` of ``log(x)`` or ``sqrt(x)``)."""
+    import sympy
+
+    from dirac.analysis.core.divisors import denominator_factors
+
+    bounds: set[Any] = set()
+    for expr in exprs:
+        for node in _nodes(expr):
+            if isinstance(node, sympy.log):
+                inner = node.args[0]
+            elif isinstance(node, sympy.Pow) and node.exp.is_Rational and not node.exp.is_Integer:
+                inner = node.base
+            else:
+                continue
+            bounds.update(denominator_factors(1 / inner, variables))
+    return bounds
 
 
 def pole_guard(mechanics: Any) -> PoleGuard | None:
@@ -308,7 +351,8 @@ def pole_guard(mechanics: Any) -> PoleGuard | None:
             pass
     if not isinstance(cached, PoleGuard):
         return None
-    return PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params))
+    return PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
+                     cached.bounds)
 
 
 def message(system: str, crossing: PoleCrossing, method: str) -> str:
