@@ -85,6 +85,8 @@ class PoleGuard:
         self._values = values  # (f_1, f_2, ...)
         self.factors = factors
         self.origins = origins
+        #: the factors as sympy expressions in the coordinates, the time and the parameters (symbolic)
+        self.expressions: list[Any] = []
         #: for each factor, whether it also bounds the real domain (``x`` of ``log(x)``, ``sqrt(x)``)
         self.bounds = list(bounds) if bounds is not None else [False] * len(factors)
         self._time = time
@@ -311,8 +313,10 @@ def _build(mechanics: Any) -> PoleGuard | None:
         compiled = scalar_function([*variables, *params], factors)
     except Exception:  # an unusual function: no guard (the run is as before)  # noqa: BLE001
         return None
-    return PoleGuard(compiled, [str(f) for f in factors], [" and of ".join(found[f]) for f in factors],
-                     time is not None, mechanics.params, [f in bounds for f in factors])
+    guard = PoleGuard(compiled, [str(f) for f in factors], [" and of ".join(found[f]) for f in factors],
+                      time is not None, mechanics.params, [f in bounds for f in factors])
+    guard.expressions = factors
+    return guard
 
 
 def _domain_bounds(exprs: list[Any], variables: list[Any]) -> set[Any]:
@@ -351,8 +355,10 @@ def pole_guard(mechanics: Any) -> PoleGuard | None:
             pass
     if not isinstance(cached, PoleGuard):
         return None
-    return PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
-                     cached.bounds)
+    guard = PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
+                      cached.bounds)
+    guard.expressions = cached.expressions
+    return guard
 
 
 def message(system: str, crossing: PoleCrossing, method: str) -> str:
