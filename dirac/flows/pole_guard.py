@@ -21,9 +21,9 @@ reads it between calls of the step loop and stops with :class:`~dirac.errors.Pol
 when a factor is zero, or when its sign differs from the last reading: the motion stepped
 across ``f = 0`` between the two readings, even if no reading came near it. The readings
 come at every sample (before the sample is stored, so the partial run ends before the
-crossing) and, in between, at a quarter of the steps in which the factor that falls
-fastest would reach zero at its last rate (:meth:`PoleGuard.next_reading`): every step
-next to a pole, up to :data:`~dirac.flows.chart_guard.MAX_GUARD_STEPS` far away. A factor
+crossing) and, in between, after half the steps in which the factor that falls fastest
+would reach zero at its last rate, unless its approach slows down so as to stop before the
+pole (:meth:`PoleGuard.next_reading`): every step next to a pole, up to :data:`~dirac.flows.chart_guard.MAX_GUARD_STEPS` far away. A factor
 that changes its sign and back between two readings is not seen (the readings' spacing
 makes that unlikely, not impossible). Factors that depend on the velocities (a force
 ``-c x_dot/|x_dot|``) are not read. Systems whose expressions hold no denominator (and no
@@ -44,10 +44,10 @@ from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS
 
 __all__ = ["PoleGuard", "pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH", "REMEDY"]
 
-#: readings per predicted approach: the guard is read again after a quarter of the steps the fastest-falling
-#: factor needs to reach zero at its last rate (the rate grows near an attracting pole: ``x ~ (t* - t)^(2/3)``
-#: for ``V = -1/x``, so the linear prediction is too late by at most a factor 3/2)
-READINGS_PER_APPROACH = 4
+#: readings per predicted approach: the guard is read again after half the steps the fastest-falling factor
+#: needs to reach zero at its last rate (the rate grows near an attracting pole: ``x ~ (t* - t)^(2/3)`` for
+#: ``V = -1/x``, so the linear prediction is too late by a factor 3/2, and half of it comes before the pole)
+READINGS_PER_APPROACH = 2
 
 REMEDY = (
     "a smaller step does not cure this: the motion reaches a singularity of its equations (the potential, the "
@@ -91,25 +91,37 @@ class PoleGuard:
         self.bounds = list(bounds) if bounds is not None else [False] * len(factors)
         self._time = time
         self._params = tuple(float(c) for c in params)
-        self._last: np.ndarray | None = None  # (members, factors): the last reading
+        self._members = 1
+        # the state of the readings, flat lists over (member, factor), plain floats: a reading of one
+        # member costs a few microseconds (numpy's overhead on arrays this small would be ten times that)
+        self._last: list[float] | None = None  # the last reading
         self._last_time = 0.0
         self._last_step = 0
-        self._rate = np.empty((0, 0))  # approach per step of each factor over the last interval
-        self._eta = np.empty((0, 0))  # steps to zero of each factor at that rate (inf: not approaching)
-        self._accelerating = np.empty((0, 0), dtype=bool)  # whether that approach was as fast as the one before
+        self._rate: list[float] = []  # approach per step of each factor over the last interval
+        self._eta: list[float] = []  # steps to zero of each factor at that rate (inf: not approaching)
+        self._accelerating: list[bool] = []  # whether that approach was as fast as the one before
+        self._span = GUARD_STEPS  # steps of the last interval
+        self._planned = GUARD_STEPS  # steps planned until the next reading
         #: steps in which the factor that falls fastest reaches zero at the rate of the last interval (inf: none falls)
         self.steps_to_pole = math.inf
         self._nearest = (0, 0, math.nan)
 
-    def read(self, q: np.ndarray, t: float = 0.0) -> np.ndarray:
-        """The factors' values at a batch of configurations ``q`` (shape ``(n,)`` or ``(B, n)``): ``(B, factors)``;
-        NaN where a factor has no real value."""
+    def _flat(self, q: np.ndarray, t: float) -> list[float]:
+        """The factors' values at a batch of configurations, flat over (member, factor); NaN where undefined."""
         rows = q.tolist() if isinstance(q, np.ndarray) else list(q)
         if rows and not isinstance(rows[0], list):
             rows = [rows]
+        self._members = len(rows)
         extra = (float(t),) if self._time else ()
-        return np.array([self._values(*row, *extra, *self._params) for row in rows], dtype=float).reshape(
-            len(rows), len(self.factors))
+        params = self._params
+        values = self._values
+        return [float(v) for row in rows for v in values(*row, *extra, *params)]
+
+    def read(self, q: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """The factors' values at a batch of configurations ``q`` (shape ``(n,)`` or ``(B, n)``): ``(B, factors)``;
+        NaN where a factor has no real value."""
+        flat = self._flat(q, t)
+        return np.array(flat, dtype=float).reshape(self._members, len(self.factors))
 
     def start(self, q: np.ndarray, t: float = 0.0, step: int = 0) -> None:
         """The first reading (at the initial state): the signs later readings are compared with.
@@ -134,85 +146,92 @@ class PoleGuard:
         PoleCrossing
             A factor is zero, or its sign differs from that of the last reading (the motion
             stepped across the pole between them); its message names the factor, the member
-            of a batch, the values and the interval of time.
+            of a batch, the values and the interval of time. Also when a factor came within a
+            step of zero, faster and faster, and went back (the steps jumped over the pole and
+            back, or do not resolve a turn next to it).
         """
-        now = self.read(q, t)
+        now = self._flat(q, t)
         t = t if at is None else float(at)
-        last, last_time, last_step = self._last, self._last_time, self._last_step
-        defined = np.isfinite(now)
-        hit = defined & (now == 0.0)
-        if last is not None:
-            hit |= defined & np.isfinite(last) & (np.sign(now) != np.sign(last))
-        if np.any(hit):
-            member, k = (int(i) for i in np.argwhere(hit)[0])
-            raise PoleCrossing(self._describe(member, k, now, last, last_time, last_step, t, step))
-        if last is None:
-            # the first reading: the initial state has every factor nonzero; NaN (no real value) is left to the loop
+        last = self._last
+        if last is None or len(last) != len(now):
+            for i, f in enumerate(now):
+                if f == 0.0:
+                    raise PoleCrossing(self._describe(i, now, None, t, step))
+            # the first reading: every factor nonzero; NaN (no real value) is left to the loop's own checks
             self._last, self._last_time, self._last_step = now, t, step
-            self._rate = np.full(now.shape, np.nan)
-            self._eta = np.full(now.shape, np.inf)
-            self._accelerating = np.ones(now.shape, dtype=bool)
+            self._rate = [math.nan] * len(now)
+            self._eta = [math.inf] * len(now)
+            self._accelerating = [True] * len(now)
+            self._span = self._planned = GUARD_STEPS
             return GUARD_STEPS
-        a, b = np.abs(last), np.abs(now)
-        with np.errstate(invalid="ignore"):
-            rate = (a - b) / max(steps, 1)  # approach per step (positive: nearer to the pole)
-            turned = defined & np.isfinite(last) & (b > a) & (self._eta <= steps) & self._accelerating
-        if np.any(turned):
-            member, k = (int(i) for i in np.argwhere(turned)[0])
-            raise PoleCrossing(self._describe_turn(member, k, now, last, last_time, last_step, t, step), turn=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            self._accelerating = ~(rate < self._rate)  # NaN (no rate before): counted as accelerating
-            self._eta = np.where(rate > 0, b / rate, np.inf)
-        self._rate = rate
+        span = max(steps, 1)
+        mean_span = 0.5 * (span + self._span)
+        rates, etas, accelerating = [], [], []
+        for i, (f, g) in enumerate(zip(now, last)):
+            if f == 0.0 or (f > 0.0 and g < 0.0) or (f < 0.0 and g > 0.0):  # at the pole, or across it
+                raise PoleCrossing(self._describe(i, now, last, t, step))
+            a, b = abs(g), abs(f)
+            rate = (a - b) / span  # approach per step (positive: nearer to the pole); NaN where undefined
+            if b > a and self._eta[i] <= steps and self._accelerating[i]:
+                raise PoleCrossing(self._describe_turn(i, now, last, t, step), turn=True)
+            change = (rate - self._rate[i]) / mean_span  # of the approach rate, per step (NaN: no rate before)
+            # an approach slowing down so that it stops within half the distance left turns before the pole
+            # (a bound orbit's near pass, an oscillation): not a pole to watch step by step
+            turns = change < 0.0 and rate * rate < -change * b
+            rates.append(rate)
+            etas.append(b / rate if rate > 0.0 and not turns else math.inf)
+            accelerating.append(not change < 0.0)
+        self._rate, self._eta, self._accelerating, self._span = rates, etas, accelerating, span
         self._last, self._last_time, self._last_step = now, t, step
-        return self.next_reading(last, now, steps)
+        return self.next_reading(now, span)
 
-    def next_reading(self, last: np.ndarray, now: np.ndarray, steps: int) -> int:
-        """Steps until the next reading, after ``steps`` steps took the factors from ``last`` to ``now``.
+    def next_reading(self, now: list[float], steps: int) -> int:
+        """Steps until the next reading, after ``steps`` steps that ended with the factors at ``now`` (flat).
 
-        Each factor that came nearer to zero would reach it after ``|f| / rate`` more steps at
-        the rate ``|f_last - f_now| / steps`` of the last interval; the guard is read again after
-        a quarter of the smallest such count (every step next to a pole), at most twice the last
-        interval and :data:`MAX_GUARD_STEPS`.
+        Each factor that came nearer to zero, and not more and more slowly so as to stop
+        before it, would reach zero after ``|f| / rate`` more steps at the rate of the last
+        interval; the guard is read again after ``1/READINGS_PER_APPROACH`` of the smallest
+        such count (every step next to a pole), at most twice the interval planned before
+        (or done) and :data:`MAX_GUARD_STEPS`.
         """
-        limit = min(MAX_GUARD_STEPS, 2 * max(steps, GUARD_STEPS // 2))
-        a, b = np.abs(last), np.abs(now)
-        nearer = np.isfinite(a) & np.isfinite(b) & (b < a)
-        if not np.any(nearer):
-            self.steps_to_pole = math.inf
+        limit = min(MAX_GUARD_STEPS, 2 * max(steps, self._planned, GUARD_STEPS // 2))
+        to_zero = min(self._eta, default=math.inf)
+        self.steps_to_pole = to_zero
+        if to_zero == math.inf:
+            self._planned = limit
             return limit
-        with np.errstate(divide="ignore", invalid="ignore"):
-            counts = np.where(nearer, b / (a - b), np.inf)
-        member, k = (int(i) for i in np.unravel_index(int(np.argmin(counts)), counts.shape))
-        to_zero = float(counts[member, k]) * max(steps, 1)
-        self.steps_to_pole, self._nearest = to_zero, (member, k, float(now[member, k]))
-        return max(1, min(limit, int(to_zero / READINGS_PER_APPROACH)))
+        i = self._eta.index(to_zero)
+        self._nearest = (i // len(self.factors), i % len(self.factors), now[i])
+        self._planned = max(1, min(limit, int(to_zero / READINGS_PER_APPROACH)))
+        return self._planned
 
     def nearest(self) -> str:
         """The factor that fell fastest towards zero at the last reading, its value and what it is a denominator of."""
         member, k, value = self._nearest
-        who = f" of member {member}" if self._last is not None and self._last.shape[0] > 1 else ""
+        who = f" of member {member}" if self._members > 1 else ""
         return f"{self.factors[k]} = {value:.3g}{who}, a denominator of {self.origins[k]}"
 
-    def _describe_turn(self, member: int, k: int, now: np.ndarray, last: np.ndarray, last_time: float,
-                       last_step: int, t: float, step: int) -> str:
-        factor, origin = self.factors[k], self.origins[k]
-        who = f" (member {member} of the batch)" if now.shape[0] > 1 else ""
-        return (f"the motion{who} came within a step of the pole {factor} = 0 of the equations of motion (a "
-                f"denominator of {origin}), faster and faster, and was back at {factor} = {now[member, k]:.3g} "
-                f"after {factor} = {last[member, k]:.3g}, between t = {last_time:.6g} and t = {t:.6g} (steps "
-                f"{last_step} to {step}): the steps do not resolve the motion at the pole (they may have jumped over "
-                "it and back, as the stages of a composition method can)")
+    def _who(self, i: int) -> tuple[str, int]:
+        """`` (member m of the batch)`` (or nothing) and the factor's index, of the flat index ``i``."""
+        member, k = divmod(i, len(self.factors))
+        return (f" (member {member} of the batch)" if self._members > 1 else ""), k
 
-    def _describe(self, member: int, k: int, now: np.ndarray, last: np.ndarray | None, last_time: float,
-                  last_step: int, t: float, step: int) -> str:
+    def _describe_turn(self, i: int, now: list[float], last: list[float], t: float, step: int) -> str:
+        who, k = self._who(i)
         factor, origin = self.factors[k], self.origins[k]
-        who = f" (member {member} of the batch)" if now.shape[0] > 1 else ""
-        value = now[member, k]
+        return (f"the motion{who} came within a step of the pole {factor} = 0 of the equations of motion (a "
+                f"denominator of {origin}), faster and faster, and was back at {factor} = {now[i]:.3g} "
+                f"after {factor} = {last[i]:.3g}, between t = {self._last_time:.6g} and t = {t:.6g} (steps "
+                f"{self._last_step} to {step}): the steps do not resolve the motion at the pole (they may have jumped "
+                "over it and back, as the stages of a composition method can)")
+
+    def _describe(self, i: int, now: list[float], last: list[float] | None, t: float, step: int) -> str:
+        who, k = self._who(i)
+        factor, origin = self.factors[k], self.origins[k]
         if last is None:
             return (f"the initial state{who} is on a pole of the equations of motion, {factor} = 0 (a denominator of "
                     f"{origin}); start away from it")
-        before = last[member, k]
+        before, value = last[i], now[i]
         if value == 0.0:
             what = f"reached the pole {factor} = 0 ({factor} was {before:.3g} at the reading before)"
         else:
@@ -223,7 +242,7 @@ class PoleGuard:
                          "root of it), so the run left the real domain there")
             what += ")"
         return (f"the motion{who} {what}, a pole of the equations of motion (a denominator of {origin}), between "
-                f"t = {last_time:.6g} and t = {t:.6g} (steps {last_step} to {step})")
+                f"t = {self._last_time:.6g} and t = {t:.6g} (steps {self._last_step} to {step})")
 
 
 def _nodes(expr: Any) -> Any:

@@ -154,3 +154,40 @@ def test_a_scene_over_the_pole_is_one_error_line_and_keeps_its_partial_run(tmp_p
 def test_a_pole_error_is_an_integration_error():
     """Callers that catch IntegrationError (the command line, scripts) keep catching it."""
     assert issubclass(PoleError, IntegrationError)
+
+
+def test_a_sign_change_between_readings_far_from_the_pole_is_caught():
+    """No reading near the pole is needed: ``x`` read at 1, then at -1 a thousand steps later, has
+    changed sign, so the motion crossed ``x = 0`` in between (intermediate value theorem: ``x(t)`` is
+    continuous), and the reading says so, naming both values and both times."""
+    from dirac.flows.pole_guard import PoleCrossing
+
+    guard = pole_guard(_log_well().mechanics)
+    assert guard is not None
+    guard.start(np.array([1.0]), 0.0, 0)
+    with pytest.raises(PoleCrossing, match=r"stepped across the pole x = 0 \(x went from 1 to -1") as caught:
+        guard.check(np.array([-1.0]), 10.0, 1000, 1000)
+    assert "between t = 0 and t = 10 (steps 0 to 1000)" in str(caught.value)
+
+
+def test_a_batch_names_the_member_that_meets_the_pole():
+    """Two members of the log well, ``x0 = 0.5`` (``t* = 0.627``) and ``x0 = 2`` (``t* = 2.51``, module
+    docstring): the run stops at the first one's pole, naming member 0, and keeps both members' samples
+    before it."""
+    L = dirac.Lagrangian.from_strings("log_well", ["x"], "x_dot**2/2 - log(x)", [], parameters={})
+    problem = ConstrainedProblem(L, q0=[[0.5], [2.0]], qdot0=[[0.0], [0.0]])
+    with pytest.raises(PoleError, match=r"member 0 of the batch\) stepped across the pole x = 0") as caught:
+        integrate(problem, "rattle-2", t_end=1.0, dt=DT, samples=7)
+    q = caught.value.partial.outputs["q"]
+    assert q.shape == (4, 2, 1) and caught.value.partial.t[-1] < T_STAR and np.all(q > 0.0)
+
+
+def test_a_pole_in_time_is_named():
+    """The force ``c/(t - 1/2)`` on a free particle has a pole at ``t = 1/2`` whatever the motion: the run
+    stops there (its step fails next to it, or steps across it) naming the factor ``2*t - 1``, with the
+    samples before ``t = 1/2``."""
+    L = dirac.Lagrangian.from_strings("pole_in_time", ["x"], "x_dot**2/2", [], parameters={"c": 0.01},
+                                      forces={"x": "c/(t - 0.5)"})
+    with pytest.raises(PoleError, match=r"2\*t - 1") as caught:
+        integrate(ConstrainedProblem(L, q0=[0.0], qdot0=[1.0]), "rattle-2", t_end=1.0, dt=0.01, samples=11)
+    assert caught.value.partial.t[-1] == pytest.approx(0.4)
