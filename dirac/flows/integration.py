@@ -534,6 +534,7 @@ class _Loop:
                 return GUARD_STEPS
             return poles.check(q, t, self.stepper.steps, steps, at=self.t_now)
         except PoleCrossing as crossing:
+            crossing.turn = not poles.nearest_accelerating()  # an approach slowing down may turn before the pole
             raise _Pole(pole_message(str(self.problem.system), crossing, self.method.name)) from None
 
     def _pole_at_failure(self, poles: PoleGuard | None, steps: int) -> None:
@@ -549,6 +550,7 @@ class _Loop:
                 f"motion ({poles.nearest()}, reached within about {max(poles.steps_to_pole, 1.0):.0f} more steps at "
                 "the rate of the last steps)"
             )
+            crossing.turn = not poles.nearest_accelerating()  # an approach slowing down may turn before the pole
             raise _Pole(pole_message(str(self.problem.system), crossing, self.method.name))
 
     def _near_singularity(self, guard: ChartGuard | None, steps: int = GUARD_STEPS) -> int:

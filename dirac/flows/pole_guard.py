@@ -60,8 +60,9 @@ REMEDY = (
 class PoleCrossing(Exception):
     """A reading of the guard found a factor at zero or across it (internal; the loop makes a PoleError of it).
 
-    ``turn`` is true when the factor kept its sign but came within a step of zero and went back:
-    the steps did not resolve the motion there (a smaller step resolves a turn before the pole).
+    ``turn`` is true when the motion may turn before the pole, so that a smaller step would
+    resolve it: the factor kept its sign but came within a step of zero and went back, or its
+    approach was slowing down (a repelling pole that a step overshot).
     """
 
     def __init__(self, text: str, turn: bool = False) -> None:
@@ -169,10 +170,11 @@ class PoleGuard:
         rates, etas, accelerating = [], [], []
         for i, (f, g) in enumerate(zip(now, last)):
             if f == 0.0 or (f > 0.0 and g < 0.0) or (f < 0.0 and g > 0.0):  # at the pole, or across it
-                raise PoleCrossing(self._describe(i, now, last, t, step))
+                # an approach that was slowing down may be a repelling pole the step overshot: hedged
+                raise PoleCrossing(self._describe(i, now, last, t, step), turn=not self._accelerating[i])
             a, b = abs(g), abs(f)
             rate = (a - b) / span  # approach per step (positive: nearer to the pole); NaN where undefined
-            if b > a and self._eta[i] <= steps and self._accelerating[i]:
+            if b > a and self._eta[i] <= steps:  # predicted to reach the pole in this interval, and went back
                 raise PoleCrossing(self._describe_turn(i, now, last, t, step), turn=True)
             change = (rate - self._rate[i]) / mean_span  # of the approach rate, per step (NaN: no rate before)
             # an approach slowing down so that it stops within half the distance left turns before the pole
@@ -205,6 +207,11 @@ class PoleGuard:
         self._planned = max(1, min(limit, int(to_zero / READINGS_PER_APPROACH)))
         return self._planned
 
+    def nearest_accelerating(self) -> bool:
+        """Whether the approach of the factor that fell fastest at the last reading was speeding up."""
+        member, k, _ = self._nearest
+        return self._accelerating[member * len(self.factors) + k]
+
     def nearest(self) -> str:
         """The factor that fell fastest towards zero at the last reading, its value and what it is a denominator of."""
         member, k, value = self._nearest
@@ -219,8 +226,9 @@ class PoleGuard:
     def _describe_turn(self, i: int, now: list[float], last: list[float], t: float, step: int) -> str:
         who, k = self._who(i)
         factor, origin = self.factors[k], self.origins[k]
+        how = ", faster and faster," if self._accelerating[i] else ""
         return (f"the motion{who} came within a step of the pole {factor} = 0 of the equations of motion (a "
-                f"denominator of {origin}), faster and faster, and was back at {factor} = {now[i]:.3g} "
+                f"denominator of {origin}){how} and was back at {factor} = {now[i]:.3g} "
                 f"after {factor} = {last[i]:.3g}, between t = {self._last_time:.6g} and t = {t:.6g} (steps "
                 f"{self._last_step} to {step}): the steps do not resolve the motion at the pole (they may have jumped "
                 "over it and back, as the stages of a composition method can)")
@@ -280,6 +288,14 @@ def _quotients(expr: Any) -> Any:
 
 
 def _build(mechanics: Any) -> PoleGuard | None:
+    """The guard of ``mechanics`` (module docstring), or ``None`` when its equations of motion have no denominator
+    in the coordinates and the time that can vanish.
+
+    The sources, for ``L = q_dot^T M q_dot / 2 - V`` with constraints ``chi`` and forces ``Q``
+    (Goldstein, "Classical Mechanics", Sect. 1.4 and 2.4: ``d/dt (M q_dot) - dL/dq = Q + G^T lambda``,
+    ``G = dchi/dq``): ``dV/dq``; ``M`` and ``dM/dq``; ``chi``, ``G``, ``dchi/dt`` and their
+    derivatives (the hidden constraint and the multipliers); ``Q``; ``dV/dt``.
+    """
     import sympy  # the mechanics were built with it: importing it costs nothing here
 
     symbolic = mechanics.symbolic

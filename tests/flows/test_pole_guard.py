@@ -191,3 +191,23 @@ def test_a_pole_in_time_is_named():
     with pytest.raises(PoleError, match=r"2\*t - 1") as caught:
         integrate(ConstrainedProblem(L, q0=[0.0], qdot0=[1.0]), "rattle-2", t_end=1.0, dt=0.01, samples=11)
     assert caught.value.partial.t[-1] == pytest.approx(0.4)
+
+
+def _repelled(dt: float):
+    L = dirac.Lagrangian.from_strings("repelled", ["x"], "x_dot**2/2 - c/x", [], parameters={"c": 1e-3})
+    return integrate(ConstrainedProblem(L, q0=[1.0], qdot0=[-1.0]), "rattle-2", t_end=2.0, dt=dt, samples=5)
+
+
+def test_a_repelling_pole_a_step_does_not_resolve_is_named_with_the_smaller_step():
+    """``V = c/x``, ``c = 1e-3``, thrown from ``x = 1`` towards the pole at speed 1: energy conservation
+    ``v^2/2 + c/x = 1/2 + c`` turns the exact motion at ``x_min = c/(1/2 + c) ~ 2e-3`` (by hand), a fifth of
+    the step ``dt = 0.01`` travels. That step lands at ``x ~ 5e-4``, where the force ``c/x^2`` is
+    thousands, and the run used to finish with its energy 1000 times the true one. It stops, saying the
+    steps do not resolve the motion at the pole and that a smaller ``dt`` resolves a turn before it;
+    with ``dt = 1e-3`` the run completes and keeps the energy ``1/2 + c`` to 1e-2."""
+    with pytest.raises(PoleError, match=r"came within a step of the pole x = 0") as caught:
+        _repelled(0.01)
+    assert "a smaller dt resolves the turn" in str(caught.value)
+    solution = _repelled(1e-3)
+    assert solution.complete
+    assert np.max(np.abs(solution.outputs["energy"] - (0.5 + 1e-3))) < 1e-2
