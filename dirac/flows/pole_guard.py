@@ -23,9 +23,13 @@ across ``f = 0`` between the two readings, even if no reading came near it. The 
 come at every sample (before the sample is stored, so the partial run ends before the
 crossing) and, in between, after half the steps in which the factor that falls fastest
 would reach zero at its last rate, unless its approach slows down so as to stop before the
-pole (:meth:`PoleGuard.next_reading`): every step next to a pole, up to :data:`~dirac.flows.chart_guard.MAX_GUARD_STEPS` far away. A factor
-that changes its sign and back between two readings is not seen (the readings' spacing
-makes that unlikely, not impossible). Factors that depend on the velocities (a force
+pole (:meth:`PoleGuard.next_reading`): every step next to a pole, up to
+:data:`~dirac.flows.chart_guard.MAX_GUARD_STEPS` far away. A factor predicted at one reading
+to reach zero before the next that went back instead stops the run too: the steps do not
+resolve the motion at the pole (a composition's stages jumped over it and back, or a step
+landed next to a repelling pole and was thrown back: ``V = c/x`` at ``dt = 0.01`` finished
+with 1000 times its energy). A factor that changes its sign and back between two readings
+farther apart is not seen (the readings' spacing makes that unlikely, not impossible). Factors that depend on the velocities (a force
 ``-c x_dot/|x_dot|``) are not read. Systems whose expressions hold no denominator (and no
 function whose derivative has one: only sums, products, positive integer powers, ``sin``,
 ``cos`` and ``exp``) have no guard and run exactly as before, without a symbolic
