@@ -22,7 +22,7 @@ import math
 import sys
 import time
 from collections.abc import Sequence
-from typing import Any, Required, TypedDict
+from typing import TYPE_CHECKING, Any, Required, TypedDict
 
 import numpy as np
 
@@ -31,11 +31,12 @@ from dirac.flows.chart_guard import GUARD_STEPS, STOP_DISTANCE, ChartGuard, char
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
 from dirac.flows.methods.torqued import refuse_undriven
-from dirac.flows.pole_guard import READINGS_PER_APPROACH, PoleCrossing, PoleGuard, pole_guard
-from dirac.flows.pole_guard import message as pole_message
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 from dirac.validate import is_real_number, unknown_name_error, validate_integer, validate_positive
+
+if TYPE_CHECKING:
+    from dirac.flows.pole_guard import PoleGuard
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS", "RunOptions"]
 
@@ -523,10 +524,15 @@ class _Loop:
         mechanics = getattr(self.problem, "mechanics", None)
         if mechanics is None or not hasattr(self.stepper, "q") or not hasattr(mechanics, "symbolic"):
             return None
+        from dirac.flows.pole_guard import pole_guard  # only runs of a mechanical system need it
+
         return pole_guard(mechanics)
 
     def _read_poles(self, poles: PoleGuard, steps: int, start: bool = False) -> int:
         """Stop at or across a pole of the equations of motion; else the steps until the guard is read again."""
+        from dirac.flows.pole_guard import PoleCrossing
+        from dirac.flows.pole_guard import message as pole_message
+
         q, t = getattr(self.stepper, "q"), getattr(self.stepper, "time", self.t_now)  # noqa: B009 (a constrained stepper)
         try:
             if start:
@@ -542,6 +548,9 @@ class _Loop:
         within a few steps (a Newton iteration fails next to a pole, where the force is unbounded)."""
         if poles is None:
             return
+        from dirac.flows.pole_guard import READINGS_PER_APPROACH, PoleCrossing
+        from dirac.flows.pole_guard import message as pole_message
+
         if steps > 0:  # a new state since the last reading: read it (and the rate); else the last prediction stands
             self._read_poles(poles, steps)
         if poles.steps_to_pole <= READINGS_PER_APPROACH:

@@ -79,7 +79,7 @@ def test_a_run_over_the_pole_stops_at_the_hand_time(method):
 def test_without_the_guard_the_jump_is_silent(monkeypatch):
     """The mutation: with the guard disabled, the same run of ``rattle-2`` completes and its energy
     jumps by more than the whole initial energy ``|log(x0)|`` (the defect the guard cures)."""
-    monkeypatch.setattr("dirac.flows.integration.pole_guard", lambda mechanics: None)
+    monkeypatch.setattr("dirac.flows.pole_guard.pole_guard", lambda mechanics: None)
     solution = integrate(_log_well(), "rattle-2", t_end=1.0, dt=DT, samples=7)
     assert solution.complete
     energy = solution.outputs["energy"]
@@ -117,7 +117,7 @@ def test_a_force_pole_the_motion_stays_away_from_changes_no_bit(monkeypatch):
     guard = pole_guard(_away_from_the_pole().mechanics)
     assert guard is not None and guard.factors == ["a - x"] and guard.origins == ["the applied forces"]
     guarded = integrate(_away_from_the_pole(), "rattle-2", t_end=20.0, dt=0.01, samples=41)
-    monkeypatch.setattr("dirac.flows.integration.pole_guard", lambda mechanics: None)
+    monkeypatch.setattr("dirac.flows.pole_guard.pole_guard", lambda mechanics: None)
     bare = integrate(_away_from_the_pole(), "rattle-2", t_end=20.0, dt=0.01, samples=41)
     assert guarded.complete and bare.complete
     assert np.max(np.abs(guarded.outputs["q"])) < 1.1
