@@ -540,7 +540,6 @@ class _Loop:
                 return GUARD_STEPS
             return poles.check(q, t, self.stepper.steps, steps, at=self.t_now)
         except PoleCrossing as crossing:
-            crossing.turn = not poles.nearest_accelerating()  # an approach slowing down may turn before the pole
             raise _Pole(pole_message(str(self.problem.system), crossing, self.method.name)) from None
 
     def _pole_at_failure(self, poles: PoleGuard | None, steps: int) -> None:
