@@ -23,6 +23,7 @@ __all__ = [
     "AnalysisError",
     "IntegrationError",
     "CoordinateSingularityError",
+    "PoleError",
     "DiracWarning",
     "warn",
     "install_warning_printer",
@@ -94,6 +95,13 @@ class IntegrationError(DiracError):
 class CoordinateSingularityError(IntegrationError):
     """A run came near a coordinate singularity (``det W = 0``, ``W = d^2 L/dq_dot^2``, e.g. ``sin(theta) = 0``
     for Euler angles): the message names the locus, the time and another chart to use."""
+
+
+class PoleError(IntegrationError):
+    """The motion reached or stepped across a pole of its equations of motion (a denominator of the force, the
+    mass matrix, the constraints or the forces vanishing, e.g. ``x = 0`` of the force ``-1/x`` of ``V = log(x)``):
+    a singularity of the physics at a finite time, which a smaller step does not cure. The message names the
+    expression that vanishes, the interval of time and the remedies; ``partial`` ends before the pole."""
 
 
 class DiracWarning(UserWarning):

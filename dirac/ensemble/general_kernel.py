@@ -45,6 +45,9 @@ FAILURES: dict[int, str] = {
     1: "Newton iteration did not converge (reduce dt)",
     2: "non-finite state (the step diverged; reduce dt)",
     3: "singular Newton matrix (the constraints are not independent here)",
+    4: ("stepped across a pole of the equations of motion (a denominator of the force, the mass matrix, the "
+        "constraints or the forces changed sign between two steps: a singularity the motion reaches; a smaller dt "
+        "does not cure it)"),
 }
 
 _CACHE: dict[str, CompiledEnsemble] = {}
@@ -175,9 +178,13 @@ def _build(scene: GeneralEnsembleScene) -> CompiledEnsemble:
         # the step leaves w = transcendentals(q) at its final q: the reductions read their sines
         entries = step_transcendentals(system_source, lagrangian.coordinates, lagrangian.parameters, sympy.Dummy("t"))
         reuse = _Reuse(entries, "\ndef velocity_w(q, p, w, t, c, out, work, piv):" in system_source) if entries else None
+    from dirac.flows.pole_guard import pole_guard
+
+    guard = pole_guard(mechanics)  # the poles of the equations of motion, read after every step (failure code 4)
+    poles = list(guard.expressions) if guard is not None else []
     source = _ensemble_source(scene, lagrangian, state, exprs, conditions, layout, step, n,
                               mechanics.n_constraints, needs_velocity, "energy_error" in kinds,
-                              "constraint_error" in kinds, pasted, plan, reuse)
+                              "constraint_error" in kinds, pasted, plan, reuse, poles)
     module = import_source(system_source + source)
     variables = {name: sympy.Symbol(name, real=True) for name in scene.source.names}
     parameter_exprs = {k: parse_expression(v, variables, what=f"[system] parameters.{k}")
@@ -237,8 +244,10 @@ def _paste_step(source: str, kernel: str) -> tuple[list[str], list[str], list[st
 def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, exprs: list, conditions: list,
                      layout: dict, step: str, n: int, m: int, needs_velocity: bool, energy: bool,
                      constraint: bool, pasted: tuple[list[str], list[str], list[str]] | None = None,
-                     plan: Any = None, reuse: _Reuse | None = None) -> str:
+                     plan: Any = None, reuse: _Reuse | None = None, poles: list | None = None) -> str:
     from dirac.codegen.kernel_source import emit_function
+
+    poles = list(poles or [])
 
     q = list(lagrangian.coordinates)
     p = [state[f"p_{s.name}"] for s in q]
@@ -251,6 +260,9 @@ def _ensemble_source(scene: GeneralEnsembleScene, lagrangian: Any, state: dict, 
                              (len(exprs),), params))
     out.append(emit_function("ens_conditions", "the when conditions (lhs - rhs)", arrays, scalars,
                              [c for c, _ in conditions], (len(conditions),), params))
+    if poles:
+        out.append(emit_function("ens_poles", "the factors of the denominators of the equations of motion "
+                                 "(dirac.flows.pole_guard)", arrays, scalars, poles, (len(poles),), params))
     # after a step: the reductions read the sines and cosines of q the step left in w (the
     # same bits; module docstring of dirac.ensemble.step_transcendentals), and v = M^-1 p too
     # when no entry of w depends on the time
@@ -326,6 +338,10 @@ def ens_velocity(q, p, t, c, v, work, piv):
     w(1, f"m_res = np.zeros({max(1, 2 * m)})")
     w(1, f"m_pc = np.zeros({max(1, n_poin)}, dtype=np.int64)")
     w(1, "m_t0 = starts[0]")
+    if poles:
+        w(1, f"m_pole = np.zeros({len(poles)})")
+        w(1, f"m_polea = np.zeros({len(poles)})")
+        w(1, "ens_poles(q, p, m_v, m_t0, c, m_pole)")
     w(1, "ens_velocity(q, p, m_t0, c, m_v, m_vw, m_vpiv)")
     w(1, "ens_values(q, p, m_v, m_t0, c, m_f)")
     for x, (_, _, e) in enumerate(layout["ext"]):
@@ -388,6 +404,16 @@ def ens_velocity(q, p, t, c, v, work, piv):
     w(4, "m_status = 2.0")
     w(4, "m_stop = True")
     w(4, "break")
+    if poles:  # a factor of a denominator that changed sign in the step: the step jumped over a pole
+        w(3, f"for m_x in range({len(poles)}):")
+        w(4, "m_polea[m_x] = m_pole[m_x]")
+        w(3, "ens_poles(q, p, m_v, tb, c, m_pole)")
+        w(3, f"for m_x in range({len(poles)}):")
+        w(4, "if (m_polea[m_x] > 0.0 and m_pole[m_x] <= 0.0) or (m_polea[m_x] < 0.0 and m_pole[m_x] >= 0.0):")
+        w(5, "m_status = 4.0")
+        w(5, "m_stop = True")
+        w(3, "if m_stop:")
+        w(4, "break")
     if needs_velocity:
         w(3, after_velocity)
     w(3, after_values)

@@ -22,11 +22,11 @@ import math
 import sys
 import time
 from collections.abc import Sequence
-from typing import Any, Required, TypedDict
+from typing import TYPE_CHECKING, Any, Required, TypedDict
 
 import numpy as np
 
-from dirac.errors import CoordinateSingularityError, InputError, IntegrationError
+from dirac.errors import CoordinateSingularityError, InputError, IntegrationError, PoleError
 from dirac.flows.chart_guard import GUARD_STEPS, STOP_DISTANCE, ChartGuard, chart_guard
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
@@ -34,6 +34,9 @@ from dirac.flows.methods.torqued import refuse_undriven
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 from dirac.validate import is_real_number, unknown_name_error, validate_integer, validate_positive
+
+if TYPE_CHECKING:
+    from dirac.flows.pole_guard import PoleGuard
 
 __all__ = ["integrate", "sample_times", "IntegrationInterrupted", "problem_kind", "DEFAULT_OUTPUTS", "RunOptions"]
 
@@ -426,6 +429,9 @@ class _Loop:
                 self._run_fixed(bar, intervals)
             else:
                 self._run_adaptive(bar)
+        except _Pole as stop:
+            self.cpu = time.process_time() - start
+            raise PoleError(str(stop), partial=self._solution(False, str(stop))) from None
         except _Singular as stop:
             self.cpu = time.process_time() - start
             raise CoordinateSingularityError(str(stop), partial=self._solution(False, str(stop))) from None
@@ -472,9 +478,13 @@ class _Loop:
         # (and checked) one step at a time
         chunk = max(MIN_CHUNK_STEPS, CHUNK_STEPS // max(1, batch))
         guard = self._chart_guard()
+        poles = self._pole_guard()
         limit = chunk
-        if guard is not None:  # near a coordinate singularity the guard is read often (dirac.flows.chart_guard)
+        if guard is not None or poles is not None:
+            # near a coordinate singularity or a pole the guards are read often (dirac.flows.chart_guard, .pole_guard)
             chunk = min(chunk, GUARD_STEPS)
+        if poles is not None:
+            self._read_poles(poles, 0, start=True)
         dt = float(self.dt)
         for index, (a, _b, n_steps) in enumerate(intervals):
             done = 0
@@ -484,12 +494,15 @@ class _Loop:
                     self.stepper.step(n, dt)
                 except StepFailure as failure:
                     self.t_now = a + (done + failure.steps_done) * dt
+                    self._pole_at_failure(poles, failure.steps_done)
                     self._near_singularity(guard)
                     raise
                 done += n
                 self.t_now = a + done * dt
+                if poles is not None:  # a chunk never spans a sample: a crossing is found before the sample is kept
+                    chunk = min(limit, self._read_poles(poles, n))
                 if guard is not None:
-                    chunk = min(limit, self._near_singularity(guard, n))
+                    chunk = min(limit if poles is None else chunk, self._near_singularity(guard, n))
                 self._check()
                 bar.update(n)
             self.t_now = float(self.times[first + index])
@@ -505,6 +518,48 @@ class _Loop:
         if mechanics is None or not hasattr(self.stepper, "q") or not hasattr(mechanics, "symbolic"):
             return None
         return chart_guard(mechanics)
+
+    def _pole_guard(self) -> PoleGuard | None:
+        """The pole guard of a constrained system's stepper, if its equations of motion have denominators that can vanish."""
+        mechanics = getattr(self.problem, "mechanics", None)
+        if mechanics is None or not hasattr(self.stepper, "q") or not hasattr(mechanics, "symbolic"):
+            return None
+        from dirac.flows.pole_guard import pole_guard  # only runs of a mechanical system need it
+
+        return pole_guard(mechanics)
+
+    def _read_poles(self, poles: PoleGuard, steps: int, start: bool = False) -> int:
+        """Stop at or across a pole of the equations of motion; else the steps until the guard is read again."""
+        from dirac.flows.pole_guard import PoleCrossing
+        from dirac.flows.pole_guard import message as pole_message
+
+        q, t = getattr(self.stepper, "q"), getattr(self.stepper, "time", self.t_now)  # noqa: B009 (a constrained stepper)
+        try:
+            if start:
+                poles.start(q, t, self.stepper.steps)
+                return GUARD_STEPS
+            return poles.check(q, t, self.stepper.steps, steps, at=self.t_now)
+        except PoleCrossing as crossing:
+            raise _Pole(pole_message(str(self.problem.system), crossing, self.method.name)) from None
+
+    def _pole_at_failure(self, poles: PoleGuard | None, steps: int) -> None:
+        """After a failed step: stop with the pole when the state is across it, or when the last readings had it
+        within a few steps (a Newton iteration fails next to a pole, where the force is unbounded)."""
+        if poles is None:
+            return
+        from dirac.flows.pole_guard import READINGS_PER_APPROACH, PoleCrossing
+        from dirac.flows.pole_guard import message as pole_message
+
+        if steps > 0:  # a new state since the last reading: read it (and the rate); else the last prediction stands
+            self._read_poles(poles, steps)
+        if poles.steps_to_pole <= READINGS_PER_APPROACH:
+            crossing = PoleCrossing(
+                f"a step failed at t = {self.t_now:.6g} (step {self.stepper.steps}) next to a pole of the equations of "
+                f"motion ({poles.nearest()}, reached within about {max(poles.steps_to_pole, 1.0):.0f} more steps at "
+                "the rate of the last steps)"
+            )
+            crossing.turn = not poles.nearest_accelerating()  # an approach slowing down may turn before the pole
+            raise _Pole(pole_message(str(self.problem.system), crossing, self.method.name))
 
     def _near_singularity(self, guard: ChartGuard | None, steps: int = GUARD_STEPS) -> int:
         """Stop near a coordinate singularity; else the steps until the guard is read again (1 when close)."""
@@ -542,6 +597,10 @@ class _Loop:
 
 class _Stop(Exception):
     """A guard rail fired (internal; becomes an IntegrationError)."""
+
+
+class _Pole(_Stop):
+    """The motion reached or stepped across a pole of its equations of motion (internal; becomes a PoleError)."""
 
 
 class _Singular(_Stop):

@@ -1,0 +1,410 @@
+"""A guard that stops a run whose motion reaches or steps across a pole of its equations of motion.
+
+The equations of motion of ``L = q_dot^T M(q, t) q_dot / 2 - V(q, t)`` with holonomic
+constraints ``chi(q, t) = 0`` and generalized forces ``Q(q, q_dot, t)`` evaluate the force
+``-dV/dq``, the entries of ``M`` and their derivatives, the constraints' first and second
+derivatives and ``Q``. Where a denominator of these expressions vanishes (``x = 0`` of the
+force ``-1/x`` of ``V = log(x)``; ``cos(q) = 0`` of ``V = tan(q)``; ``x - a = 0`` of a force
+``1/(x - a)``) the vector field has a pole. Such a pole is a singularity of the physics, not
+of the chart (Arnold, "Mathematical Methods of Classical Mechanics", Sect. 4 on motion in
+a potential: with ``v^2/2 + V(x) = E`` the speed is infinite where ``V -> -infinity``, and
+the motion reaches that point at a finite time when ``integral dx / sqrt(2 (E - V(x)))``
+converges there). A fixed step is blind to it: the force ``-1/x`` is defined on both sides
+of ``x = 0``, so a step jumps over the pole and the run goes on with an energy that jumped
+(``V = log(x)`` from ``x = 0.5`` at rest with ``dt = 0.01``: a relative energy jump of 1.5,
+and no word). A smaller step only moves the jump.
+
+:class:`PoleGuard` evaluates the irreducible factors ``f`` of those denominators that can
+vanish (:func:`dirac.analysis.core.divisors.denominator_factors`), compiled as one scalar
+function of the coordinates (and the time). The loop of :func:`dirac.flows.integrate`
+reads it between calls of the step loop and stops with :class:`~dirac.errors.PoleError`
+when a factor is zero, or when its sign differs from the last reading: the motion stepped
+across ``f = 0`` between the two readings, even if no reading came near it. The readings
+come at every sample (before the sample is stored, so the partial run ends before the
+crossing) and, in between, after half the steps in which the factor that falls fastest
+would reach zero at its last rate, unless its approach slows down so as to stop before the
+pole (:meth:`PoleGuard.next_reading`): every step next to a pole, up to
+:data:`~dirac.flows.chart_guard.MAX_GUARD_STEPS` far away. A factor predicted at one reading
+to reach zero before the next that went back instead stops the run too: the steps do not
+resolve the motion at the pole (a composition's stages jumped over it and back, or a step
+landed next to a repelling pole and was thrown back: ``V = c/x`` at ``dt = 0.01`` finished
+with 1000 times its energy). A factor that changes its sign and back between two readings
+farther apart is not seen (the readings' spacing makes that unlikely, not impossible). Factors that depend on the velocities (a force
+``-c x_dot/|x_dot|``) are not read. Systems whose expressions hold no denominator (and no
+function whose derivative has one: only sums, products, positive integer powers, ``sin``,
+``cos`` and ``exp``) have no guard and run exactly as before, without a symbolic
+derivative taken.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS
+
+__all__ = ["PoleGuard", "pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH", "REMEDY"]
+
+#: readings per predicted approach: the guard is read again after half the steps the fastest-falling factor
+#: needs to reach zero at its last rate (the rate grows near an attracting pole: ``x ~ (t* - t)^(2/3)`` for
+#: ``V = -1/x``, so the linear prediction is too late by a factor 3/2, and half of it comes before the pole)
+READINGS_PER_APPROACH = 2
+
+REMEDY = (
+    "a smaller step does not cure this: the motion reaches a singularity of its equations (the potential, the "
+    "mass matrix, the constraints or the forces are infinite there) at a finite time; regularise the expression "
+    "near the pole (soften 1/x to x/(x**2 + eps**2), or log(x) to log(x**2 + eps**2)/2), stop the run before "
+    "it (a t_end before the time named), or change the model (a wall: an impulse reversing the velocity)"
+)
+
+
+class PoleCrossing(Exception):
+    """A reading of the guard found a factor at zero or across it (internal; the loop makes a PoleError of it).
+
+    ``turn`` is true when the motion may turn before the pole, so that a smaller step would
+    resolve it: the factor kept its sign but came within a step of zero and went back, or its
+    approach was slowing down (a repelling pole that a step overshot).
+    """
+
+    def __init__(self, text: str, turn: bool = False) -> None:
+        super().__init__(text)
+        self.turn = turn
+
+
+class PoleGuard:
+    """The sign of each factor of the denominators of one system's equations of motion, compiled (module docstring).
+
+    Attributes
+    ----------
+    factors
+        The factors as text (``"x"``), in reading order.
+    origins
+        For each factor, what it is a denominator of (``"the force -dV/dq"``).
+    """
+
+    def __init__(self, values: Callable[..., list[float]], factors: list[str], origins: list[str], time: bool,
+                 params: np.ndarray, bounds: list[bool] | None = None) -> None:
+        self._values = values  # (f_1, f_2, ...)
+        self.factors = factors
+        self.origins = origins
+        #: the factors as sympy expressions in the coordinates, the time and the parameters (symbolic)
+        self.expressions: list[Any] = []
+        #: for each factor, whether it also bounds the real domain (``x`` of ``log(x)``, ``sqrt(x)``)
+        self.bounds = list(bounds) if bounds is not None else [False] * len(factors)
+        self._time = time
+        self._params = tuple(float(c) for c in params)
+        self._members = 1
+        # the state of the readings, flat lists over (member, factor), plain floats: a reading of one
+        # member costs a few microseconds (numpy's overhead on arrays this small would be ten times that)
+        self._last: list[float] | None = None  # the last reading
+        self._last_time = 0.0
+        self._last_step = 0
+        self._rate: list[float] = []  # approach per step of each factor over the last interval
+        self._eta: list[float] = []  # steps to zero of each factor at that rate (inf: not approaching)
+        self._accelerating: list[bool] = []  # whether that approach was as fast as the one before
+        self._span = GUARD_STEPS  # steps of the last interval
+        self._planned = GUARD_STEPS  # steps planned until the next reading
+        #: steps in which the factor that falls fastest reaches zero at the rate of the last interval (inf: none falls)
+        self.steps_to_pole = math.inf
+        self._nearest = (0, 0, math.nan)
+
+    def _flat(self, q: np.ndarray, t: float) -> list[float]:
+        """The factors' values at a batch of configurations, flat over (member, factor); NaN where undefined."""
+        rows = q.tolist() if isinstance(q, np.ndarray) else list(q)
+        if rows and not isinstance(rows[0], list):
+            rows = [rows]
+        self._members = len(rows)
+        extra = (float(t),) if self._time else ()
+        params = self._params
+        values = self._values
+        return [float(v) for row in rows for v in values(*row, *extra, *params)]
+
+    def read(self, q: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """The factors' values at a batch of configurations ``q`` (shape ``(n,)`` or ``(B, n)``): ``(B, factors)``;
+        NaN where a factor has no real value."""
+        flat = self._flat(q, t)
+        return np.array(flat, dtype=float).reshape(self._members, len(self.factors))
+
+    def start(self, q: np.ndarray, t: float = 0.0, step: int = 0) -> None:
+        """The first reading (at the initial state): the signs later readings are compared with.
+
+        Raises
+        ------
+        PoleCrossing
+            The initial state is on a pole (a factor is zero there).
+        """
+        self._last = None
+        self.steps_to_pole = math.inf
+        self.check(q, t, step, GUARD_STEPS)
+
+    def check(self, q: np.ndarray, t: float, step: int, steps: int, at: float | None = None) -> int:
+        """Read the guard after ``steps`` steps that ended at time ``t`` (step ``step``); the steps until the next reading.
+
+        ``t`` is the time the factors are evaluated at (that of the state); ``at``, when given,
+        the time the messages name (the loop's time on the sample grid).
+
+        Raises
+        ------
+        PoleCrossing
+            A factor is zero, or its sign differs from that of the last reading (the motion
+            stepped across the pole between them); its message names the factor, the member
+            of a batch, the values and the interval of time. Also when a factor came within a
+            step of zero, faster and faster, and went back (the steps jumped over the pole and
+            back, or do not resolve a turn next to it).
+        """
+        now = self._flat(q, t)
+        t = t if at is None else float(at)
+        last = self._last
+        if last is None or len(last) != len(now):
+            for i, f in enumerate(now):
+                if f == 0.0:
+                    raise PoleCrossing(self._describe(i, now, None, t, step))
+            # the first reading: every factor nonzero; NaN (no real value) is left to the loop's own checks
+            self._last, self._last_time, self._last_step = now, t, step
+            self._rate = [math.nan] * len(now)
+            self._eta = [math.inf] * len(now)
+            self._accelerating = [True] * len(now)
+            self._span = self._planned = GUARD_STEPS
+            return GUARD_STEPS
+        span = max(steps, 1)
+        mean_span = 0.5 * (span + self._span)
+        rates, etas, accelerating = [], [], []
+        for i, (f, g) in enumerate(zip(now, last)):
+            if f == 0.0 or (f > 0.0 and g < 0.0) or (f < 0.0 and g > 0.0):  # at the pole, or across it
+                # an approach that was slowing down may be a repelling pole the step overshot: hedged
+                raise PoleCrossing(self._describe(i, now, last, t, step), turn=not self._accelerating[i])
+            a, b = abs(g), abs(f)
+            rate = (a - b) / span  # approach per step (positive: nearer to the pole); NaN where undefined
+            if b > a and self._eta[i] <= steps:  # predicted to reach the pole in this interval, and went back
+                raise PoleCrossing(self._describe_turn(i, now, last, t, step), turn=True)
+            change = (rate - self._rate[i]) / mean_span  # of the approach rate, per step (NaN: no rate before)
+            # an approach slowing down so that it stops within half the distance left turns before the pole
+            # (a bound orbit's near pass, an oscillation): not a pole to watch step by step
+            turns = change < 0.0 and rate * rate < -change * b
+            rates.append(rate)
+            etas.append(b / rate if rate > 0.0 and not turns else math.inf)
+            accelerating.append(not change < 0.0)
+        self._rate, self._eta, self._accelerating, self._span = rates, etas, accelerating, span
+        self._last, self._last_time, self._last_step = now, t, step
+        return self.next_reading(now, span)
+
+    def next_reading(self, now: list[float], steps: int) -> int:
+        """Steps until the next reading, after ``steps`` steps that ended with the factors at ``now`` (flat).
+
+        Each factor that came nearer to zero, and not more and more slowly so as to stop
+        before it, would reach zero after ``|f| / rate`` more steps at the rate of the last
+        interval; the guard is read again after ``1/READINGS_PER_APPROACH`` of the smallest
+        such count (every step next to a pole), at most twice the interval planned before
+        (or done) and :data:`MAX_GUARD_STEPS`.
+        """
+        limit = min(MAX_GUARD_STEPS, 2 * max(steps, self._planned, GUARD_STEPS // 2))
+        to_zero = min(self._eta, default=math.inf)
+        self.steps_to_pole = to_zero
+        if to_zero == math.inf:
+            self._planned = limit
+            return limit
+        i = self._eta.index(to_zero)
+        self._nearest = (i // len(self.factors), i % len(self.factors), now[i])
+        self._planned = max(1, min(limit, int(to_zero / READINGS_PER_APPROACH)))
+        return self._planned
+
+    def nearest_accelerating(self) -> bool:
+        """Whether the approach of the factor that fell fastest at the last reading was speeding up."""
+        member, k, _ = self._nearest
+        return self._accelerating[member * len(self.factors) + k]
+
+    def nearest(self) -> str:
+        """The factor that fell fastest towards zero at the last reading, its value and what it is a denominator of."""
+        member, k, value = self._nearest
+        who = f" of member {member}" if self._members > 1 else ""
+        return f"{self.factors[k]} = {value:.3g}{who}, a denominator of {self.origins[k]}"
+
+    def _who(self, i: int) -> tuple[str, int]:
+        """`` (member m of the batch)`` (or nothing) and the factor's index, of the flat index ``i``."""
+        member, k = divmod(i, len(self.factors))
+        return (f" (member {member} of the batch)" if self._members > 1 else ""), k
+
+    def _describe_turn(self, i: int, now: list[float], last: list[float], t: float, step: int) -> str:
+        who, k = self._who(i)
+        factor, origin = self.factors[k], self.origins[k]
+        how = ", faster and faster," if self._accelerating[i] else ""
+        return (f"the motion{who} came within a step of the pole {factor} = 0 of the equations of motion (a "
+                f"denominator of {origin}){how} and was back at {factor} = {now[i]:.3g} "
+                f"after {factor} = {last[i]:.3g}, between t = {self._last_time:.6g} and t = {t:.6g} (steps "
+                f"{self._last_step} to {step}): the steps do not resolve the motion at the pole (they may have jumped "
+                "over it and back, as the stages of a composition method can)")
+
+    def _describe(self, i: int, now: list[float], last: list[float] | None, t: float, step: int) -> str:
+        who, k = self._who(i)
+        factor, origin = self.factors[k], self.origins[k]
+        if last is None:
+            return (f"the initial state{who} is on a pole of the equations of motion, {factor} = 0 (a denominator of "
+                    f"{origin}); start away from it")
+        before, value = last[i], now[i]
+        if value == 0.0:
+            what = f"reached the pole {factor} = 0 ({factor} was {before:.3g} at the reading before)"
+        else:
+            what = (f"stepped across the pole {factor} = 0 ({factor} went from {before:.3g} to {value:.3g}: "
+                    "the step jumped over it, so the run after it is not the motion")
+            if self.bounds[k]:
+                what += (f"; {factor} = 0 also bounds the real domain of the system's expressions (a logarithm or a "
+                         "root of it), so the run left the real domain there")
+            what += ")"
+        return (f"the motion{who} {what}, a pole of the equations of motion (a denominator of {origin}), between "
+                f"t = {self._last_time:.6g} and t = {t:.6g} (steps {self._last_step} to {step})")
+
+
+def _nodes(expr: Any) -> Any:
+    import sympy
+
+    return sympy.preorder_traversal(expr)
+
+
+def _may_have_poles(exprs: list[Any]) -> bool:
+    """Whether an expression or one of its derivatives can have a denominator: a power that is not a
+    nonnegative integer, or a function other than ``sin``, ``cos`` and ``exp`` (whose derivatives have none)."""
+    import sympy
+
+    plain = (sympy.sin, sympy.cos, sympy.exp)
+    for expr in exprs:
+        for node in _nodes(expr):
+            if isinstance(node, sympy.Pow) and not (node.exp.is_Integer and node.exp >= 0):
+                return True
+            if isinstance(node, sympy.Function) and not isinstance(node, plain):
+                return True
+    return False
+
+
+def _quotients(expr: Any) -> Any:
+    """``expr`` with ``tan``, ``cot``, ``sec``, ``csc`` (and ``tanh``, ``coth``) written as quotients of sines
+    and cosines: the same function, whose derivatives show the denominators."""
+    import sympy
+
+    return expr.replace(sympy.tan, lambda u: sympy.sin(u) / sympy.cos(u)).replace(
+        sympy.cot, lambda u: sympy.cos(u) / sympy.sin(u)).replace(
+        sympy.sec, lambda u: 1 / sympy.cos(u)).replace(
+        sympy.csc, lambda u: 1 / sympy.sin(u)).replace(
+        sympy.tanh, lambda u: sympy.sinh(u) / sympy.cosh(u)).replace(
+        sympy.coth, lambda u: sympy.cosh(u) / sympy.sinh(u))
+
+
+def _build(mechanics: Any) -> PoleGuard | None:
+    """The guard of ``mechanics`` (module docstring), or ``None`` when its equations of motion have no denominator
+    in the coordinates and the time that can vanish.
+
+    The sources, for ``L = q_dot^T M q_dot / 2 - V`` with constraints ``chi`` and forces ``Q``
+    (Goldstein, "Classical Mechanics", Sect. 1.4 and 2.4: ``d/dt (M q_dot) - dL/dq = Q + G^T lambda``,
+    ``G = dchi/dq``): ``dV/dq``; ``M`` and ``dM/dq``; ``chi``, ``G``, ``dchi/dt`` and their
+    derivatives (the hidden constraint and the multipliers); ``Q``; ``dV/dt``.
+    """
+    import sympy  # the mechanics were built with it: importing it costs nothing here
+
+    symbolic = mechanics.symbolic
+    q = list(symbolic.get("coordinates") or ())
+    if not q:
+        return None
+    time = mechanics.time_symbol
+    variables = [*q, *([time] if time is not None else [])]
+    velocities = set(symbolic.get("velocities") or ())
+    V = sympy.sympify(symbolic.get("potential") or 0)
+    M = [sympy.sympify(e) for e in (symbolic.get("mass") or [])]
+    chis = [sympy.sympify(e) for e in (symbolic.get("constraints") or [])]
+    forces = [sympy.sympify(e) for e in (symbolic.get("forces") or [])]
+    if not _may_have_poles([V, *M, *chis, *forces]):
+        return None  # polynomials in the coordinates, sines, cosines and exponentials: no denominator anywhere
+    # tan(u) = sin(u)/cos(u) and its kin: their derivatives (1 + tan(u)**2) hide the denominator
+    V, M, chis, forces = (_quotients(V), [_quotients(e) for e in M], [_quotients(e) for e in chis],
+                          [_quotients(e) for e in forces])
+
+    from dirac.analysis.core.divisors import denominator_factors
+
+    sources: list[tuple[str, list[Any]]] = [
+        ("the force -dV/dq", [sympy.diff(V, x) for x in q]),
+        ("the mass matrix or its derivatives", [*M, *(sympy.diff(e, x) for e in M for x in q)]),
+    ]
+    if chis:
+        gradients = [sympy.diff(c, x) for c in chis for x in variables]
+        sources.append(("the constraints' derivatives (the constraint forces)",
+                        [*chis, *gradients, *(sympy.diff(g, x) for g in gradients for x in variables)]))
+    if forces:
+        sources.append(("the applied forces", forces))
+    if time is not None:
+        sources.append(("the time derivative of the potential", [sympy.diff(V, time)]))
+    found: dict[Any, list[str]] = {}
+    for origin, exprs in sources:
+        for e in exprs:
+            for f in denominator_factors(sympy.sympify(e), variables):
+                if f.free_symbols & velocities:
+                    continue  # a factor in the velocities is not read (module docstring)
+                if origin not in found.setdefault(f, []):
+                    found[f].append(origin)
+    if not found:
+        return None
+    bounds = _domain_bounds([V, *M, *chis, *forces], variables)
+    from dirac.codegen.scalar_backend import scalar_function
+
+    factors = list(found)
+    params = list(symbolic.get("parameters") or ())
+    try:
+        compiled = scalar_function([*variables, *params], factors)
+    except Exception:  # an unusual function: no guard (the run is as before)  # noqa: BLE001
+        return None
+    guard = PoleGuard(compiled, [str(f) for f in factors], [" and of ".join(found[f]) for f in factors],
+                      time is not None, mechanics.params, [f in bounds for f in factors])
+    guard.expressions = factors
+    return guard
+
+
+def _domain_bounds(exprs: list[Any], variables: list[Any]) -> set[Any]:
+    """The factors of the arguments of ``log`` and of the bases of fractional powers in ``exprs``: where
+    the real domain of the expressions ends (``x`` of ``log(x)`` or ``sqrt(x)``)."""
+    import sympy
+
+    from dirac.analysis.core.divisors import denominator_factors
+
+    bounds: set[Any] = set()
+    for expr in exprs:
+        for node in _nodes(expr):
+            if isinstance(node, sympy.log):
+                inner = node.args[0]
+            elif isinstance(node, sympy.Pow) and node.exp.is_Rational and not node.exp.is_Integer:
+                inner = node.base
+            else:
+                continue
+            bounds.update(denominator_factors(1 / inner, variables))
+    return bounds
+
+
+def pole_guard(mechanics: Any) -> PoleGuard | None:
+    """A fresh :class:`PoleGuard` of a :class:`~dirac.flows.mechanics.MechanicalSystem` for one run, or ``None``.
+
+    The factors are found and compiled once per system (kept on it); each call gives a guard
+    with no reading yet.
+    """
+    missing = object()
+    cached = getattr(mechanics, "_pole_guard", missing)
+    if cached is missing:
+        cached = _build(mechanics)
+        try:
+            mechanics._pole_guard = cached
+        except AttributeError:  # a frozen system: build again next time
+            pass
+    if not isinstance(cached, PoleGuard):
+        return None
+    guard = PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
+                      cached.bounds)
+    guard.expressions = cached.expressions
+    return guard
+
+
+def message(system: str, crossing: PoleCrossing, method: str) -> str:
+    """The error text of a :class:`PoleCrossing` of the run of ``system`` with ``method``: what, where and the remedy."""
+    text = f"the run of {system!r} with method {method} stopped: {crossing}; "
+    if crossing.turn:
+        text += ("if the exact motion turns before the pole (a repelling pole, or a close pass such as a periapsis), "
+                 "a smaller dt resolves the turn; if it reaches the pole, ")
+    return text + REMEDY
+
