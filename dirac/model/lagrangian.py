@@ -30,7 +30,10 @@ from dirac.errors import InputError
 from dirac.model.expressions import ALLOWED_CONSTANTS, ALLOWED_FUNCTIONS, TIME, non_real_constant, parse_expression
 from dirac.model.from_sympy import plain_forces, plain_parts
 from dirac.model.lagranges_method import is_lagranges_method, lagranges_method_parts
+from dirac.model.permanent import freeze_imports
 from dirac.validate import did_you_mean, is_real_number, unknown_name_error, validate_finite
+
+freeze_imports()  # sympy's objects live as long as the process: out of the collector's way (dirac.model.permanent)
 
 __all__ = ["Lagrangian", "TIME", "velocity_name", "momentum_name", "multiplier_name", "latex_name", "latex_names"]
 
