@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ChartGuard", "chart_guard", "GUARD_STEPS", "WATCH_DISTANCE", "STOP_DISTANCE"]
+__all__ = ["ChartGuard", "chart_guard", "built_once", "GUARD_STEPS", "WATCH_DISTANCE", "STOP_DISTANCE"]
 
 #: steps between the first two readings of the guard
 GUARD_STEPS = 32
@@ -191,14 +191,21 @@ def _build(mechanics: Any) -> ChartGuard | None:
     return ChartGuard(compiled, text, time is not None, mechanics.params)
 
 
-def chart_guard(mechanics: Any) -> ChartGuard | None:
-    """The :class:`ChartGuard` of a :class:`~dirac.flows.mechanics.MechanicalSystem` (built once), or ``None``."""
+def built_once(mechanics: Any, attribute: str, build: Callable[[Any], Any]) -> Any:
+    """``build(mechanics)``, kept on the system as ``attribute`` so that later runs reuse it
+    (a guard of one system is built once: its factors are found and compiled then)."""
     missing = object()
-    cached = getattr(mechanics, "_chart_guard", missing)
+    cached = getattr(mechanics, attribute, missing)
     if cached is missing:
-        cached = _build(mechanics)
+        cached = build(mechanics)
         try:
-            mechanics._chart_guard = cached
+            setattr(mechanics, attribute, cached)
         except AttributeError:  # a frozen system: build again next time
             pass
+    return cached
+
+
+def chart_guard(mechanics: Any) -> ChartGuard | None:
+    """The :class:`ChartGuard` of a :class:`~dirac.flows.mechanics.MechanicalSystem` (built once), or ``None``."""
+    cached = built_once(mechanics, "_chart_guard", _build)
     return cached if isinstance(cached, ChartGuard) else None

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS
+from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS, built_once
 
 __all__ = ["PoleGuard", "pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH", "REMEDY"]
 
@@ -384,14 +384,7 @@ def pole_guard(mechanics: Any) -> PoleGuard | None:
     The factors are found and compiled once per system (kept on it); each call gives a guard
     with no reading yet.
     """
-    missing = object()
-    cached = getattr(mechanics, "_pole_guard", missing)
-    if cached is missing:
-        cached = _build(mechanics)
-        try:
-            mechanics._pole_guard = cached
-        except AttributeError:  # a frozen system: build again next time
-            pass
+    cached = built_once(mechanics, "_pole_guard", _build)
     if not isinstance(cached, PoleGuard):
         return None
     guard = PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
