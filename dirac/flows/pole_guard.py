@@ -29,7 +29,9 @@ to reach zero before the next that went back instead stops the run too: the step
 resolve the motion at the pole (a composition's stages jumped over it and back, or a step
 landed next to a repelling pole and was thrown back: ``V = c/x`` at ``dt = 0.01`` finished
 with 1000 times its energy). A factor that changes its sign and back between two readings
-farther apart is not seen (the readings' spacing makes that unlikely, not impossible). Factors that depend on the velocities (a force
+farther apart is not seen (the readings' spacing makes that unlikely, not impossible). A factor of a
+denominator is read only where the expression grows toward its zero set (:func:`_unbounded_at`):
+``sin(x)/x`` is bounded at ``x = 0`` and the motion passes there. Factors that depend on the velocities (a force
 ``-c x_dot/|x_dot|``) are not read. Systems whose expressions hold no denominator (and no
 function whose derivative has one: only sums, products, positive integer powers, ``sin``,
 ``cos`` and ``exp``) have no guard and run exactly as before, without a symbolic
@@ -333,21 +335,24 @@ def _build(mechanics: Any) -> PoleGuard | None:
         sources.append(("the applied forces", forces))
     if time is not None:
         sources.append(("the time derivative of the potential", [sympy.diff(V, time)]))
+    params = list(symbolic.get("parameters") or ())
+    values = dict(zip(params, (float(c) for c in mechanics.params)))
     found: dict[Any, list[str]] = {}
     for origin, exprs in sources:
         for e in exprs:
-            for f in denominator_factors(sympy.sympify(e), variables):
+            e = sympy.sympify(e)
+            for f in denominator_factors(e, variables):
                 if f.free_symbols & velocities:
                     continue  # a factor in the velocities is not read (module docstring)
-                if origin not in found.setdefault(f, []):
-                    found[f].append(origin)
+                if origin in found.get(f, []) or not _unbounded_at(e, f, variables, values):
+                    continue  # already found, or e stays bounded where f vanishes (sin(x)/x at x = 0)
+                found.setdefault(f, []).append(origin)
     if not found:
         return None
     bounds = _domain_bounds([V, *M, *chis, *forces], variables)
     from dirac.codegen.scalar_backend import scalar_function
 
     factors = list(found)
-    params = list(symbolic.get("parameters") or ())
     try:
         compiled = scalar_function([*variables, *params], factors)
     except Exception:  # an unusual function: no guard (the run is as before)  # noqa: BLE001
@@ -356,6 +361,72 @@ def _build(mechanics: Any) -> PoleGuard | None:
                       time is not None, mechanics.params, [f in bounds for f in factors])
     guard.expressions = factors
     return guard
+
+
+#: points of ``f = 0`` at which an expression's growth toward the zero set is measured
+REMOVABLE_SAMPLES = 3
+#: distances from ``f = 0`` (along the gradient of ``f``) at which the expression is evaluated
+REMOVABLE_DISTANCES = (1e-2, 1e-5)
+#: growth of ``|e|`` between those distances (relative to ``1 + |z|``) above which ``f = 0`` is a pole of ``e``
+#: (a simple pole grows 1000 x, ``1/sqrt(x)`` 32 x, a bounded expression about 1 x)
+POLE_GROWTH = 10.0
+
+
+def _unbounded_at(e: Any, f: Any, variables: list[Any], values: dict[Any, float]) -> bool:
+    """Whether ``e`` grows without bound toward ``f = 0``, a factor of one of its denominators.
+
+    A denominator need not make a pole: ``sin(x)/x`` and the force ``(x cos x - sin x)/x^2``
+    of ``V = -sin(x)/x`` stay bounded at ``x = 0`` (a removable singularity), and so does
+    ``(x^2 - x)/(x - 1)`` at ``x = 1`` (the factor cancels); the motion passes there. At up to
+    :data:`REMOVABLE_SAMPLES` points ``z`` of ``f = 0`` (found by Newton steps along ``grad f``
+    from seeded random points, the parameters at their values) ``e`` is evaluated at
+    ``z + d (1 + max |z|) n`` on both sides, ``n = grad f / |grad f|``, for the distances ``d``
+    of :data:`REMOVABLE_DISTANCES`: a pole of order ``k`` grows by ``1000^k`` between them, a
+    bounded expression by about 1. True when the growth exceeds :data:`POLE_GROWTH` (or ``e``
+    is not finite there) at some point, and also when no point of ``f = 0`` is found or the
+    evaluation fails: a factor not shown removable stays a pole.
+    """
+    import sympy
+
+    try:
+        at = {k: v for k, v in values.items() if k in e.free_symbols or k in f.free_symbols}
+        e_at, f_at = e.subs(at), f.subs(at)
+        e_fn = sympy.lambdify(variables, e_at, "math")
+        f_fn = sympy.lambdify(variables, f_at, "math")
+        grad_fn = sympy.lambdify(variables, [sympy.diff(f_at, x) for x in variables], "math")
+    except Exception:  # an expression lambdify cannot print: not shown removable  # noqa: BLE001
+        return True
+    rng = np.random.default_rng(20241129)
+    found_points = 0
+    for _ in range(4 * REMOVABLE_SAMPLES):
+        z = rng.normal(size=len(variables))
+        try:
+            for _ in range(60):  # Newton's method along the gradient onto f = 0
+                g = np.array(grad_fn(*z), dtype=float)
+                value = float(f_fn(*z))
+                norm2 = float(g @ g)
+                if not (math.isfinite(value) and norm2 > 0.0):
+                    break
+                if abs(value) <= 1e-13 * (1.0 + float(np.abs(z).max())):
+                    break
+                z = z - value * g / norm2
+            g = np.array(grad_fn(*z), dtype=float)
+            if not abs(float(f_fn(*z))) <= 1e-12 * (1.0 + float(np.abs(z).max())) or not float(g @ g) > 0.0:
+                continue
+            n = g / math.sqrt(float(g @ g))
+            scale = 1.0 + float(np.abs(z).max())
+            near, far = (max(abs(float(e_fn(*(z + side * d * scale * n)))) for side in (1.0, -1.0))
+                         for d in (REMOVABLE_DISTANCES[1], REMOVABLE_DISTANCES[0]))
+        except (ArithmeticError, ValueError, TypeError):
+            continue
+        if not (math.isfinite(near) and math.isfinite(far)):
+            return True
+        found_points += 1
+        if near > POLE_GROWTH * max(far, 1e-300):
+            return True
+        if found_points >= REMOVABLE_SAMPLES:
+            return False
+    return found_points == 0
 
 
 def _domain_bounds(exprs: list[Any], variables: list[Any]) -> set[Any]:

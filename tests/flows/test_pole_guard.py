@@ -213,3 +213,33 @@ def test_a_repelling_pole_a_step_does_not_resolve_is_named_with_the_smaller_step
     solution = _repelled(1e-3)
     assert solution.complete
     assert np.max(np.abs(solution.outputs["energy"] - (0.5 + 1e-3))) < 1e-2
+
+
+def test_a_removable_singularity_is_no_pole_and_the_motion_passes_it():
+    """``V = -sin(x)/x``: its force ``(x cos x - sin x)/x^2`` has the denominator ``x`` but stays bounded at
+    ``x = 0`` (``-x/3 + O(x^3)``), so the motion oscillates through it. From ``x = 1`` at rest the energy is
+    ``E = -sin(1)`` and, by symmetry of ``V``, the motion reaches ``x = -1`` at half its period,
+    ``T/2 = 2 integral_0^1 dx / sqrt(2 (sin(x)/x - sin(1)))`` (quadrature here). ``V = (x^2 - x)/(x - 1)``
+    is ``x``: the factor cancels, and ``x = 2 - t - t^2/2`` from ``x = 2`` at speed ``-1`` passes ``x = 1``."""
+    from scipy.integrate import quad
+
+    sinc = dirac.Lagrangian.from_strings("sinc_well", ["x"], "x_dot**2/2 + sin(x)/x", [], parameters={})
+    problem = ConstrainedProblem(sinc, q0=[1.0], qdot0=[0.0])
+    assert pole_guard(problem.mechanics) is None
+    half = 2 * quad(lambda x: 1 / math.sqrt(2 * (math.sin(x) / x - math.sin(1.0))), 0.0, 1.0, limit=200)[0]
+    run = integrate(problem, "rattle-4", t_end=half, dt=half / 2000, samples=2)
+    assert run["q"][-1, 0] == pytest.approx(-1.0, abs=1e-6)
+    cancelled = dirac.Lagrangian.from_strings("cancelled", ["x"], "x_dot**2/2 - (x**2 - x)/(x - 1)", [], parameters={})
+    problem = ConstrainedProblem(cancelled, q0=[2.0], qdot0=[-1.0])
+    assert pole_guard(problem.mechanics) is None
+    run = integrate(problem, "rattle-2", t_end=3.0, dt=0.01, samples=4)
+    assert np.allclose(run["q"][:, 0], [2.0 - t - t * t / 2 for t in (0.0, 1.0, 2.0, 3.0)], atol=1e-9)
+
+
+def test_a_pole_under_a_root_is_still_a_pole():
+    """``V = -(x**2)**(1/4) = -sqrt(|x|)`` gives a force that grows like ``|x|^(-1/2)`` at ``x = 0``: a pole
+    (the growth between the distances read is ``1000^(1/2) = 32``, above the threshold 10), kept as the
+    factor ``Abs(x)`` (sympy writes the root of ``x**2`` with it)."""
+    root = dirac.Lagrangian.from_strings("quarter", ["x"], "x_dot**2/2 + (x**2)**(1/4)", [], parameters={})
+    guard = pole_guard(ConstrainedProblem(root, q0=[1.0], qdot0=[0.0]).mechanics)
+    assert guard is not None and guard.factors == ["Abs(x)"]
