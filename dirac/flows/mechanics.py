@@ -44,7 +44,17 @@ DIRAC_FLOW_ROAD = 'use method = "midpoint" on the Dirac flow instead'
 class NotMechanicalError(InputError):
     """The Lagrangian is not ``1/2 q_dot^T M(q) q_dot - V(q)`` (terms linear in the
     velocities, a kinetic energy that is not quadratic): RATTLE cannot take it, the Dirac
-    flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may."""
+    flow of its analysis (:class:`dirac.flows.analysed.AnalysedSystem`) may.
+
+    ``reason`` says what the Lagrangian is; ``road`` the way out when the Dirac flow takes it
+    (:data:`DIRAC_FLOW_ROAD`, empty otherwise). The message is ``reason; road``: a caller with
+    another way out (Python, a scene) puts its own after ``reason``.
+    """
+
+    def __init__(self, reason: str, road: str = "") -> None:
+        super().__init__(f"{reason}; {road}" if road else reason)
+        self.reason = reason
+        self.road = road
 
 
 def _conformal_rate(forces: Sequence[sympy.Expr], velocities: Sequence[sympy.Symbol], mass: sympy.Matrix,
@@ -275,7 +285,7 @@ class MechanicalSystem:
             raise NotMechanicalError(
                 f"the Lagrangian of {lagrangian.name!r} has terms linear in the velocities "
                 f"({', '.join(offending)}, e.g. magnetic or gyroscopic terms): RATTLE needs "
-                f"L = 1/2 q_dot^T M(q) q_dot - V(q); {DIRAC_FLOW_ROAD}"
+                "L = 1/2 q_dot^T M(q) q_dot - V(q)", road=DIRAC_FLOW_ROAD,
             )
         potential = sympy.expand(-potential_terms)
         mass = sympy.Matrix(hessian)

@@ -36,6 +36,14 @@ if TYPE_CHECKING:
 __all__ = ["RigidBodyProblem", "HeavyTopProblem", "ConstrainedProblem", "ForcedProblem", "Impulse", "Problem",
            "OffSurfaceError"]
 
+#: the way out a Python user is shown for a Lagrangian with terms linear in the velocities
+PYTHON_DIRAC_FLOW_ROAD = (
+    "run the Dirac flow of its analysis instead: from dirac.flows.analysed import AnalysedProblem, "
+    "AnalysedSystem; system = AnalysedSystem.from_lagrangian(lagrangian); "
+    "dirac.integrate(AnalysedProblem(system, system.initial_state({'x': ...}, q_dot={'x': ...})), "
+    "\"midpoint\", ...) (or a scipy method; a scene takes this road by itself)"
+)
+
 
 class OffSurfaceError(InputError):
     """Initial data of a :class:`ConstrainedProblem` off the constraint surface.
@@ -287,22 +295,17 @@ class ConstrainedProblem:
 
         mechanics = self.mechanics
         if isinstance(mechanics, Lagrangian):
-            from dirac.flows.mechanics import DIRAC_FLOW_ROAD, MechanicalSystem, NotMechanicalError
+            from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
 
             try:
                 mechanics = MechanicalSystem.from_lagrangian(mechanics, with_forces=self.kind == "forced")
             except NotMechanicalError as exc:
-                if DIRAC_FLOW_ROAD not in str(exc):
+                if not exc.road:
                     raise
                 if self.kind == "forced":
-                    raise NotMechanicalError(str(exc).replace(
-                        DIRAC_FLOW_ROAD, "forces and impulses are integrated for that form only")) from None
-                raise NotMechanicalError(str(exc).replace(DIRAC_FLOW_ROAD, (
-                    "run the Dirac flow of its analysis instead: from dirac.flows.analysed import AnalysedProblem, "
-                    "AnalysedSystem; system = AnalysedSystem.from_lagrangian(lagrangian); "
-                    "dirac.integrate(AnalysedProblem(system, system.initial_state({'x': ...}, q_dot={'x': ...})), "
-                    "\"midpoint\", ...) (or a scipy method; a scene takes this road by itself)"
-                ))) from None
+                    raise NotMechanicalError(
+                        f"{exc.reason}; forces and impulses are integrated for that form only") from None
+                raise NotMechanicalError(exc.reason, road=PYTHON_DIRAC_FLOW_ROAD) from None
         if self.kind == "forced" and not getattr(mechanics, "forced", False):
             raise InputError(
                 f"a ForcedProblem needs the forced kernels of {mechanics.name!r}: give the Lagrangian, or "

@@ -418,7 +418,7 @@ def _impulse_tables(tables: object, source: str) -> list[tuple[float, dict[str, 
 
 def _general_problem(system: dict, initial: dict, source: str, base: Path,
                      impulses: list | None = None) -> ConstrainedProblem | AnalysedProblem:
-    from dirac.flows.mechanics import DIRAC_FLOW_ROAD, MechanicalSystem, NotMechanicalError
+    from dirac.flows.mechanics import MechanicalSystem, NotMechanicalError
     from dirac.flows.problems import ConstrainedProblem, ForcedProblem, OffSurfaceError
     from dirac.model.system_file import lagrangian_from_table
     from dirac.model.systems import load_system
@@ -462,7 +462,7 @@ def _general_problem(system: dict, initial: dict, source: str, base: Path,
         if forced:
             raise InputError(
                 f"{source}: forces and impulses are integrated for L = 1/2 q_dot^T M(q) q_dot - V(q) only; "
-                f"{exc}".replace(f"; {DIRAC_FLOW_ROAD}", "")
+                f"{exc.reason}"
             ) from None
         return _analysed_problem(lagrangian, overrides, initial, source)
     names = mechanics.coordinate_names
