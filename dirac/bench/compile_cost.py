@@ -26,19 +26,21 @@ The systems are those of ``dirac_systems.latency_models`` and N-link pendulums i
 angles (``n_link_pendulum_N``: unit masses and rods, ``M_ij = (N - max(i, j)) cos(q_i - q_j)``),
 the configuration-dependent masses up to six degrees of freedom.
 
-The module imports only the standard library: the children import ``dirac`` and numba (and only what an
+The module imports only the standard library and the latency bench's environment of a cold child
+(:func:`dirac.bench.latency.cold_environment`): the children import ``dirac`` and numba (and only what an
 older checkout of the engine has too, so that ``pythonpath`` can time one side by side).
 """
 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 import tempfile
 from collections.abc import Sequence
 from typing import Any
+
+from dirac.bench.latency import cold_environment
 
 __all__ = ["measure_compile_cost", "format_compile_cost", "n_link_pendulum_text", "DEFAULT_SYSTEMS"]
 
@@ -131,11 +133,7 @@ json.dump({"system": name, "n": n, "kernel": kernel, "chars": kernel_chars(sourc
 
 def _child(system: str, pythonpath: str | None = None) -> dict[str, Any]:
     with tempfile.TemporaryDirectory(prefix="dirac-compile-cost-") as scratch:
-        environment = dict(os.environ, DIRAC_CACHE_DIR=os.path.join(scratch, "dirac"),
-                           NUMBA_CACHE_DIR=os.path.join(scratch, "numba"))
-        environment.pop("DIRAC_KERNELS", None)  # the default policy: building the system compiles nothing
-        if pythonpath:
-            environment["PYTHONPATH"] = pythonpath + os.pathsep + environment.get("PYTHONPATH", "")
+        environment = cold_environment(scratch, pythonpath)  # the default policy: building the system compiles nothing
         given = [json.dumps(n_link_pendulum_text(int(system.rsplit("_", 1)[1])))] \
             if system.startswith("n_link_pendulum_") else []
         done = subprocess.run([sys.executable, "-c", _CHILD, system, *given], capture_output=True, text=True,

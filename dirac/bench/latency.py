@@ -47,7 +47,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-__all__ = ["LatencyRow", "run_latency", "format_latency", "BreakdownRow", "run_breakdown", "format_breakdown", "CORPUS", "ANALYZE_TARGETS", "FIRST_TARGET", "STUDY_TARGET"]
+__all__ = ["LatencyRow", "cold_environment", "run_latency", "format_latency", "BreakdownRow", "run_breakdown", "format_breakdown", "CORPUS", "ANALYZE_TARGETS", "FIRST_TARGET", "STUDY_TARGET"]
 
 #: the corpus (names of ``dirac_systems.latency_models.MODELS``)
 CORPUS = ("pendulum_angle", "double_pendulum_angles", "triple_pendulum_angles", "pendulum_cartesian",
@@ -250,13 +250,21 @@ class LatencyRow:
     angles: list[list[float]] | None = field(default=None, repr=False)
 
 
+def cold_environment(scratch: str, pythonpath: str | None = None) -> dict[str, str]:
+    """The environment of a fresh child as a new user meets it: empty caches of generated code
+    (``DIRAC_CACHE_DIR``) and of numba (``NUMBA_CACHE_DIR``) in ``scratch``, the default kernel
+    policy (no ``DIRAC_KERNELS``), and ``pythonpath`` (a checkout to time) in front."""
+    env = dict(os.environ, DIRAC_CACHE_DIR=os.path.join(scratch, "dirac"), NUMBA_CACHE_DIR=os.path.join(scratch, "numba"))
+    env.pop("DIRAC_KERNELS", None)
+    if pythonpath:
+        env["PYTHONPATH"] = pythonpath + os.pathsep + env.get("PYTHONPATH", "")
+    return env
+
+
 def _child(arguments: list[str], pythonpath: str | None, timeout: float) -> tuple[float, float, str, str, int, list]:
     """Run ``python arguments`` fresh with an empty cache: (wall, cpu, stdout, stderr, exit code, compilations)."""
     with tempfile.TemporaryDirectory(prefix="dirac-latency-") as scratch:
-        env = dict(os.environ, DIRAC_CACHE_DIR=os.path.join(scratch, "dirac"), NUMBA_CACHE_DIR=os.path.join(scratch, "numba"))
-        env.pop("DIRAC_KERNELS", None)  # the default policy, as a user meets it
-        if pythonpath:
-            env["PYTHONPATH"] = pythonpath + os.pathsep + env.get("PYTHONPATH", "")
+        env = cold_environment(scratch, pythonpath)
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         try:
