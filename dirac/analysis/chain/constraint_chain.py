@@ -67,7 +67,7 @@ from dirac.analysis.core.numeric import (
     numeric_rank,
 )
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.core.rank_loci import BracketBlocks, EntryBlock
+from dirac.analysis.core.rank_loci import BracketBlocks, DivisorLocus, EntryBlock
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM
 from dirac.analysis.legendre.regularity import (
     IRREGULAR_GRADIENT,
@@ -289,10 +289,11 @@ class ConstraintChain:
         #: the sizes of the terms of derivatives (:func:`~dirac.analysis.core.rank_loci.magnitude`), shared by the stages
         self._magnitudes: dict[sympy.Expr, sympy.Expr] = {}
         self._hessian: EntryBlock | None = None
-        self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock]] = {}
+        self._minors_of: dict[tuple[tuple[sympy.Expr, ...], bool], list[BracketBlocks | EntryBlock | DivisorLocus]] = {}
         self._row_support: dict = {}  # constraint -> the k with a non-zero {Phi, phi_k}
         self._varying: dict[int, bool] = {}  # row -> whether its coefficients in the pivot rows vary between points
         self._legendre_divisors: list[sympy.Expr] | None = None  # the factors of the denominator of H_c (found on first use)
+        self._divisor_locus: DivisorLocus | None = None  # their zero sets, kept away from by the sample points
         #: divisor -> whether it is a branch (None: it does not vanish on the surface), decided once per chain
         self._judged: dict[tuple[sympy.Expr, int], bool | None] = {}
         primary = [tidy(p, self.phase_space.variables, sign=True, rational=prints_shorter(p, 4000)) for p in self.primary]
@@ -435,9 +436,7 @@ class ConstraintChain:
         """
         if not points:
             return
-        if self._legendre_divisors is None:
-            self._legendre_divisors = [d.divisor for d in divisions_of([self.canonical_hamiltonian], 1, "", self.phase_space.variables)]
-        if not self._legendre_divisors:
+        if not self._divisors_of_hamiltonian():
             return
         scales = self.numerics.term_scale(self._legendre_divisors, points)  # first: the values below come with the sizes
         values = np.abs(self.numerics.evaluate(self._legendre_divisors, points))
@@ -451,12 +450,18 @@ class ConstraintChain:
                     f"aside with --assume \"{f} != 0\" (in Python assume=[\"{f} != 0\"]) or analyse it as a system of its own"
                 )
 
+    def _divisors_of_hamiltonian(self) -> list[sympy.Expr]:
+        """The factors of the denominators of ``H_c`` (found on first use)."""
+        if self._legendre_divisors is None:
+            self._legendre_divisors = [d.divisor for d in divisions_of([self.canonical_hamiltonian], 1, "", self.phase_space.variables)]
+        return self._legendre_divisors
+
     def _near_locus(self, points: list[np.ndarray]) -> bool:
         """Whether a point of the last stage lies next to a locus where ``C_ab = {Phi_a, Phi_b}`` drops rank."""
         minors = self._minors(self.constraints, whole=True)
         return any(self.numerics.near_rank_drop(minors, z) is not None for z in points)
 
-    def _minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks | EntryBlock]:
+    def _minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks | EntryBlock | DivisorLocus]:
         """The blocks whose ranks are read at the points of ``constraints``' surface (see :meth:`_stage_points`).
 
         ``{Phi_a, phi_k}``, with ``whole`` also ``C_ab`` over all the constraints, and the
@@ -471,18 +476,24 @@ class ConstraintChain:
             self._minors_of[key] = self._new_minors(constraints, whole)
         return self._minors_of[key]
 
-    def _new_minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks | EntryBlock]:
+    def _new_minors(self, constraints: list[sympy.Expr], whole: bool) -> list[BracketBlocks | EntryBlock | DivisorLocus]:
         """The blocks of :meth:`_minors`, built."""
         hessian = self._hessian_block()
+        divisors = self._divisors_of_hamiltonian()
+        tests: list[BracketBlocks | EntryBlock | DivisorLocus] = [hessian] if hessian is not None else []
+        if divisors:  # points on a pole of H_c are set aside too (their ranks are meaningless)
+            if self._divisor_locus is None:
+                self._divisor_locus = DivisorLocus(self.numerics, divisors)
+            tests.append(self._divisor_locus)
         if not self.primary:
-            return [hessian] if hessian is not None else []
+            return tests
         rows = list(constraints) + [p for p in self.primary if p not in set(constraints)]
         position = {c: a for a, c in enumerate(rows)}
         own = list(range(len(constraints)))
         blocks = {"{Phi_a, phi_k}": (own, [position[p] for p in self.primary])}
         if whole:
             blocks["C_ab = {Phi_a, Phi_b}"] = (own, own)
-        return [BracketBlocks(self.numerics, rows, blocks, self._magnitudes)] + ([hessian] if hessian is not None else [])
+        return [BracketBlocks(self.numerics, rows, blocks, self._magnitudes), *tests]
 
     def _hessian_block(self) -> EntryBlock | None:
         """The Hessian as a block whose rank is read (compiled once), when it has rank > 0 and no velocities in it."""

@@ -22,7 +22,7 @@ import sympy
 
 from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics
 
-__all__ = ["SINGULAR_MINOR", "BracketBlocks", "EntryBlock", "magnitude", "near_rank_drop"]
+__all__ = ["SINGULAR_MINOR", "BracketBlocks", "DivisorLocus", "EntryBlock", "magnitude", "near_rank_drop"]
 
 #: a singular value of a matrix whose rank the analysis uses (``W``, ``{Phi_a, Phi_b}``,
 #: ``{Phi_a, phi_k}``), relative to the size of the terms its entries are computed from,
@@ -199,3 +199,40 @@ class EntryBlock:
         ``ZERO_TOLERANCE`` of the equilibrated matrix do not count (see :func:`near_rank_drop`).
         """
         return int(np.sum(_equilibrated_singular_values(*self.at(z)) > ZERO_TOLERANCE))
+
+
+class DivisorLocus:
+    """The zero sets of denominators of ``H_c``, tested at points like a block whose rank drops.
+
+    Where the Legendre map solves the velocities from a block of ``W``, the block's
+    determinant divides the canonical Hamiltonian; where it vanishes, ``H_c`` and every
+    consistency condition have a pole, and ranks read there are meaningless. Gauss–Newton
+    projections are drawn there too: onto the primary surface of the rigid body in its
+    matrix coordinates (``R p_R^T`` symmetric), three of four projections landed within
+    ``1e-11`` of ``det R = 0`` (one exactly on it). A point where ``|d| / magnitude(d)`` is
+    below :data:`SINGULAR_MINOR` (or not finite) is reported like a point next to a rank
+    drop, and :meth:`dirac.analysis.core.numeric.Numerics.surface_points` sets it aside.
+
+    Parameters
+    ----------
+    numerics
+        Where the divisors and their :func:`magnitude` are compiled.
+    divisors
+        The factors of the denominators of ``H_c``.
+    """
+
+    def __init__(self, numerics: Numerics, divisors: Sequence[sympy.Expr]) -> None:
+        self.divisors = list(divisors)
+        memo: dict[sympy.Expr, sympy.Expr] = {}
+        self._values = numerics.function(self.divisors)
+        self._sizes = numerics.function([magnitude(d, memo) for d in self.divisors])
+
+    def near_rank_drop(self, z: np.ndarray) -> tuple[float, str] | None:
+        """The smallest ``|d| / magnitude(d)`` at ``z`` when it is below :data:`SINGULAR_MINOR`, with the divisor's name."""
+        with np.errstate(all="ignore"):
+            ratios = np.abs(self._values(z)) / self._sizes(z)
+        ratios = np.where(np.isfinite(ratios), ratios, 0.0)
+        k = int(np.argmin(ratios))
+        if ratios[k] >= SINGULAR_MINOR:
+            return None
+        return float(ratios[k]), f"the block of W the velocities are solved from (its determinant {self.divisors[k]} divides H_c)"

@@ -108,3 +108,35 @@ def test_a_hessian_whose_rank_drops_on_the_constraint_surface_is_refused():
     assert dirac.analyze(lagrangian.__class__.from_strings(
         "kept", ["q1", "q2", "q3"], "-q1_dot*q2_dot - q2*q1_dot*q3_dot - q2_dot*q3_dot", constraints=["q1"]
     )).hessian_rank == 3
+
+
+def test_stage_points_keep_off_the_poles_of_the_canonical_hamiltonian(monkeypatch):
+    """The paper's (228), the rigid body in its matrix coordinates: ``H_c`` divides by ``det R``.
+
+    On the primary surface (``p_lambda = 0``, ``R p_R^T`` symmetric) Gauss–Newton projections
+    were drawn to ``det R = 0``: three of four stage-1 points within ``1e-11`` of it, one with
+    ``det R = 0.0`` exactly, where the consistency matrix is not finite and the analysis was
+    refused ("a rank was needed where the expressions are not finite"); on another machine the
+    same points sat at ``det R ~ 1e-12``, and ranks were read at a pole. Every point the chain
+    reads is now at least ``SINGULAR_MINOR`` away, relative to the size of the six products of
+    ``det R`` (by hand: the cofactor expansion).
+    """
+    from dirac.analysis.chain.constraint_chain import ConstraintChain
+
+    read: list[np.ndarray] = []
+    original = ConstraintChain._stage_points
+
+    def recording(self, *args, **kwargs):
+        points = original(self, *args, **kwargs)
+        read.extend(points)
+        return points
+
+    monkeypatch.setattr(ConstraintChain, "_stage_points", recording)
+    analysis = dirac.analyze(dirac.load_system("rigid_body_momentum"))
+    assert (len(analysis.second_class), analysis.physical_degrees_of_freedom) == (24, 3)
+    assert len(read) >= 8
+    for z in read:
+        r = np.asarray(z[:9]).reshape(3, 3)
+        products = [r[0, i] * r[1, j] * r[2, k] for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1), (0, 2, 1), (1, 0, 2), (2, 1, 0))]
+        det = products[0] + products[1] + products[2] - products[3] - products[4] - products[5]
+        assert abs(det) >= SINGULAR_MINOR * sum(abs(p) for p in products), r
