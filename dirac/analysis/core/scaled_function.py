@@ -42,12 +42,34 @@ def _literal(value: float) -> str:
     return repr(value) if math.isfinite(value) else f"float({repr(value)!r})"
 
 
-def _nan_on_error(fn: ScaledFunction, n: int) -> ScaledFunction:
+def _nan_on_error(fn: ScaledFunction, arguments: Sequence[sympy.Symbol], expressions: list[sympy.Expr]) -> ScaledFunction:
+    """``fn``, where a point outside the domain of some expressions gives NaN for those only.
+
+    The expressions of a batch share one straight-line body, which stops at the first
+    division by zero or math domain error of any of them: at a point on a pole of one
+    expression, a polynomial of the same batch would read NaN too, and a rank or a zero test
+    taken of it would be refused or wrong ((228)'s consistency matrix on ``det R = 0``, where
+    its polynomial rows are defined). After such an error each expression is evaluated by a
+    function of its own (compiled on the first error), so NaN marks exactly the undefined ones.
+    """
+    n = len(expressions)
+    alone: list[ScaledFunction] = []
+
+    def one_by_one(flag: int, *args: float) -> Any:
+        if n == 1:
+            return ([math.nan], [math.nan]) if flag == BOTH else [math.nan]
+        if not alone:
+            alone.extend(scaled_function(arguments, [e]) for e in expressions)
+        parts = [f(BOTH, *args) for f in alone]
+        values = [v[0] for v, _ in parts]
+        sizes = [z[0] for _, z in parts]
+        return (values, sizes) if flag == BOTH else (sizes if flag else values)
+
     def wrapped(flag: int, *args: float) -> Any:
         try:
             return fn(flag, *args)
         except (ValueError, ZeroDivisionError, OverflowError):
-            return ([math.nan] * n, [math.nan] * n) if flag == BOTH else [math.nan] * n
+            return one_by_one(flag, *args)
 
     return wrapped
 
@@ -70,8 +92,9 @@ def scaled_function(arguments: Sequence[sympy.Symbol], expressions: Sequence[sym
         terms ``t_i`` (:func:`terms_of`) added in their order, a term that is a number as
         ``|float(t)|``, of a complex value its real part;
         ``f(BOTH, a_0, a_1, ...)``: ``(values, sizes)``, the same numbers as the two calls
-        above, from one pass through the body. Every value is NaN when the point
-        is outside the domain (a math domain error, a division by zero, an overflow).
+        above, from one pass through the body. A value (and its size) is NaN where
+        the point is outside its expression's domain (a math domain error, a division by
+        zero, an overflow); the other expressions keep their values (:func:`_nan_on_error`).
 
     Raises
     ------
@@ -100,4 +123,4 @@ def scaled_function(arguments: Sequence[sympy.Symbol], expressions: Sequence[sym
     )
     namespace: dict[str, Any] = {"math": math}
     exec(compile(source, "<dirac codegen>", "exec"), namespace)
-    return _nan_on_error(namespace["_f"], len(expressions))
+    return _nan_on_error(namespace["_f"], arguments, expressions)

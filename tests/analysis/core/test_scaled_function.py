@@ -45,6 +45,21 @@ def test_domain_error_gives_nan() -> None:
     assert all(math.isnan(v) for v in fn(True, -1.0))
 
 
+def test_a_pole_of_one_expression_leaves_the_others_of_its_batch_defined() -> None:
+    """A batch of x*y + 1, 1/(x - y) and y**2 at x = y = 2: the second divides by zero, the others
+    are 5 and 4 with sizes 1 + 4 + 1 = 6 and 1 + 4 = 5 (by hand). The shared body stops at the
+    division; the values of the others must not be lost with it (a consistency matrix of the
+    rigid body in matrix coordinates read NaN in polynomial rows on det R = 0)."""
+    fn = scaled_function([x, y], [x * y + 1, 1 / (x - y), y**2])
+    values = fn(False, 2.0, 2.0)
+    assert values[0] == 5.0 and math.isnan(values[1]) and values[2] == 4.0
+    sizes = fn(True, 2.0, 2.0)
+    assert sizes[0] == 6.0 and math.isnan(sizes[1]) and sizes[2] == 5.0
+    both = fn(2, 2.0, 2.0)
+    assert both[0][0] == 5.0 and both[1][2] == 5.0 and math.isnan(both[0][1])
+    assert fn(False, 3.0, 2.0) == [7.0, 1.0, 4.0]  # off the pole: the shared body, as before
+
+
 def test_term_scale_of_numerics_by_hand() -> None:
     """Numerics.term_scale of a*x + y - 2 (parameter a = 3) at x = 1, y = -4: 1 + 3 + 4 + 2 = 10."""
     space = PhaseSpace((x,), (y,), (a,))
