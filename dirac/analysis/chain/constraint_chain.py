@@ -436,11 +436,12 @@ class ConstraintChain:
         """
         if not points:
             return
-        if not self._divisors_of_hamiltonian():
+        divisors = self._divisors_of_hamiltonian()
+        if not divisors:
             return
-        scales = self.numerics.term_scale(self._legendre_divisors, points)  # first: the values below come with the sizes
-        values = np.abs(self.numerics.evaluate(self._legendre_divisors, points))
-        for k, f in enumerate(self._legendre_divisors):
+        scales = self.numerics.term_scale(divisors, points)  # first: the values below come with the sizes
+        values = np.abs(self.numerics.evaluate(divisors, points))
+        for k, f in enumerate(divisors):
             hit = values[:, k] <= ROUND_OFF * scales[:, k]  # NaN (undefined) is left to the rank checks
             if np.any(hit):
                 raise AnalysisError(
