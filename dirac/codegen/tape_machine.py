@@ -18,7 +18,12 @@ giving a non-finite value of finite arguments), the arguments are restored and
 :class:`TapeError` is raised, so the caller can run the call on another tier, which then
 behaves as it always does.
 
-numba is imported when the machine is first needed (not at the import of this module).
+The loop exists twice, as the same instructions: compiled ahead of time, at the package's
+install, as the C extension :mod:`dirac.codegen._tape` (``setup.py``; a first run costs no
+compilation and no import of numba), and as :func:`_execute` here, which numba compiles on
+first use where that extension was not built (no C compiler at the install) or where
+``DIRAC_TAPE_MACHINE=numba`` asks for it; numba is imported only then (not at the import of
+this module). Both give the interpreter's numbers, bit for bit.
 """
 
 from __future__ import annotations
@@ -32,7 +37,8 @@ import numpy as np
 
 from dirac.codegen.tape_source import Tape
 
-__all__ = ["TapeFunction", "TapeError", "machine", "machine_loaded", "machine_ready", "machine_source", "machine_compile_seconds", "ERRORS"]
+__all__ = ["TapeFunction", "TapeError", "machine", "machine_kind", "machine_loaded", "machine_ready", "machine_source",
+           "machine_compile_seconds", "ahead_of_time", "ERRORS", "MACHINE_VARIABLE"]
 
 #: error codes of the machine
 ERRORS = {1: "division by zero", 2: "index out of range (or negative)", 3: "math domain or range error",
@@ -41,6 +47,9 @@ ERRORS = {1: "division by zero", 2: "index out of range (or negative)", 3: "math
 _MACHINE: Any = None
 _SOURCE: str | None = None
 _COMPILE_SECONDS: float | None = None
+#: the environment variable that chooses the machine: ``numba`` for the numba-compiled loop
+#: (else the one compiled at the install, when it was built)
+MACHINE_VARIABLE = "DIRAC_TAPE_MACHINE"
 
 
 class TapeError(Exception):
@@ -164,15 +173,36 @@ def machine_source() -> str:
     return _SOURCE
 
 
+def ahead_of_time() -> Any:
+    """The machine compiled at the install (:mod:`dirac.codegen._tape`'s ``run_tape``), or None
+    where it was not built or ``DIRAC_TAPE_MACHINE=numba`` asks for numba's."""
+    import os
+
+    if os.environ.get(MACHINE_VARIABLE, "").strip().lower() == "numba":
+        return None
+    try:
+        from dirac.codegen import _tape
+    except ImportError:
+        return None
+    return _tape.run_tape
+
+
+def machine_kind() -> str:
+    """``"ahead-of-time"`` (the C extension) or ``"numba"``: which loop :func:`machine` gives."""
+    return "ahead-of-time" if ahead_of_time() is not None else "numba"
+
+
 def machine_loaded() -> bool:
-    """Whether the machine is compiled or loaded in this process."""
-    return _MACHINE is not None
+    """Whether the machine is compiled or loaded in this process (the one compiled at the
+    install is, as soon as it can be imported: that costs no compilation)."""
+    return _MACHINE is not None or ahead_of_time() is not None
 
 
 def machine_ready() -> bool:
-    """Whether the machine costs no compilation: loaded in this process, or its marker in the
-    cache says numba's on-disk cache holds it (read without importing numba)."""
-    if _MACHINE is not None:
+    """Whether the machine costs no compilation: compiled at the install, loaded in this
+    process, or its marker in the cache says numba's on-disk cache holds it (read without
+    importing numba)."""
+    if _MACHINE is not None or ahead_of_time() is not None:
         return True
     from dirac.codegen.numba_backend import ready_marker, source_path
 
@@ -186,6 +216,11 @@ def machine(why: str = "a run on the tape machine", announce: Callable[[str, str
     global _MACHINE, _COMPILE_SECONDS
     if _MACHINE is None:
         start = time.process_time()
+        compiled = ahead_of_time()
+        if compiled is not None:
+            _COMPILE_SECONDS = time.process_time() - start
+            _MACHINE = compiled
+            return _MACHINE
         import numba
 
         from dirac.codegen.background import mark_ready

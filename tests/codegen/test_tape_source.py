@@ -12,8 +12,22 @@ import math
 import numpy as np
 import pytest
 
+from dirac.codegen import tape_machine
 from dirac.codegen.tape_machine import TapeError, TapeFunction, _execute
 from dirac.codegen.tape_source import OPS, translate
+
+
+@pytest.fixture(autouse=True, params=["ahead-of-time", "numba"])
+def machine_kind(request, monkeypatch) -> str:
+    """Every test runs on both loops of the machine: the one compiled at the install (the C
+    extension) and the one numba compiles (where that extension was not built)."""
+    monkeypatch.setattr(tape_machine, "_MACHINE", None)
+    if request.param == "numba":
+        monkeypatch.setenv(tape_machine.MACHINE_VARIABLE, "numba")
+    else:
+        monkeypatch.delenv(tape_machine.MACHINE_VARIABLE, raising=False)
+    assert tape_machine.machine_kind() == request.param
+    return request.param
 
 _PROGRAM = '''
 def kernel(x, out, a, b, n_steps):
@@ -231,3 +245,68 @@ def test_arrays_sharing_memory_are_not_taken() -> None:
     base = np.zeros(3)
     assert not function.accepts((base[:2], base[1:]))
     assert function.accepts((np.zeros(2), np.zeros(2)))
+
+
+def test_the_machine_compiled_at_the_install_is_there(machine_kind: str) -> None:
+    """The package's install builds the C loop (setup.py): a first run needs neither numba's
+    import nor a compilation of the machine. Where it is missing, numba's loop stands in."""
+    if machine_kind == "ahead-of-time":
+        assert tape_machine.ahead_of_time() is not None and tape_machine.machine_ready()
+        assert tape_machine.machine() is tape_machine.ahead_of_time()
+
+
+_UNARY_VALUES = (0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 0.9999999999999999, 1.5, 2.0, 3.141592653589793, 1e-300, -1e-300,
+                 5e-324, 1e15, -7.25, 20.0, 709.7, 710.0, -745.2, 1e308, math.inf, -math.inf, math.nan)
+
+
+@pytest.mark.parametrize("name", ["sqrt", "sin", "cos", "tan", "exp", "log", "asin", "acos", "atan", "sinh", "cosh",
+                                  "tanh", "fabs", "atan2"])
+def test_every_function_of_the_machine_gives_pythons_bits_or_stops_where_python_raises(name: str) -> None:
+    """Each function of math the machine evaluates, at values that cover its domain, its
+    edges, round-off neighbours, overflows, infinities and NaN: the bits of Python's math,
+    or a stop where Python raises. (abs for fabs; atan2 against the values in both places.)"""
+    call = {"fabs": "abs(x[i])", "atan2": "math.atan2(x[i], x[n - 1 - i])"}.get(name, f"math.{name}(x[i])")
+    source = f"def kernel(x, out, n):\n    for i in range(n):\n        out[i] = {call}\n"
+    tape = translate(source, "kernel")
+    assert tape is not None
+    python = _python(source, "kernel")
+    for value in _UNARY_VALUES:
+        x = np.array([value, 0.25, -2.0 * value])
+        out_python, out_tape = np.zeros(3), np.zeros(3)
+        try:
+            python(x, out_python, 3)
+        except (ValueError, OverflowError):
+            with pytest.raises(TapeError):
+                TapeFunction(tape)(x, out_tape, 3)
+            continue
+        TapeFunction(tape)(x, out_tape, 3)
+        assert out_python.tobytes() == out_tape.tobytes(), (name, value, out_python, out_tape)
+
+
+def test_two_dimensional_arrays_and_every_jump_run_as_in_python() -> None:
+    """LOAD2 and STORE2 (a 2-D work array, a matrix argument stored flat), JLE, JLT and JEQ
+    both ways, against Python's own run of the source, and an index out of a row stops."""
+    source = (
+        "def kernel(x, out, n):\n"
+        "    W = np.empty((3, 2))\n"
+        "    for i in range(3):\n"
+        "        for j in range(2):\n"
+        "            W[i, j] = x[i] * (j + 1.5) if x[i] <= x[j] else x[j] - x[i]\n"
+        "    k = 0\n"
+        "    while k < n:\n"
+        "        out[k] = W[2 if k == 2 else (1 if k == 1 else 0), 1] / (1.0 + abs(x[k]))\n"
+        "        if out[k] == x[k] or not (out[k] >= 0.0):\n"
+        "            out[k] = -out[k]\n"
+        "        k += 1\n"
+    )
+    tape = translate(source, "kernel")
+    reasons: list[str] = []
+    assert translate(source, "kernel", reasons) is not None, reasons
+    python = _python(source, "kernel")
+    for x in (np.array([0.3, -1.25, 2.0]), np.array([1.0, 1.0, -0.0]), np.array([math.nan, 2.0, -3.0])):
+        out_python, out_tape = np.zeros(3), np.zeros(3)
+        python(x.copy(), out_python, 3)
+        TapeFunction(tape)(x.copy(), out_tape, 3)
+        assert out_python.tobytes() == out_tape.tobytes()
+    with pytest.raises(TapeError, match="index"):
+        TapeFunction(tape)(np.zeros(3), np.zeros(3), 4)

@@ -1,0 +1,174 @@
+/* The tape machine's loop, compiled ahead of time (at the package's install).
+ *
+ * The same machine as dirac/codegen/tape_machine.py's _execute, which numba compiles on a
+ * machine where this extension was not built: the same instructions (op, a, b, c, d) over a
+ * float64 register file and one float64 memory, the same operation numbers
+ * (dirac.codegen.tape_source.OPS), the same error codes (tape_machine.ERRORS). Each
+ * instruction is one IEEE 754 double operation in the order of the tape, and the functions
+ * of math.h are the libm CPython's math module and numba call: the results are those of the
+ * interpreter and of numba, bit for bit. The build keeps the compiler from contracting a
+ * product and a sum into a fused multiply-add (-ffp-contract=off, setup.py), which would
+ * round once where the interpreter rounds twice.
+ *
+ * run_tape(code, reg, mem, base, rows, cols) -> int: code, base, rows and cols are
+ * contiguous int64 buffers, reg and mem writable contiguous float64 buffers.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+
+static int
+take(PyObject *obj, Py_buffer *view, int writable, char kind, const char *name)
+{
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, view, flags) < 0)
+        return -1;
+    const char *format = view->format ? view->format : "B";
+    if (format[0] == '<' || format[0] == '=' || format[0] == '@')
+        format++;
+    int ok = view->itemsize == 8 && format[1] == '\0'
+             && (kind == 'd' ? format[0] == 'd' : (format[0] == 'q' || format[0] == 'l'));
+    if (!ok) {
+        PyErr_Format(PyExc_TypeError, "run_tape: %s must be a contiguous %s array", name,
+                     kind == 'd' ? "float64" : "int64");
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static int
+index_ok(double x, int64_t size)
+{
+    /* Python's int(x) truncates towards zero; the machine accepts 0 <= int(x) < size, which
+       for a number is -1 < x < size (NaN fails both comparisons) */
+    return x > -1.0 && x < (double)size;
+}
+
+static int
+execute(const int64_t *code, Py_ssize_t n, double *reg, double *mem, const int64_t *base,
+        const int64_t *rows, const int64_t *cols)
+{
+    Py_ssize_t pc = 0;
+    while (pc < n) {
+        int64_t op = code[pc], a = code[pc + 1], b = code[pc + 2], c = code[pc + 3], d = code[pc + 4];
+        pc += 5;
+        switch (op) {
+        case 3: reg[a] = reg[b] * reg[c]; break;
+        case 1: reg[a] = reg[b] + reg[c]; break;
+        case 2: reg[a] = reg[b] - reg[c]; break;
+        case 0: reg[a] = reg[b]; break;
+        case 6: /* LOAD reg a <- array b [reg c] */
+            if (!index_ok(reg[c], rows[b]))
+                return 2;
+            reg[a] = mem[base[b] + (int64_t)reg[c]];
+            break;
+        case 11: /* JLT: to a when (reg b < reg c) is not d */
+            if ((reg[b] < reg[c]) != (d != 0))
+                pc = 5 * a;
+            break;
+        case 13: /* JEQ */
+            if ((reg[b] == reg[c]) != (d != 0))
+                pc = 5 * a;
+            break;
+        case 10: pc = 5 * a; break; /* JMP */
+        case 4: /* DIV */
+            if (reg[c] == 0.0)
+                return 1;
+            reg[a] = reg[b] / reg[c];
+            break;
+        case 5: reg[a] = -reg[b]; break;
+        case 7: /* STORE array a [reg b] <- reg c */
+            if (!index_ok(reg[b], rows[a]))
+                return 2;
+            mem[base[a] + (int64_t)reg[b]] = reg[c];
+            break;
+        case 8: /* LOAD2 reg a <- array b [reg c, reg d] */
+            if (!index_ok(reg[c], rows[b]) || !index_ok(reg[d], cols[b]))
+                return 2;
+            reg[a] = mem[base[b] + (int64_t)reg[c] * cols[b] + (int64_t)reg[d]];
+            break;
+        case 9: /* STORE2 array a [reg b, reg c] <- reg d */
+            if (!index_ok(reg[b], rows[a]) || !index_ok(reg[c], cols[a]))
+                return 2;
+            mem[base[a] + (int64_t)reg[b] * cols[a] + (int64_t)reg[c]] = reg[d];
+            break;
+        case 12: /* JLE */
+            if ((reg[b] <= reg[c]) != (d != 0))
+                pc = 5 * a;
+            break;
+        case 14: reg[a] = fabs(reg[b]); break;
+        case 27: reg[a] = atan2(reg[b], reg[c]); break;
+        default: {
+            double x = reg[b], y;
+            switch (op) {
+            case 15: y = sqrt(x); break;
+            case 16: y = sin(x); break;
+            case 17: y = cos(x); break;
+            case 18: y = tan(x); break;
+            case 19: y = exp(x); break;
+            case 20: y = log(x); break;
+            case 21: y = asin(x); break;
+            case 22: y = acos(x); break;
+            case 23: y = atan(x); break;
+            case 24: y = sinh(x); break;
+            case 25: y = cosh(x); break;
+            case 26: y = tanh(x); break;
+            default: return 4;
+            }
+            if ((y != y && x == x) || (isinf(y) && isfinite(x))) /* where Python's math raises */
+                return 3;
+            reg[a] = y;
+        }
+        }
+    }
+    return 0;
+}
+
+static PyObject *
+run_tape(PyObject *self, PyObject *args)
+{
+    PyObject *objects[6];
+    if (!PyArg_ParseTuple(args, "OOOOOO:run_tape", &objects[0], &objects[1], &objects[2], &objects[3],
+                          &objects[4], &objects[5]))
+        return NULL;
+    static const char kinds[6] = {'q', 'd', 'd', 'q', 'q', 'q'};
+    static const int writable[6] = {0, 1, 1, 0, 0, 0};
+    static const char *names[6] = {"code", "reg", "mem", "base", "rows", "cols"};
+    Py_buffer views[6];
+    int taken = 0;
+    for (; taken < 6; taken++) {
+        if (take(objects[taken], &views[taken], writable[taken], kinds[taken], names[taken]) < 0)
+            break;
+    }
+    int status = -1;
+    if (taken == 6) {
+        Py_BEGIN_ALLOW_THREADS
+        status = execute((const int64_t *)views[0].buf, views[0].len / 8, (double *)views[1].buf,
+                         (double *)views[2].buf, (const int64_t *)views[3].buf, (const int64_t *)views[4].buf,
+                         (const int64_t *)views[5].buf);
+        Py_END_ALLOW_THREADS
+    }
+    for (int k = 0; k < taken; k++)
+        PyBuffer_Release(&views[k]);
+    if (taken < 6)
+        return NULL;
+    return PyLong_FromLong(status);
+}
+
+static PyMethodDef methods[] = {
+    {"run_tape", run_tape, METH_VARARGS,
+     "run_tape(code, reg, mem, base, rows, cols) -> int: run a tape; 0, or an error code of "
+     "dirac.codegen.tape_machine.ERRORS."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_tape", "The tape machine's loop, compiled ahead of time.",
+                                    -1, methods};
+
+PyMODINIT_FUNC
+PyInit__tape(void)
+{
+    return PyModule_Create(&module);
+}
