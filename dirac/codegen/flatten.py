@@ -43,6 +43,7 @@ Reference: the inline expansion of a compiler (Aho, Lam, Sethi & Ullman, *Compil
 from __future__ import annotations
 
 import ast
+import re
 import itertools
 from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
@@ -626,10 +627,40 @@ def specialise_solves(source: str, max_size: int | None = None) -> str:
                     continue
                 node.func = ast.Name(id=name, ctx=ast.Load())
                 used.add(size)
+        _float_pivots(function)
     if not used:
         return source
     ast.fix_missing_locations(tree)
     return ast.unparse(tree) + "\n" + "".join(unrolled_lu_source(size) for size in sorted(used))
+
+
+def _float_pivots(function: ast.FunctionDef) -> None:
+    """Pivot arrays that only unrolled solves use, allocated as float64 instead of int64.
+
+    The unrolled ``lu_factor_<k>`` stores each row exchange and ``lu_solve_<k>`` compares it
+    with integer literals, never indexes with it (:func:`~dirac.codegen.small_solves.unrolled_lu_source`):
+    an exchange held as a double compares the same, and a loop without integer arrays runs
+    on the tape machine (whose memory is float64), as the RATTLE loops' pivots do. A name
+    bound once by ``np.empty(k, dtype=np.int64)`` whose every other use is the second argument
+    of such a call loses its ``dtype``.
+    """
+    unrolled = re.compile(r"lu_(factor|solve)_[0-9]+$")
+    uses: dict[str, int] = {}
+    as_pivot: dict[str, int] = {}
+    allocations: dict[str, ast.Call] = {}
+    for node in walk(function):
+        if isinstance(node, ast.Name):
+            uses[node.id] = uses.get(node.id, 0) + 1
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and unrolled.match(node.func.id) \
+                and len(node.args) >= 2 and isinstance(node.args[1], ast.Name):
+            as_pivot[node.args[1].id] = as_pivot.get(node.args[1].id, 0) + 1
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name) \
+                and isinstance(node.value, ast.Call) and ast.unparse(node.value.func) == "np.empty" \
+                and len(node.value.args) == 1 and [ast.unparse(k) for k in node.value.keywords] == ["dtype=np.int64"]:
+            allocations[node.targets[0].id] = node.value
+    for name, call in allocations.items():
+        if name in as_pivot and uses.get(name) == as_pivot[name] + 1:
+            call.keywords = []
 
 
 def function_text(source: str, name: str) -> str | None:
@@ -662,4 +693,9 @@ def specialised_function(source: str, name: str, max_size: int | None = None) ->
     tree = ast.parse(specialised)
     tree.body = [node for node in tree.body if not (isinstance(node, ast.FunctionDef)
                                                      and node.name in ("lu_factor", "lu_solve"))]
-    return ast.unparse(tree) + "\n"
+    # the unrolled solves inlined where they are called: a step loop without calls runs on
+    # the tape machine (which translates no calls); the same statements in the same order
+    text = ast.unparse(tree) + "\n"
+    marked = re.sub(r"@numba\.njit\(cache=True\)\ndef (lu_(?:factor|solve)_[0-9]+)\(",
+                    r'@numba.njit(cache=True, inline="always")\ndef \1(', text)
+    return flatten_source(marked) if marked != text else text

@@ -88,14 +88,14 @@ def midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info):
     F of this module (Hairer, Lubich & Wanner IV.2), simplified Newton with a
     finite-difference Jacobian of F at z0 per step, factored once per step; an analysed
     system then projects onto Phi = 0 (Hairer, Lubich & Wanner IV.4)."""
-    NZ = z.shape[0]
-    f = np.empty(NZ)
-    fz = np.empty(NZ)
-    zz = np.empty(NZ)
-    z1 = np.empty(NZ)
-    r = np.empty(NZ)
-    J = np.empty((NZ, NZ))
-    piv = np.empty(NZ, dtype=np.int64)
+    NZ = 2 * __N__  # z = (q, p): arrays of constant shape (the tape machine allocates no others)
+    f = np.empty(2 * __N__)
+    fz = np.empty(2 * __N__)
+    zz = np.empty(2 * __N__)
+    z1 = np.empty(2 * __N__)
+    r = np.empty(2 * __N__)
+    J = np.empty((2 * __N__, 2 * __N__))
+    piv = np.empty(2 * __N__, dtype=np.int64)
     work = field_work()
     PROJECT_WORK
     evals = 0.0

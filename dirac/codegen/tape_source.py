@@ -634,7 +634,8 @@ def _array_names(function: ast.FunctionDef) -> set[str]:
 
 
 class _Lengths(ast.NodeTransformer):
-    """``a.shape[0]`` of an array argument -> a name the call fills with its length."""
+    """``a.shape[0]`` of an array -> a name the call fills with its length (an argument's, or a
+    local array's constant rows)."""
 
     def __init__(self) -> None:
         self.found: set[str] = set()
@@ -673,8 +674,10 @@ def translate(source: str, name: str, reasons: list[str] | None = None) -> Tape 
             translator.variable(f"_len_{array}")
         tape = translator.run()
         for array in sorted(lengths.found):
-            if array not in translator.array_names or tape.arrays[translator.array_names[array]] != (-1, -1):
-                raise Decline(f"{array}.shape of a local array")
+            if array not in translator.array_names:
+                raise Decline(f"{array}.shape of a name that is not an array")
+            # an argument's length comes with the call; a local array's is its constant rows,
+            # which the call sets the same way (TapeFunction: reg[length] = rows[slot])
             tape.lengths[translator.array_names[array]] = translator.names[f"_len_{array}"]
     except (Decline, RecursionError) as error:
         if reasons is not None:
