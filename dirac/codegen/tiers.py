@@ -67,6 +67,7 @@ from dirac.codegen.tape_source import translate
 from dirac.errors import inform
 
 __all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TAPE_SPEEDUP", "TAPE_MACHINE_SECONDS", "TAPE_LOAD_SECONDS",
+           "TAPE_TRANSLATE_SECONDS",
            "TAPE_PROBE_STEPS", "TAPE_RATE_STEPS", "tape_enabled", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "SHARED_CORE_FACTOR",
            "CHECK_SECONDS",
            "WARM_UP_STEPS", "WARM_UP_UNTIMED_STEPS", "WAIT_FACTOR", "choose_road", "background_enabled", "spare_core",
@@ -81,6 +82,10 @@ TAPE_SPEEDUP = 5.0
 #: from numba's on-disk cache (about 0.3 s)
 TAPE_MACHINE_SECONDS = 0.9
 TAPE_LOAD_SECONDS = 0.3
+#: CPU seconds to translate a step loop to a tape, once per loop (:func:`~dirac.codegen.tape_source.translate`:
+#: 53-62 ms measured for the RATTLE loops of the triple pendulum, the tops in Euler angles and
+#: the Cartesian double pendulum, about 20,000 characters each): the tape must save more
+TAPE_TRANSLATE_SECONDS = 0.1
 #: steps of the first part a loop runs on the tape, which measures the tape's own rate
 TAPE_PROBE_STEPS = 256
 #: parts of fewer steps do not count in the tape's rate (each call costs some microseconds of
@@ -150,11 +155,12 @@ def choose_road(interpreted: float, compile_seconds: float, background: float | 
     Returns
     -------
     str
-        The road, by this table (with ``c`` = :data:`COMPILE_SECONDS`, ``W`` = :data:`WAIT_FACTOR`):
+        The road, by this table (with ``c`` = :data:`COMPILE_SECONDS`, ``W`` = :data:`WAIT_FACTOR`,
+        ``t`` = :data:`TAPE_TRANSLATE_SECONDS`):
 
         ================================  ==============
+        ``T + t < I``, ``T <= E``         tape
         ``I <= c``                        interpreted
-        ``T < I``, ``T <= E``             tape
         ``I <= E``                        interpreted
         ``I > W E``                       compile
         ``E < I <= W E``, ``B < I``       background
@@ -176,15 +182,17 @@ def choose_road(interpreted: float, compile_seconds: float, background: float | 
     than the interpreted run) and the child can still end the run sooner than the interpreter
     (``B < I``); it then never waits longer than the interpreted run (Paleczny, Vick & Click,
     "The Java HotSpot server compiler", JVM '01, for background compilation in a tiered JIT).
-    The tape is taken when it ends the run before both the interpreter and the compiler: its
-    wait (the machine, compiled once for every system) is part of ``T < I``, so it never
-    waits longer than the interpreted run either. Without a tape the table is the one of
+    The tape is taken when it ends the run before both the interpreter and the compiler, by
+    more than the translation of the loop costs: its wait (none for the machine compiled at
+    the install; numba's import and the machine's compilation or load otherwise) is part of
+    ``T``, so it never waits longer than the interpreted run either; a run of less than a
+    second interpreted takes it only when the machine costs nothing to get. Without a tape the table is the one of
     two roads: ``I <= max(c, E)`` interpreted.
     """
+    if tape is not None and tape + TAPE_TRANSLATE_SECONDS < interpreted and tape <= compile_seconds:
+        return "tape"
     if interpreted <= COMPILE_SECONDS:
         return "interpreted"
-    if tape is not None and tape < interpreted and tape <= compile_seconds:
-        return "tape"
     if interpreted <= compile_seconds:
         return "interpreted"
     if interpreted > WAIT_FACTOR * compile_seconds:
@@ -609,6 +617,12 @@ class TieredFunction:
             return
         remaining = math.inf if planned is None else per_step * planned
         if remaining <= COMPILE_SECONDS:
+            # no compilation pays; the tape does when the machine costs nothing to get (compiled
+            # at the install, or loaded in this process) and it saves more than its translation
+            if remaining > TAPE_TRANSLATE_SECONDS and machine_loaded():
+                tape = self.tape_estimate(planned, args)
+                if tape is not None and tape + TAPE_TRANSLATE_SECONDS < remaining:
+                    self.on_tape = True
             return
         estimate = self.compile_estimate()
         background = None

@@ -169,8 +169,13 @@ def test_a_loop_the_tape_declines_keeps_the_two_other_roads(tmp_path, monkeypatc
     (50.0, 4.19, None, 11.4, "compile"),
     # 3e4 steps: I = 1.5 s, T = 1.4 + 0.3 = 1.7 s > I: interpreted (the machine would not pay)
     (1.5, 4.19, None, 1.7, "interpreted"),
-    # I below a second: interpreted whatever the tape
-    (0.9, 4.19, None, 0.2, "interpreted"),
+    # I below a second: the tape when the machine costs nothing to get (compiled at the install)
+    # and it saves more than the loop's translation (0.1 s): T + 0.1 = 0.3 < 0.9
+    (0.9, 4.19, None, 0.2, "tape"),
+    # ... not when the machine must first be compiled (numba's import and the loop: T = 1.4 + 0.2)
+    (0.9, 4.19, None, 1.6, "interpreted"),
+    # ... nor when the saving is below the translation's cost: 0.03 + 0.1 > 0.12
+    (0.12, 4.19, None, 0.03, "interpreted"),
     # no tape: the table of two roads, unchanged
     (5.0, 4.19, None, None, "compile"),
     (6.0, 4.19, 5.0, None, "background"),
