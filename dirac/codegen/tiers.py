@@ -618,10 +618,14 @@ class TieredFunction:
         remaining = math.inf if planned is None else per_step * planned
         if remaining <= COMPILE_SECONDS:
             # no compilation pays; the tape does when the machine costs nothing to get (compiled
-            # at the install, or loaded in this process) and it saves more than its translation
-            if remaining > TAPE_TRANSLATE_SECONDS and machine_loaded():
+            # at the install, or loaded in this process) and it saves more than its translation,
+            # which is paid once: a loop called again and again for short runs (the pilots of
+            # auto) translates once it has spent that long interpreted (the rent-or-buy rule)
+            if machine_loaded() and (remaining > TAPE_TRANSLATE_SECONDS or self.interpreted_seconds >= TAPE_TRANSLATE_SECONDS):
+                translated = self.name in self.module._tapes
+                cost = 0.0 if translated or self.interpreted_seconds >= TAPE_TRANSLATE_SECONDS else TAPE_TRANSLATE_SECONDS
                 tape = self.tape_estimate(planned, args)
-                if tape is not None and tape + TAPE_TRANSLATE_SECONDS < remaining:
+                if tape is not None and tape + cost < remaining:
                     self.on_tape = True
             return
         estimate = self.compile_estimate()
