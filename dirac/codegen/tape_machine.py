@@ -288,6 +288,8 @@ class TapeFunction:
             return False
         arrays = []
         for position, ((kind, _), value) in enumerate(zip(self.tape.parameters, args)):
+            if kind == "unused":
+                continue
             if kind == "array":
                 if not (isinstance(value, np.ndarray) and value.dtype == np.float64 and value.ndim == 1):
                     return False
@@ -311,7 +313,7 @@ class TapeFunction:
         for (kind, where), value in zip(self.tape.parameters, args):
             if kind == "scalar":
                 reg[where] = float(value)
-            else:
+            elif kind == "array":
                 mem[base[where]:base[where] + rows[where]] = value
                 slot += 1
         for where, register in self.tape.lengths.items():

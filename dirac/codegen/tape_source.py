@@ -68,7 +68,8 @@ class Tape:
     constants : dict of int to float
         Registers holding constants (loaded before each run).
     parameters : list of tuple
-        Per parameter of the function, in order: ``("scalar", register)`` or ``("array", slot)``.
+        Per parameter of the function, in order: ``("scalar", register)``, ``("array", slot)``,
+        or ``("unused", -1)`` for one the body never reads (any value is taken).
     arrays : list of tuple of int
         Per array slot: ``(rows, cols)`` of a local array of constant shape, ``(-1, -1)`` for an
         argument (its size is known at the call), ``2`` dimensions when ``cols > 0``.
@@ -146,8 +147,11 @@ class _Translator:
         used_as_array = _array_names(self.function)
         negated = _negated_parameters(self.function, used_as_array)
         self.tape.float_parameters = {i for i, a in enumerate(arguments.args) if a.arg in negated}
+        loaded = {node.id for node in ast.walk(self.function) if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load)}
         for argument in arguments.args:
-            if argument.arg in used_as_array:
+            if argument.arg not in used_as_array and argument.arg not in loaded:
+                self.tape.parameters.append(("unused", -1))  # any value (an empty parameter vector)
+            elif argument.arg in used_as_array:
                 slot = len(self.tape.arrays)
                 self.tape.arrays.append((-1, -1))
                 self.array_names[argument.arg] = slot

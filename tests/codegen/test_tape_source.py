@@ -236,6 +236,19 @@ def test_a_unary_minus_of_a_value_that_may_be_an_integer_is_declined() -> None:
     assert doubled is not None and doubled.float_parameters == set()
 
 
+def test_a_parameter_the_body_never_reads_takes_any_value() -> None:
+    """A loop of a system without parameters is passed an empty parameter vector it never
+    reads: the tape takes it whatever it is (an array, a number), as Python does."""
+    tape = translate("def kernel(x, c, out):\n    out[0] = x[0] * 2.0\n", "kernel")
+    assert tape is not None and tape.parameters[1] == ("unused", -1)
+    function = TapeFunction(tape)
+    for c in (np.zeros(0), 3.5, np.zeros((2, 2))):
+        out = np.zeros(1)
+        assert function.accepts((np.array([1.25]), c, out))
+        function(np.array([1.25]), c, out)
+        assert out[0] == 2.5
+
+
 def test_arrays_sharing_memory_are_not_taken() -> None:
     """The machine copies its arrays in and out: two arguments that are views of one array
     would not see each other's writes, as they do in Python, so such a call is not taken."""

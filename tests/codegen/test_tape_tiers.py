@@ -80,6 +80,65 @@ def test_a_time_dependent_system_runs_on_the_tape_with_the_interpreters_bits(mon
 
 
 
+@pytest.mark.parametrize("model_name", ["relativistic_oscillator", "anharmonic_oscillator", "quartic_oscillator"])
+def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bits(model_name: str, monkeypatch) -> None:
+    """The implicit midpoint loop of an analysed flow (its Newton matrix of size 2n, factored
+    by an unrolled LU whose pivots the interpreted text holds as doubles): the relativistic
+    oscillator (its square root of H, the constraints solved out of the flow) and a regular
+    anharmonic oscillator ``L = x'^2/2 - k x^2/2 - x^4/4`` and the quartic one without a parameter
+    (its loop never reads the empty parameter vector), 500 steps on the three tiers end on
+    the same state, evaluation count and residual. (A flow projected onto second-class
+    constraints after each step calls the projection as a function, and a mechanical
+    system's midpoint loop its field: those keep the two other roads.)"""
+    import dirac
+    from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
+    from dirac_systems.latency_models import MODELS
+
+    if model_name == "relativistic_oscillator":
+        model = MODELS[model_name]()
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(model.system))
+        z0 = np.asarray(model.state, dtype=float)
+    elif model_name == "anharmonic_oscillator":
+        lagrangian = dirac.Lagrangian.from_strings(model_name, ["x"], "x_dot**2/2 - k*x**2/2 - x**4/4",
+                                                   parameters={"k": 1.5})
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
+        z0 = np.array([0.5, 0.25])
+    else:  # no parameters: the loop never reads its (empty) parameter vector
+        lagrangian = dirac.Lagrangian.from_strings(model_name, ["x"], "x_dot**2/2 - x**4/4")
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
+        z0 = np.array([0.5, 0.25])
+    problem = AnalysedProblem(analysed, z0)
+    captured: list[tuple[tiers.TieredModule, str, tuple]] = []
+    original = tiers.TieredFunction.run_steps
+
+    def spy(self, steps, planned, *args):
+        if not captured and self.name == "midpoint_run":
+            captured.append((self.module, self.name, tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args)))
+        return original(self, steps, planned, *args)
+
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", spy)
+    monkeypatch.setenv("DIRAC_TAPE", "0")
+    integrate(problem, "midpoint", dt=1e-3, t_end=0.005)
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", original)
+    module, name, args = captured[0]
+    reasons: list[str] = []
+    from dirac.codegen.tape_source import translate
+
+    assert translate(module._texts[name], name, reasons) is not None, reasons
+    tape = module.tape_function(name)
+    assert tape is not None
+    finals = {}
+    for tier, function in {"interpreted": module.interpreted_function(name), "tape": tape,
+                           "compiled": getattr(module.compiled, name)}.items():
+        state = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+        state[4] = 500  # midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info)
+        function(*state)
+        finals[tier] = state
+    for tier in ("tape", "compiled"):
+        for position in (0, 7):  # z, info
+            assert np.array_equal(finals[tier][position], finals["interpreted"][position]), (tier, position)
+    assert finals["tape"][7][0] == 500 and finals["tape"][7][1] == 0.0
+
 
 def _loop(tmp_path, monkeypatch, source: str = SINE_LOOP) -> tiers.TieredFunction:
     monkeypatch.setenv("DIRAC_CACHE_DIR", str(tmp_path))
