@@ -22,17 +22,23 @@ def _captured_loop(model_name: str, monkeypatch) -> tuple[tiers.TieredModule, st
     model = MODELS[model_name]()
     n = len(model.state) // 2
     problem = ConstrainedProblem(model.system, q0=model.state[:n], p0=model.state[n:])
+    return _capture(problem, "rattle-2", monkeypatch)
+
+
+def _capture(problem, method: str, monkeypatch, name: str | None = None) -> tuple[tiers.TieredModule, str, tuple]:
+    """The generated module of ``problem``, the name of the step loop its run with ``method``
+    calls first (or the loop ``name``), and that call's arguments (copied at its first call)."""
     captured: list[tuple[tiers.TieredModule, str, tuple]] = []
     original = tiers.TieredFunction.run_steps
 
     def spy(self, steps, planned, *args):  # whatever the tier (the kernel may be in the cache already)
-        if not captured and self._split_positions() is not None:
+        if not captured and self._split_positions() is not None and name in (None, self.name):
             captured.append((self.module, self.name, tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args)))
         return original(self, steps, planned, *args)
 
     monkeypatch.setattr(tiers.TieredFunction, "run_steps", spy)
     monkeypatch.setenv("DIRAC_TAPE", "0")
-    integrate(problem, "rattle-2", dt=1e-3, t_end=0.005)
+    integrate(problem, method, dt=1e-3, t_end=0.005)
     monkeypatch.setattr(tiers.TieredFunction, "run_steps", original)
     return captured[0]
 
@@ -107,20 +113,7 @@ def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bit
         lagrangian = dirac.Lagrangian.from_strings(model_name, ["x"], "x_dot**2/2 - x**4/4")
         analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
         z0 = np.array([0.5, 0.25])
-    problem = AnalysedProblem(analysed, z0)
-    captured: list[tuple[tiers.TieredModule, str, tuple]] = []
-    original = tiers.TieredFunction.run_steps
-
-    def spy(self, steps, planned, *args):
-        if not captured and self.name == "midpoint_run":
-            captured.append((self.module, self.name, tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args)))
-        return original(self, steps, planned, *args)
-
-    monkeypatch.setattr(tiers.TieredFunction, "run_steps", spy)
-    monkeypatch.setenv("DIRAC_TAPE", "0")
-    integrate(problem, "midpoint", dt=1e-3, t_end=0.005)
-    monkeypatch.setattr(tiers.TieredFunction, "run_steps", original)
-    module, name, args = captured[0]
+    module, name, args = _capture(AnalysedProblem(analysed, z0), "midpoint", monkeypatch, "midpoint_run")
     reasons: list[str] = []
     from dirac.codegen.tape_source import translate
 
