@@ -43,8 +43,8 @@ Reference: the inline expansion of a compiler (Aho, Lam, Sethi & Ullman, *Compil
 from __future__ import annotations
 
 import ast
-import re
 import itertools
+import re
 from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
 

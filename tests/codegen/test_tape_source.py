@@ -16,7 +16,6 @@ from dirac.codegen import tape_machine
 from dirac.codegen.tape_machine import TapeError, TapeFunction, _execute
 from dirac.codegen.tape_source import OPS, translate
 
-
 #: set (as .ci/run does) to fail instead of skipping the C loop's tests where it is not built
 REQUIRE_EXTENSION = "DIRAC_REQUIRE_TAPE_EXTENSION"
 
