@@ -38,12 +38,15 @@ take(PyObject *obj, Py_buffer *view, int writable, char kind, const char *name)
     return 0;
 }
 
-static int
-index_ok(double x, int64_t size)
+static int64_t
+index_of(double x, int64_t size)
 {
-    /* Python's int(x) truncates towards zero; the machine accepts 0 <= int(x) < size, which
-       for a number is -1 < x < size (NaN fails both comparisons) */
-    return x > -1.0 && x < (double)size;
+    /* Python's int(x), truncated towards zero, when 0 <= int(x) < size; else -1 (NaN fails
+       the comparison, and -1 < x < 0 truncates to 0, which an empty array does not hold) */
+    if (!(x > -1.0 && x < (double)size))
+        return -1;
+    int64_t i = (int64_t)x;
+    return i < size ? i : -1;
 }
 
 static int
@@ -59,11 +62,13 @@ execute(const int64_t *code, Py_ssize_t n, double *reg, double *mem, const int64
         case 1: reg[a] = reg[b] + reg[c]; break;
         case 2: reg[a] = reg[b] - reg[c]; break;
         case 0: reg[a] = reg[b]; break;
-        case 6: /* LOAD reg a <- array b [reg c] */
-            if (!index_ok(reg[c], rows[b]))
+        case 6: { /* LOAD reg a <- array b [reg c] */
+            int64_t i = index_of(reg[c], rows[b]);
+            if (i < 0)
                 return 2;
-            reg[a] = mem[base[b] + (int64_t)reg[c]];
+            reg[a] = mem[base[b] + i];
             break;
+        }
         case 11: /* JLT: to a when (reg b < reg c) is not d */
             if ((reg[b] < reg[c]) != (d != 0))
                 pc = 5 * a;
@@ -79,21 +84,27 @@ execute(const int64_t *code, Py_ssize_t n, double *reg, double *mem, const int64
             reg[a] = reg[b] / reg[c];
             break;
         case 5: reg[a] = -reg[b]; break;
-        case 7: /* STORE array a [reg b] <- reg c */
-            if (!index_ok(reg[b], rows[a]))
+        case 7: { /* STORE array a [reg b] <- reg c */
+            int64_t i = index_of(reg[b], rows[a]);
+            if (i < 0)
                 return 2;
-            mem[base[a] + (int64_t)reg[b]] = reg[c];
+            mem[base[a] + i] = reg[c];
             break;
-        case 8: /* LOAD2 reg a <- array b [reg c, reg d] */
-            if (!index_ok(reg[c], rows[b]) || !index_ok(reg[d], cols[b]))
+        }
+        case 8: { /* LOAD2 reg a <- array b [reg c, reg d] */
+            int64_t i = index_of(reg[c], rows[b]), j = index_of(reg[d], cols[b]);
+            if (i < 0 || j < 0)
                 return 2;
-            reg[a] = mem[base[b] + (int64_t)reg[c] * cols[b] + (int64_t)reg[d]];
+            reg[a] = mem[base[b] + i * cols[b] + j];
             break;
-        case 9: /* STORE2 array a [reg b, reg c] <- reg d */
-            if (!index_ok(reg[b], rows[a]) || !index_ok(reg[c], cols[a]))
+        }
+        case 9: { /* STORE2 array a [reg b, reg c] <- reg d */
+            int64_t i = index_of(reg[b], rows[a]), j = index_of(reg[c], cols[a]);
+            if (i < 0 || j < 0)
                 return 2;
-            mem[base[a] + (int64_t)reg[b] * cols[a] + (int64_t)reg[c]] = reg[d];
+            mem[base[a] + i * cols[a] + j] = reg[d];
             break;
+        }
         case 12: /* JLE */
             if ((reg[b] <= reg[c]) != (d != 0))
                 pc = 5 * a;

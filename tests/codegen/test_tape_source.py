@@ -194,6 +194,10 @@ def test_an_index_out_of_range_stops_the_machine() -> None:
     for k in (3, -1):
         with pytest.raises(TapeError, match="index"):
             function(np.zeros(3), np.zeros(1), k)
+    # an empty array holds no index, not even the 0 that -0.5 truncates to (Python raises too)
+    for k in (0, -0.5, 0.5):
+        with pytest.raises(TapeError, match="index"):
+            function(np.zeros(0), np.zeros(1), k)
     out = np.zeros(1)
     function(np.array([1.0, 2.0, 5.0]), out, 2)
     assert out[0] == 5.0
