@@ -237,7 +237,7 @@ def _rename(node: ast.AST, names: dict[str, ast.expr]) -> ast.AST:
 
 
 def _renamed_copy(node: _T, names: dict[str, ast.expr]) -> _T:
-    """``_rename(_copy(node), names)`` in one pass: the copy of an inlined helper's statement."""
+    """``_rename(_copy(node), names)`` in one pass: a statement of an inlined function, copied."""
     if isinstance(node, ast.AST):
         if node.__class__ is ast.Name:
             replaced = _renamed(cast(ast.Name, node), names)
