@@ -36,9 +36,10 @@ from __future__ import annotations
 
 import ast
 import itertools
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar, cast
 
-from dirac.codegen.flatten import copy_tree, walk
+from dirac.codegen.flatten import replace_children, walk
 
 __all__ = ["scalar_function", "unroll_loops", "scalarise_arrays", "item_loads", "UNROLL_MAX"]
 
@@ -51,6 +52,8 @@ UNROLL_STATEMENTS = 512
 #: the largest array (elements) replaced by locals
 SCALAR_MAX = 64
 
+_Node = TypeVar("_Node", bound=ast.AST)
+
 
 def _int_constant(node: ast.AST) -> int | None:
     if isinstance(node, ast.Constant) and type(node.value) is int:
@@ -58,52 +61,99 @@ def _int_constant(node: ast.AST) -> int | None:
     return None
 
 
+def _fold_binop(node: ast.BinOp) -> ast.AST:
+    """``node`` with integer literal operands (already folded) folded: ``+``, ``-``, ``*``."""
+    a, b = _int_constant(node.left), _int_constant(node.right)
+    if a is None or b is None:
+        return node
+    if isinstance(node.op, ast.Add):
+        return ast.copy_location(ast.Constant(a + b), node)
+    if isinstance(node.op, ast.Sub):
+        return ast.copy_location(ast.Constant(a - b), node)
+    if isinstance(node.op, ast.Mult):
+        return ast.copy_location(ast.Constant(a * b), node)
+    return node
+
+
+def _fold_unary(node: ast.UnaryOp) -> ast.AST:
+    """``-K`` of an integer literal (already folded) folded."""
+    a = _int_constant(node.operand)
+    if a is not None and isinstance(node.op, ast.USub):
+        return ast.copy_location(ast.Constant(-a), node)
+    return node
+
+
+def _fold_compare(node: ast.Compare) -> ast.AST:
+    """One comparison of two integer literals (already folded) folded to ``True``/``False``."""
+    a = _int_constant(node.left)
+    if a is None or len(node.ops) != 1:
+        return node
+    b = _int_constant(node.comparators[0])
+    if b is None:
+        return node
+    operations: dict[type, Any] = {ast.Eq: a == b, ast.NotEq: a != b, ast.Lt: a < b, ast.LtE: a <= b,
+                                   ast.Gt: a > b, ast.GtE: a >= b}
+    value = operations.get(type(node.ops[0]))
+    return node if value is None else ast.copy_location(ast.Constant(bool(value)), node)
+
+
+_FOLD_ONE: dict[type, Callable[[Any], ast.AST]] = {ast.BinOp: _fold_binop, ast.UnaryOp: _fold_unary,
+                                                   ast.Compare: _fold_compare}
+
+
 class _Fold(ast.NodeTransformer):
     """Integer arithmetic and comparisons of integer literals folded; floats never touched."""
 
     def visit_BinOp(self, node: ast.BinOp) -> ast.AST:
         self.generic_visit(node)
-        a, b = _int_constant(node.left), _int_constant(node.right)
-        if a is None or b is None:
-            return node
-        if isinstance(node.op, ast.Add):
-            return ast.copy_location(ast.Constant(a + b), node)
-        if isinstance(node.op, ast.Sub):
-            return ast.copy_location(ast.Constant(a - b), node)
-        if isinstance(node.op, ast.Mult):
-            return ast.copy_location(ast.Constant(a * b), node)
-        return node
+        return _fold_binop(node)
 
     def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
         self.generic_visit(node)
-        a = _int_constant(node.operand)
-        if a is not None and isinstance(node.op, ast.USub):
-            return ast.copy_location(ast.Constant(-a), node)
-        return node
+        return _fold_unary(node)
 
     def visit_Compare(self, node: ast.Compare) -> ast.AST:
         self.generic_visit(node)
-        a = _int_constant(node.left)
-        if a is None or len(node.ops) != 1:
-            return node
-        b = _int_constant(node.comparators[0])
-        if b is None:
-            return node
-        operations: dict[type, Any] = {ast.Eq: a == b, ast.NotEq: a != b, ast.Lt: a < b, ast.LtE: a <= b,
-                                       ast.Gt: a > b, ast.GtE: a >= b}
-        value = operations.get(type(node.ops[0]))
-        return node if value is None else ast.copy_location(ast.Constant(bool(value)), node)
+        return _fold_compare(node)
 
 
-class _Substitute(ast.NodeTransformer):
-    def __init__(self, name: str, value: int) -> None:
-        self.name = name
-        self.value = value
+def _instance(node: _Node, name: str, value: int) -> _Node:
+    """A copy of ``node`` with the loads of ``name`` replaced by the literal ``value`` and the
+    integer arithmetic on literals folded (bottom up, as :class:`_Fold` folds): the same tree as a
+    copy, a substitution and a fold in three passes of :class:`ast.NodeTransformer`, in one pass
+    (those passes were most of the unrolling, about half of the 0.13 s :func:`scalar_function`
+    took on the RATTLE step of a triple pendulum in angles)."""
+    kind = node.__class__
+    if kind is ast.Name and node.id == name and node.ctx.__class__ is ast.Load:  # type: ignore[attr-defined]
+        constant = ast.Constant(value)
+        for attribute in node._attributes:
+            if hasattr(node, attribute):
+                setattr(constant, attribute, getattr(node, attribute))
+        return cast(_Node, constant)
+    new = kind()
+    for field in node._fields:
+        try:
+            child = getattr(node, field)
+        except AttributeError:
+            continue
+        if child.__class__ is list:
+            child = [_instance(item, name, value) if isinstance(item, ast.AST) else item for item in child]
+        elif isinstance(child, ast.AST):
+            child = _instance(child, name, value)
+        setattr(new, field, child)
+    for attribute in node._attributes:
+        if hasattr(node, attribute):
+            setattr(new, attribute, getattr(node, attribute))
+    if kind is ast.BinOp or kind is ast.UnaryOp or kind is ast.Compare:
+        return cast(_Node, _FOLD_ONE[kind](new))
+    return new
 
-    def visit_Name(self, node: ast.Name) -> ast.AST:
-        if node.id == self.name and isinstance(node.ctx, ast.Load):
-            return ast.copy_location(ast.Constant(self.value), node)
-        return node
+
+def _fold_tree(node: ast.AST) -> ast.AST:
+    """``_Fold().visit(node)``, in place, with :func:`~dirac.codegen.flatten.replace_children`."""
+    replace_children(node, _fold_tree)
+    fold = _FOLD_ONE.get(node.__class__)
+    return fold(node) if fold is not None else node
 
 
 def _own_jumps(statements: list[ast.stmt]) -> bool:
@@ -149,6 +199,11 @@ def _prune_block(statements: list[ast.stmt]) -> list[ast.stmt]:
     return out
 
 
+def _statements(statements: list[ast.stmt]) -> int:
+    """The statements in ``statements``, those nested in them included."""
+    return sum(isinstance(node, ast.stmt) for s in statements for node in walk(s))
+
+
 def _unroll_block(statements: list[ast.stmt]) -> list[ast.stmt]:
     out: list[ast.stmt] = []
     for statement in _prune_block(statements):
@@ -162,11 +217,10 @@ def _unroll_block(statements: list[ast.stmt]) -> list[ast.stmt]:
         if isinstance(statement, ast.For):
             count = _literal_range(statement)
             target = statement.target
-            size = sum(isinstance(node, ast.stmt) for s in statement.body for node in walk(s))
             if count is not None and isinstance(target, ast.Name) and not _own_jumps(statement.body) \
-                    and not _binds(statement.body, target.id) and count * size <= UNROLL_STATEMENTS:
+                    and not _binds(statement.body, target.id) and count * _statements(statement.body) <= UNROLL_STATEMENTS:
                 for value in range(count):
-                    copies = [_Fold().visit(_Substitute(target.id, value).visit(copy_tree(s))) for s in statement.body]
+                    copies = [_instance(s, target.id, value) for s in statement.body]
                     out.extend(_unroll_block(copies))
                 if count:
                     out.append(ast.Assign(targets=[ast.Name(id=target.id, ctx=ast.Store())], value=ast.Constant(count - 1)))
@@ -178,7 +232,7 @@ def _unroll_block(statements: list[ast.stmt]) -> list[ast.stmt]:
 def unroll_loops(function: ast.FunctionDef) -> bool:
     """Step 1 of the module docstring, in place; whether a loop was unrolled."""
     loops = sum(isinstance(node, ast.For) for node in walk(function))
-    function.body = _unroll_block([_Fold().visit(s) for s in function.body])
+    function.body = _unroll_block([cast(ast.stmt, _fold_tree(s)) for s in function.body])
     return sum(isinstance(node, ast.For) for node in walk(function)) != loops
 
 
@@ -221,17 +275,15 @@ def _literal_index(node: ast.Subscript, shape: tuple[int, ...]) -> tuple[int, ..
     return tuple(int(v) for v in values if v is not None)
 
 
-class _Replace(ast.NodeTransformer):
-    def __init__(self, names: dict[str, str]) -> None:
-        self.names = names
-
-    def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
-        if isinstance(node.value, ast.Name) and node.value.id in self.names:
-            index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
-            suffix = "_".join(str(_int_constant(i)) for i in index)
-            return ast.copy_location(ast.Name(id=f"{self.names[node.value.id]}_{suffix}", ctx=node.ctx), node)
-        self.generic_visit(node)
-        return node
+def _replace(node: ast.AST, names: dict[str, str]) -> ast.AST:
+    """``node`` with every subscript ``x[i, j]`` of an array ``x`` of ``names`` replaced by the
+    local ``names[x]_i_j`` (in place)."""
+    if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in names:
+        index = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+        suffix = "_".join(str(_int_constant(i)) for i in index)
+        return ast.copy_location(ast.Name(id=f"{names[node.value.id]}_{suffix}", ctx=node.ctx), node)
+    replace_children(node, lambda child: _replace(child, names))
+    return node
 
 
 def scalarise_arrays(function: ast.FunctionDef) -> bool:
@@ -248,19 +300,24 @@ def scalarise_arrays(function: ast.FunctionDef) -> bool:
         return False
     allowed: set[int] = set()  # the Name nodes that are the array of a literal subscript
     stores: dict[str, int] = {}
-    for node in walk(function):
+    uses: list[ast.Name] = []  # the Name nodes of the candidates
+    taken = set(arguments)  # every name the function uses
+    for node in walk(function):  # one walk of the tree for all three
         if isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name) and node.value.id in candidates:
             if _literal_index(node, candidates[node.value.id][1]) is not None:
                 allowed.add(id(node.value))
-        if isinstance(node, ast.Name) and not isinstance(node.ctx, ast.Load):
-            stores[node.id] = stores.get(node.id, 0) + 1
-    for node in walk(function):
-        if isinstance(node, ast.Name) and node.id in candidates and id(node) not in allowed:
+        elif isinstance(node, ast.Name):
+            taken.add(node.id)
+            if not isinstance(node.ctx, ast.Load):
+                stores[node.id] = stores.get(node.id, 0) + 1
+            if node.id in candidates:
+                uses.append(node)
+    for node in uses:
+        if node.id in candidates and id(node) not in allowed:
             if not (isinstance(node.ctx, ast.Store) and stores.get(node.id) == 1):
                 candidates.pop(node.id)  # used whole, sliced, indexed by a variable or rebound
     if not candidates:
         return False
-    taken = {node.id for node in walk(function) if isinstance(node, ast.Name)} | arguments
     names: dict[str, str] = {}
     for name in candidates:
         prefix = f"_a_{name}"
@@ -278,17 +335,21 @@ def scalarise_arrays(function: ast.FunctionDef) -> bool:
         for index in itertools.product(*(range(s) for s in shape)):
             target = f"{names[name]}_{'_'.join(map(str, index))}"
             body.append(ast.Assign(targets=[ast.Name(id=target, ctx=ast.Store())], value=zero))
-    function.body = [_Replace(names).visit(statement) for statement in body]
+    function.body = [cast(ast.stmt, _replace(statement, names)) for statement in body]
     return True
 
 
-class _ItemLoads(ast.NodeTransformer):
+class _ItemLoads:
+    """``a[i, j]`` read from one of ``arrays`` made ``a.item(i, j)`` (in place, with :func:`~dirac.codegen.flatten.replace_children`)."""
+
     def __init__(self, arrays: set[str]) -> None:
         self.arrays = arrays
         self.changed = False
 
-    def visit_Subscript(self, node: ast.Subscript) -> ast.AST:
-        self.generic_visit(node)
+    def visit(self, node: ast.AST) -> ast.AST:
+        replace_children(node, self.visit)
+        if not isinstance(node, ast.Subscript):
+            return node
         if not (isinstance(node.ctx, ast.Load) and isinstance(node.value, ast.Name) and node.value.id in self.arrays):
             return node
         parts = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
@@ -308,7 +369,7 @@ def item_loads(function: ast.FunctionDef) -> bool:
     arrays = {name for name in arrays if name not in stored or name in
               {found[0] for found in map(_allocation, function.body) if found is not None}}
     loads = _ItemLoads(arrays)
-    function.body = [loads.visit(statement) for statement in function.body]
+    function.body = [cast(ast.stmt, loads.visit(statement)) for statement in function.body]
     return loads.changed
 
 

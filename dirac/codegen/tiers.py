@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from dirac.codegen.background import (
+    DEFAULT_COMPILE_FLOOR,
     BackgroundCompile,
     estimate_child_start_seconds,
     estimate_compile_seconds,
@@ -424,6 +425,16 @@ class TieredFunction:
         start = 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
         return estimate_compile_seconds(self.kernel_chars(), SHARED_CORE_FACTOR) + start
 
+    def compile_floor(self) -> float:
+        """A lower bound of :meth:`compile_estimate` known without reading the kernel's size (a
+        parse of the generated module: 40-70 ms for the RATTLE loops of the double and triple
+        pendulums): :data:`~dirac.codegen.background.DEFAULT_COMPILE_FLOOR`, the least
+        :func:`estimate_compile_seconds` gives, plus numba's import while it is not imported.
+        A road chosen against it is the road chosen against the estimate."""
+        import sys
+
+        return DEFAULT_COMPILE_FLOOR + (0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS)
+
     def background_estimate(self) -> float:
         """Estimated seconds until a background compilation of this function, started now,
         would have its machine code running here: the child's start-up
@@ -591,6 +602,8 @@ class TieredFunction:
                 self.compile("DIRAC_KERNELS=compiled", args)
                 return
             tape = self.tape_estimate(planned, args)
+            if tape is not None and tape <= WAIT_FACTOR * self.compile_floor():
+                return  # within what any compilation costs: the estimate (a parse of the module) is not read
             if self._tape_compile_estimate is None:  # read once: the history of the cache is a file
                 self._tape_compile_estimate = self.compile_estimate()
             estimate = self._tape_compile_estimate
@@ -628,12 +641,20 @@ class TieredFunction:
                 if tape is not None and tape + cost < remaining:
                     self.on_tape = True
             return
+        tape = self.tape_estimate(planned, args)
+        if tape is not None and tape + TAPE_TRANSLATE_SECONDS < remaining and tape <= self.compile_floor() \
+                and machine_loaded():
+            # choose_road's tape, whatever the compilation's estimate: it is never below the floor
+            # (read without parsing the module; the machine is there, so no compilation to announce)
+            machine(f"about {planned} steps to go, {remaining:.1f} s interpreted", announce_compilation)
+            self.on_tape = True
+            return
         estimate = self.compile_estimate()
         background = None
         if estimate < remaining <= WAIT_FACTOR * estimate and background_enabled() and not self.background_failed \
                 and spare_core():
             background = self.background_estimate()
-        road = choose_road(remaining, estimate, background, self.tape_estimate(planned, args))
+        road = choose_road(remaining, estimate, background, tape)
         if road == "tape":
             machine(f"about {planned} steps to go, {remaining:.1f} s interpreted, about {estimate:.1g} s to compile "
                     f"{self.name}", announce_compilation)

@@ -156,6 +156,35 @@ def test_a_loop_longer_than_a_second_but_shorter_than_its_compilation_goes_on_th
     assert x[0] == hand_loop(0.5, 3000) and (info[0], info[1], info[2]) == (3000, 0.0, 3000)
 
 
+def test_a_loop_whose_tape_costs_less_than_any_compilation_never_reads_the_compile_estimate(tmp_path,
+                                                                                          monkeypatch) -> None:
+    """1.2e6 steps at 1 us a step interpreted (I = 1.2 s, beyond a second): the tape's estimate
+    (a fifth of that, 0.24 s; then its measured rate) is below the least any compilation is
+    estimated at (:meth:`~dirac.codegen.tiers.TieredFunction.compile_floor`), so the tape is
+    :func:`~dirac.codegen.tiers.choose_road`'s road whatever the estimate, and the estimate (a
+    parse of the module for the kernel's size) is never read, neither to take the tape nor on
+    it. The iterates are the hand loop's to the last bit."""
+    from dirac.codegen.tape_machine import machine_loaded
+
+    if not machine_loaded():
+        pytest.skip("the machine compiled at the install is not built here")
+
+    def unread(self):
+        raise AssertionError("the compile estimate was read")
+
+    monkeypatch.setattr(tiers, "spare_core", lambda: False)
+    monkeypatch.setattr(tiers.TieredFunction, "compile_estimate", unread)
+    monkeypatch.setattr(tiers.TieredFunction, "kernel_chars", unread)
+    monkeypatch.setattr(tiers.TieredFunction, "seconds_per_step", lambda self: 1e-6)
+    function = _loop(tmp_path, monkeypatch)
+    assert 1.2e6 * 1e-6 / tiers.TAPE_SPEEDUP < function.compile_floor()
+    assert tiers.choose_road(1.2, function.compile_floor(), None, 1.2e6 * 1e-6 / tiers.TAPE_SPEEDUP) == "tape"
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(3000, 1_200_000, x, 0.0, 0.1, 3000, info)
+    assert function.tier == "tape" and function.tape_steps == 3000
+    assert x[0] == hand_loop(0.5, 3000) and (info[0], info[1], info[2]) == (3000, 0.0, 3000)
+
+
 def test_a_short_loop_stays_interpreted_without_the_machine(tmp_path, monkeypatch) -> None:
     """40 steps: far below a second interpreted; neither the tape nor the compiler is asked for."""
     function = _loop(tmp_path, monkeypatch)
