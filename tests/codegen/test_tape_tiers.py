@@ -80,16 +80,19 @@ def test_a_time_dependent_system_runs_on_the_tape_with_the_interpreters_bits(mon
 
 
 
-@pytest.mark.parametrize("model_name", ["relativistic_oscillator", "anharmonic_oscillator", "quartic_oscillator"])
+@pytest.mark.parametrize("model_name", ["relativistic_oscillator", "anharmonic_oscillator", "quartic_oscillator",
+                                        "pendulum_cartesian", "spherical_pendulum"])
 def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bits(model_name: str, monkeypatch) -> None:
     """The implicit midpoint loop of an analysed flow (its Newton matrix of size 2n, factored
     by an unrolled LU whose pivots the interpreted text holds as doubles): the relativistic
     oscillator (its square root of H, the constraints solved out of the flow) and a regular
     anharmonic oscillator ``L = x'^2/2 - k x^2/2 - x^4/4`` and the quartic one without a parameter
     (its loop never reads the empty parameter vector), 500 steps on the three tiers end on
-    the same state, evaluation count and residual. (A flow projected onto second-class
-    constraints after each step calls the projection as a function, and a mechanical
-    system's midpoint loop its field: those keep the two other roads.)"""
+    the same state, evaluation count and residual. Two flows projected onto their
+    second-class constraints after each step (the pendulum in Cartesian coordinates, z of
+    size 6 and 4 constraints; the spherical pendulum, 8 and 4), whose projection numba
+    compiles as a function and the interpreted text inlines
+    (:func:`~dirac.codegen.flatten.inline_worked_helpers`), likewise."""
     import dirac
     from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
     from dirac_systems.latency_models import MODELS
@@ -103,6 +106,13 @@ def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bit
                                                    parameters={"k": 1.5})
         analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
         z0 = np.array([0.5, 0.25])
+    elif model_name == "pendulum_cartesian":
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(MODELS[model_name]().system))
+        z0 = analysed.initial_state({"x": 0.8414709848078965, "y": -0.5403023058681398}, q_dot={"x": 0.0, "y": 0.0})
+    elif model_name == "spherical_pendulum":
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(dirac.load_system(model_name)))
+        z0 = analysed.initial_state({"x": 0.8414709848078965, "y": 0.0, "z": -0.5403023058681398},
+                                    q_dot={"x": 0.0, "y": 1.0, "z": 0.0})
     else:  # no parameters: the loop never reads its (empty) parameter vector
         lagrangian = dirac.Lagrangian.from_strings(model_name, ["x"], "x_dot**2/2 - x**4/4")
         analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
@@ -125,6 +135,11 @@ def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bit
     from dirac.codegen.tape_source import translate
 
     assert translate(module._texts[name], name, reasons) is not None, reasons
+    if model_name in ("pendulum_cartesian", "spherical_pendulum"):  # numba's text still calls the projection
+        from dirac.codegen.flatten import function_text
+
+        assert "project(z, " in (function_text(module.source, name) or "")
+        assert "project(" not in module._texts[name]
     tape = module.tape_function(name)
     assert tape is not None
     finals = {}
