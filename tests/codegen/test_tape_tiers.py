@@ -261,3 +261,45 @@ def test_choose_road_with_a_tape_follows_its_table(interpreted, compile_seconds,
     """choose_road against its table, worked by hand with COMPILE_SECONDS = 1 and WAIT_FACTOR = 2."""
     assert tiers.COMPILE_SECONDS == 1.0 and tiers.WAIT_FACTOR == 2.0
     assert tiers.choose_road(interpreted, compile_seconds, background, tape) == road
+
+
+def test_a_mechanical_midpoint_loop_inlines_its_field_with_numbas_bits(monkeypatch) -> None:
+    """The midpoint loop of a mechanical system (the Cartesian pendulum, ``ConstrainedProblem``)
+    hands ``field_into`` a tuple of 17 work arrays: its interpreted text inlines the field, one
+    array per entry (numba's source still calls it), and 500 steps end on numba's z and info.
+    The tape still declines it (the field takes views ``z[:n]`` and calls ``dirac_projection``),
+    so the loop keeps the two other roads."""
+    import dirac
+    from dirac.codegen.flatten import function_text
+    from dirac.codegen.tape_source import translate
+    from dirac_systems.latency_models import MODELS
+
+    model = MODELS["pendulum_cartesian"]()
+    problem = ConstrainedProblem(model.system, model.state[:2], model.state[2:])
+    captured: list[tuple[tiers.TieredModule, str, tuple]] = []
+    original = tiers.TieredFunction.run_steps
+
+    def spy(self, steps, planned, *args):
+        if not captured and self.name == "midpoint_run":
+            captured.append((self.module, self.name, tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args)))
+        return original(self, steps, planned, *args)
+
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", spy)
+    monkeypatch.setenv("DIRAC_TAPE", "0")
+    dirac.integrate(problem, "midpoint", dt=1e-3, t_end=0.005)
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", original)
+    module, name, args = captured[0]
+    assert "field_into(zz, " in (function_text(module.source, name) or "")
+    assert "field_into(" not in module._texts[name]
+    reasons: list[str] = []
+    assert translate(module._texts[name], name, reasons) is None and reasons
+    finals = {}
+    for tier, function in {"interpreted": module.interpreted_function(name),
+                           "compiled": getattr(module.compiled, name)}.items():
+        state = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+        state[4] = 500  # midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info)
+        function(*state)
+        finals[tier] = state
+    for position in (0, 7):
+        assert np.array_equal(finals["compiled"][position], finals["interpreted"][position]), position
+    assert finals["compiled"][7][0] == 500 and finals["compiled"][7][1] == 0.0
