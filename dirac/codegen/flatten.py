@@ -49,7 +49,7 @@ from collections.abc import Callable, Iterator
 from typing import TypeVar, cast
 
 __all__ = ["flatten_source", "straight", "tidy_function", "specialise_solves", "specialised_function", "function_text", "walk", "copy_tree", "INLINE_MARK",
-           "SEPARATE", "SMALL", "inline_worked_helpers"]
+           "SEPARATE", "SMALL"]
 
 #: the decorator generated modules put on a helper to be inlined
 INLINE_MARK = '@numba.njit(cache=True, inline="always")'
