@@ -792,8 +792,10 @@ def inline_worked_helpers(source: str, text: str) -> str | None:
     The same floating-point operations run in the same order on the same values (the
     arrays are the same allocations, named apart), so the interpreter, the tape and numba
     still give the same bits, which tests/codegen/test_tape_tiers.py checks. A work tuple
-    used in any other way, or a helper whose returns cannot be made breaks, leaves the text as
-    it is (the tape then declines the call, as before).
+    used in any other way, a helper whose returns cannot be made breaks, or a solve that stays
+    looped after the inlining (a matrix over
+    :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`), leaves the text as it is (the tape
+    then declines the loop, as before).
     """
     if "_work()" not in text:
         return None
@@ -818,7 +820,7 @@ def inline_worked_helpers(source: str, text: str) -> str | None:
             arrays = _allocations(parsed) if isinstance(parsed, ast.FunctionDef) else None
             if arrays is not None and len(arrays) > 1:
                 works[statement.targets[0].id] = (statement, arrays)
-    if not works:
+    if not works or not _solves_unrolled(function):  # the caller's own solves first (cheap)
         return None
     # every use of w: an argument (a plain name) of a statement calling a helper that unpacks it
     uses = {name: 0 for name in works}
@@ -882,8 +884,26 @@ def inline_worked_helpers(source: str, text: str) -> str | None:
     caller_names = _stored_names(function.body) | {a.arg for a in function.args.args}
     if not _splice(function, {id(call) for call, _, _ in calls}, flattener, caller_names):
         return None  # a call could not be inlined: keep the text as it was (the tape declines it)
+    if not _solves_unrolled(function):
+        # a solve left looped keeps its integer pivots, which the tape declines: the larger text
+        # would only cost its rewriting (the analysed Cartesian double pendulum, z of size 12:
+        # a first 5-step run took 1.1-1.7 s of CPU instead of 0.2-0.35 s, 3 alternating pairs)
+        return None
     ast.fix_missing_locations(function)
     return ast.unparse(ast.Module(body=[function], type_ignores=[])) + "\n"
+
+
+def _solves_unrolled(function: ast.FunctionDef) -> bool:
+    """Whether every ``lu_factor`` / ``lu_solve`` of ``function`` works on a matrix that
+    :func:`specialise_solves` unrolls (allocated in it with a literal size up to
+    :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`)."""
+    from dirac.codegen.small_solves import UNROLLED_MAX_SIZE
+
+    shapes = _matrix_allocations(function)
+    return not any(isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                   and node.func.id in ("lu_factor", "lu_solve")
+                   and not (node.args and 1 <= _square_size(node.args[0], shapes) <= UNROLLED_MAX_SIZE)
+                   for node in walk(function))
 
 
 def _splice(node: ast.AST, calls: set[int], flattener: _Flattener, caller_names: set[str]) -> bool:

@@ -279,6 +279,15 @@ def run(z, tol, n_steps, out):
 
 
 @numba.njit(cache=True)
+def big(z, tol):
+    J = np.empty((9, 9))
+    piv = np.empty(9, dtype=np.int64)
+    w = halve_work()
+    lu_factor(J, piv)
+    halve(z, tol, w)
+
+
+@numba.njit(cache=True)
 def leaks(z, tol):
     w = halve_work()
     halve(z, tol, w)
@@ -292,7 +301,9 @@ def test_a_helper_handed_a_work_tuple_is_inlined_with_one_array_per_entry() -> N
     written computes, and the hand iteration (z = (0, 40), tol = 1): step 0, z0 = 3, five
     halvings (the cap: |z1| = 1.25 still > 1) give 0.09375; step 1, z0 = 3.09375, two halvings
     (|z| <= 1 after the second: the early exit) give 0.7734375; step 2, z0 = 3.7734375, two
-    halvings give 0.943359375. A tuple that leaves the function is left alone."""
+    halvings give 0.943359375. A tuple that leaves the function is left alone, and so is a
+    loop whose own solve stays looped (9 x 9, over the unrolled sizes: its integer pivots keep
+    it off the tape anyway)."""
     from dirac.codegen.flatten import function_text, inline_worked_helpers
 
     text = inline_worked_helpers(_WORKED, function_text(_WORKED, "run") or "")
@@ -309,3 +320,6 @@ def test_a_helper_handed_a_work_tuple_is_inlined_with_one_array_per_entry() -> N
     assert results[0] == results[1]
     assert results[1][1] == [0.09375, 0.7734375, 0.943359375]
     assert inline_worked_helpers(_WORKED, function_text(_WORKED, "leaks") or "") is None
+    assert inline_worked_helpers(_WORKED, function_text(_WORKED, "big") or "") is None
+    small = _WORKED.replace("(9, 9)", "(2, 2)")
+    assert inline_worked_helpers(small, function_text(small, "big") or "") is not None
