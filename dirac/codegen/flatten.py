@@ -742,15 +742,21 @@ def function_text(source: str, name: str) -> str | None:
 
 
 def specialised_function(source: str, name: str, max_size: int | None = None) -> str | None:
-    """The source of function ``name`` of ``source`` with its solves of literal size
+    """The source of function ``name`` of ``source`` with the helpers it hands a tuple of work
+    arrays inlined (:func:`inline_worked_helpers`) and its solves of literal size
     unrolled, followed by the unrolled solves it calls (:func:`specialise_solves` of that
-    one function), or None when it has none. Only this function is parsed: the interpreted
+    one function), or None when it has neither. Only this function is parsed: the interpreted
     tier specialises the functions it runs, when it first runs them, and a module whose
     loops never solve with a fixed matrix (a constant mass) pays nothing."""
     text = function_text(source, name)
-    if text is None or ("lu_factor(" not in text and "lu_solve(" not in text) or "np.empty((" not in text \
-            and "np.zeros((" not in text:
+    if text is None:
         return None
+    inlined = inline_worked_helpers(source, text)
+    if inlined is not None:
+        text = inlined
+    if ("lu_factor(" not in text and "lu_solve(" not in text) or "np.empty((" not in text \
+            and "np.zeros((" not in text:
+        return inlined
     helpers = "".join(t for t in (function_text(source, "lu_factor"), function_text(source, "lu_solve")) if t)
     specialised = specialise_solves(helpers + text, max_size)
     if specialised == helpers + text:
@@ -764,3 +770,291 @@ def specialised_function(source: str, name: str, max_size: int | None = None) ->
     marked = re.sub(r"@numba\.njit\(cache=True\)\ndef (lu_(?:factor|solve)_[0-9]+)\(",
                     r'@numba.njit(cache=True, inline="always")\ndef \1(', text)
     return flatten_source(marked) if marked != text else text
+
+
+def _allocations(function: ast.FunctionDef) -> list[ast.expr] | None:
+    """The arrays a work function ``def f(): return (np.empty(...), ...)`` (or ``return
+    np.empty(...)``) allocates, in order (one for a single array), or None for any other function."""
+    body = _without_docstring(list(function.body))
+    if function.args.args or len(body) != 1 or not isinstance(body[0], ast.Return) or body[0].value is None:
+        return None
+    value = body[0].value
+    parts = list(value.elts) if isinstance(value, ast.Tuple) else [value]
+    for part in parts:
+        if not (isinstance(part, ast.Call) and isinstance(part.func, ast.Attribute)
+                and isinstance(part.func.value, ast.Name) and part.func.value.id == "np"
+                and part.func.attr in ("empty", "zeros")):
+            return None
+    return parts
+
+
+def _returns_as_breaks(body: list[ast.stmt]) -> list[ast.stmt] | None:
+    """``body`` whose bare ``return`` statements all sit in its last statement, a ``for`` loop
+    without ``else``, outside the loops nested in it: with each such return a ``break``
+    (leaving that loop, the last statement, is leaving the function). None otherwise, or when
+    ``body`` has no return there."""
+    if not body or not isinstance(body[-1], ast.For) or body[-1].orelse or _has_return(body[:-1]):
+        return None
+    loop = _copy(body[-1])
+    found = False
+
+    def rewrite(statements: list[ast.stmt]) -> list[ast.stmt] | None:
+        nonlocal found
+        out: list[ast.stmt] = []
+        for statement in statements:
+            if isinstance(statement, ast.Return):
+                if statement.value is not None:
+                    return None
+                found = True
+                out.append(ast.Break())
+                continue
+            if isinstance(statement, (ast.For, ast.While)):
+                if _has_return([statement]):
+                    return None
+            else:
+                for field in ("body", "orelse"):
+                    inner = getattr(statement, field, None)
+                    if isinstance(inner, list) and inner and isinstance(inner[0], ast.stmt):
+                        rewritten = rewrite(inner)
+                        if rewritten is None:
+                            return None
+                        setattr(statement, field, rewritten)
+                if _has_return([statement]) and not isinstance(statement, ast.If):
+                    return None
+            out.append(statement)
+        return out
+
+    loop_body = rewrite(loop.body)
+    if loop_body is None or not found:
+        return None
+    loop.body = loop_body
+    return [*body[:-1], loop]
+
+
+def inline_worked_helpers(source: str, text: str) -> str | None:
+    """``text`` (one function of the flattened module ``source``) with the helpers it hands a
+    tuple of work arrays inlined, for the interpreted tier and the tape only, or None when it
+    has none.
+
+    A step loop allocates a helper's scratch space once, ``w = project_work()`` (a tuple of
+    ``np.empty`` arrays), and calls the helper at each step, ``project(z, t, c, tol, w)``,
+    which unpacks it first, ``phi, y, D, A, piv = w``. The flattening policy
+    (:func:`straight`) keeps such a helper (with loops, over :data:`SMALL` statements) a
+    function, for numba's compile time, and the tape machine translates neither calls nor
+    tuples. Here, in the text the interpreter runs and the tape translates (the compiled
+    source is not touched):
+
+    * ``w = project_work()`` becomes one allocation per array, ``w_phi = np.empty(4)``, ...
+      (the arrays have constant shapes where the work function's are literal);
+    * the helper loses its tuple parameter for one parameter per array (the unpacking goes);
+      a bare ``return`` in the loop that ends it (the projection's test of convergence)
+      becomes a ``break``, which leaves the same statements unrun;
+    * each statement calling it is replaced by its body with its locals renamed
+      (:meth:`_Flattener._instance`, tags above the ``_i<k>_`` already in the text). The
+      function is not tidied again: the interpreter and the tape gain nothing measurable
+      from it, and it cost a fifth of this rewriting's 0.14 s on the Cartesian pendulum.
+
+    The same floating-point operations run in the same order on the same values (the
+    arrays are the same allocations, named apart), so the interpreter, the tape and numba
+    still give the same bits, which tests/codegen/test_tape_tiers.py checks. A work tuple
+    used in any other way, a helper whose returns cannot be made breaks, or a solve that stays
+    looped after the inlining (a matrix over
+    :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`), leaves the text as it is (the tape
+    then declines the loop, as before).
+    """
+    if "_work()" not in text:
+        return None
+    tree = ast.parse(text)
+    function = tree.body[0] if len(tree.body) == 1 and isinstance(tree.body[0], ast.FunctionDef) else None
+    if function is None:
+        return None
+    taken = _loaded_names([function]) | {a.arg for a in function.args.args}
+    # w = f_work() at the top level of the function, w a name bound once
+    works: dict[str, tuple[ast.Assign, list[ast.expr]]] = {}
+    stores: dict[str, int] = {}
+    for node in walk(function):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, (ast.Store, ast.Del)):
+            stores[node.id] = stores.get(node.id, 0) + 1
+    for statement in function.body:
+        if isinstance(statement, ast.Assign) and len(statement.targets) == 1 \
+                and isinstance(statement.targets[0], ast.Name) and stores.get(statement.targets[0].id) == 1 \
+                and isinstance(statement.value, ast.Call) and isinstance(statement.value.func, ast.Name) \
+                and not statement.value.args and not statement.value.keywords:
+            maker = function_text(source, statement.value.func.id)
+            parsed = ast.parse(maker).body[0] if maker is not None else None
+            arrays = _allocations(parsed) if isinstance(parsed, ast.FunctionDef) else None
+            if arrays is not None and len(arrays) > 1:
+                works[statement.targets[0].id] = (statement, arrays)
+    if not works or not _solves_unrolled(function):  # the caller's own solves first (cheap)
+        return None
+    # every use of w: an argument (a plain name) of a statement calling a helper that unpacks it
+    uses = {name: 0 for name in works}
+    for node in walk(function):
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load) and node.id in uses:
+            uses[node.id] += 1
+    helpers: dict[str, ast.FunctionDef] = {}
+    calls: list[tuple[ast.Call, int, str]] = []
+    refused: set[str] = set()
+    for node in walk(function):
+        if not isinstance(node, ast.Call):
+            continue
+        for position, argument in enumerate(node.args):
+            if isinstance(argument, ast.Name) and argument.id in works:
+                uses[argument.id] -= 1
+                callee = node.func.id if isinstance(node.func, ast.Name) else None
+                if callee is None or not _unpacks(source, callee, position, len(works[argument.id][1]), helpers):
+                    refused.add(argument.id)
+                else:
+                    calls.append((node, position, argument.id))
+    statement_calls = {id(s.value) for s in walk(function) if isinstance(s, ast.Expr) and isinstance(s.value, ast.Call)}
+    for call, _, work in calls:
+        if id(call) not in statement_calls:
+            refused.add(work)
+    usable = {w for w in works if w not in refused and uses[w] == 0}
+    calls = [c for c in calls if c[2] in usable]
+    if not calls:
+        return None
+    # one allocation per array, named after the helper's unpacked names
+    named: dict[str, list[str]] = {}
+    for work in usable:
+        statement, arrays = works[work]
+        first = next(c for c in calls if c[2] == work)
+        targets = _unpacked_names(helpers[first[0].func.id], first[1]) or []  # type: ignore[attr-defined]
+        names = []
+        for target in targets:
+            local = f"{work}_{target}"
+            while local in taken:
+                local = "_" + local
+            taken.add(local)
+            names.append(local)
+        named[work] = names
+    new_body: list[ast.stmt] = []
+    for statement in function.body:
+        bound = statement.targets[0].id if isinstance(statement, ast.Assign) \
+            and isinstance(statement.targets[0], ast.Name) else ""
+        if bound in usable:
+            new_body.extend(ast.Assign(targets=[ast.Name(id=local, ctx=ast.Store())], value=_copy(array), lineno=0)
+                            for local, array in zip(named[bound], works[bound][1]))
+        else:
+            new_body.append(statement)
+    function.body = new_body
+    for call, position, work in calls:
+        call.args[position:position + 1] = [ast.Name(id=local, ctx=ast.Load()) for local in named[work]]
+    inline = {call.func.id for call, _, _ in calls}  # type: ignore[attr-defined]
+    flattener = _Flattener(ast.Module(body=[_unpacked_helper(helpers[name]) for name in sorted(inline)],
+                                      type_ignores=[]), lambda helper: helper.name in inline)
+    # fresh locals: a tag above every ``_i<k>_`` the module's own flattening gave the function
+    tags = [int(k) for k in re.findall(r"\b_i([0-9]+)_", text)]
+    flattener.counter = itertools.count(max(tags, default=-1) + 1)
+    caller_names = _stored_names(function.body) | {a.arg for a in function.args.args}
+    if not _splice(function, {id(call) for call, _, _ in calls}, flattener, caller_names):
+        return None  # a call could not be inlined: keep the text as it was (the tape declines it)
+    if not _solves_unrolled(function):
+        # a solve left looped keeps its integer pivots, which the tape declines: the larger text
+        # would only cost its rewriting (the analysed Cartesian double pendulum, z of size 12:
+        # a first 5-step run took 1.1-1.7 s of CPU instead of 0.2-0.35 s, 3 alternating pairs)
+        return None
+    ast.fix_missing_locations(function)
+    return ast.unparse(ast.Module(body=[function], type_ignores=[])) + "\n"
+
+
+def _solves_unrolled(function: ast.FunctionDef) -> bool:
+    """Whether every ``lu_factor`` / ``lu_solve`` of ``function`` works on a matrix that
+    :func:`specialise_solves` unrolls (allocated in it with a literal size up to
+    :data:`~dirac.codegen.small_solves.UNROLLED_MAX_SIZE`)."""
+    from dirac.codegen.small_solves import UNROLLED_MAX_SIZE
+
+    shapes = _matrix_allocations(function)
+    return not any(isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                   and node.func.id in ("lu_factor", "lu_solve")
+                   and not (node.args and 1 <= _square_size(node.args[0], shapes) <= UNROLLED_MAX_SIZE)
+                   for node in walk(function))
+
+
+def _splice(node: ast.AST, calls: set[int], flattener: _Flattener, caller_names: set[str]) -> bool:
+    """Replace, in the statement lists under ``node``, each statement that is one of ``calls``
+    by the called helper's body (:meth:`_Flattener._instance`); False when one cannot be."""
+    for field in ("body", "orelse", "finalbody"):
+        statements = getattr(node, field, None)
+        if not (isinstance(statements, list) and statements and isinstance(statements[0], ast.stmt)):
+            continue
+        out: list[ast.stmt] = []
+        for statement in statements:
+            if isinstance(statement, ast.Expr) and id(statement.value) in calls:
+                call = statement.value
+                assert isinstance(call, ast.Call) and isinstance(call.func, ast.Name)
+                helper = flattener.helpers[call.func.id]
+                instance = None if helper.statements is None else \
+                    flattener._instance(helper, call, caller_names, helper.statements)
+                if instance is None:
+                    return False
+                out.extend(instance[0] or [ast.Pass()])
+                continue
+            if not _splice(statement, calls, flattener, caller_names):
+                return False
+            out.append(statement)
+        setattr(node, field, out)
+    return True
+
+
+def _unpacks(source: str, name: str, position: int, count: int, helpers: dict[str, ast.FunctionDef]) -> bool:
+    """Whether module function ``name`` unpacks its parameter ``position`` into ``count``
+    names at the top of its body (``a, b, ... = work``) and uses it nowhere else, takes no
+    slice (a view, which the tape does not translate), and can be inlined as a statement
+    (its returns, if any, made breaks by :func:`_returns_as_breaks`)."""
+    if name not in helpers:
+        text = function_text(source, name)
+        parsed = ast.parse(text).body[0] if text is not None else None
+        if not isinstance(parsed, ast.FunctionDef):
+            return False
+        helpers[name] = parsed
+    function = helpers[name]
+    if position >= len(function.args.args):
+        return False
+    parameter = function.args.args[position].arg
+    targets = _unpacked_names(function, position)
+    if targets is None or len(targets) != count:
+        return False
+    loads = 0
+    for node in walk(function):
+        if isinstance(node, ast.Slice):
+            # a view (the mechanical field's q = z[:n]) the tape declines anyway: inlined, the
+            # larger text made a first midpoint run of the Cartesian pendulum (1000 steps) cost
+            # 1.16x the CPU of the process (median of 4 fresh pairs; 0.01-0.41 s more)
+            return False
+        if isinstance(node, ast.Name) and node.id == parameter:
+            loads += 1
+    return loads == 1
+
+
+def _unpacked_names(function: ast.FunctionDef, position: int) -> list[str] | None:
+    """The names of ``a, b, ... = p`` at the top level of ``function``, ``p`` its parameter ``position``."""
+    parameter = function.args.args[position].arg
+    for statement in _without_docstring(list(function.body)):
+        if isinstance(statement, ast.Assign) and len(statement.targets) == 1 \
+                and isinstance(statement.targets[0], ast.Tuple) and isinstance(statement.value, ast.Name) \
+                and statement.value.id == parameter \
+                and all(isinstance(e, ast.Name) for e in statement.targets[0].elts):
+            return [e.id for e in statement.targets[0].elts]  # type: ignore[attr-defined]
+    return None
+
+
+def _unpacked_helper(function: ast.FunctionDef) -> ast.FunctionDef:
+    """A copy of ``function`` marked for inlining, one parameter per unpacked work array in
+    place of the tuple, the unpacking removed, and its final loop's returns made breaks."""
+    helper = _copy(function)
+    body = _without_docstring(list(helper.body))
+    for position, argument in enumerate(list(helper.args.args)):
+        names = _unpacked_names(helper, position)
+        if names is None:
+            continue
+        body = [s for s in body if not (isinstance(s, ast.Assign) and isinstance(s.value, ast.Name)
+                                        and s.value.id == argument.arg and isinstance(s.targets[0], ast.Tuple))]
+        helper.args.args[position:position + 1] = [ast.arg(arg=name) for name in names]
+        break
+    if _restructure(body) is None:
+        breaks = _returns_as_breaks(body)
+        body = breaks if breaks is not None else body
+    helper.body = body or [ast.Pass()]
+    helper.decorator_list = [ast.parse(INLINE_MARK + "\ndef f():\n    pass").body[0].decorator_list[0]]  # type: ignore[attr-defined]
+    return helper

@@ -240,3 +240,86 @@ def test_a_choice_on_a_literal_argument_is_folded_to_its_value() -> None:
         assert info.tolist() == [1.0, -3.0]
         module.run(2.5, info)
         assert info.tolist() == [0.0, 5.0]
+
+
+_WORKED = '''"""worked -- generated for a test"""
+import numpy as np
+import numba
+
+
+@numba.njit(cache=True)
+def halve_work():
+    """Work arrays of halve."""
+    return (np.empty(2), np.empty((2, 2)))
+
+
+@numba.njit(cache=True)
+def halve(z, tol, work):
+    """Halve z until its largest entry is at most tol, at most 5 times (a return in the loop)."""
+    y, M = work
+    for _it in range(5):
+        size = 0.0
+        for i in range(2):
+            size = max(size, abs(z[i]))
+        if size <= tol:
+            return
+        for i in range(2):
+            M[i, i] = 0.5
+            y[i] = M[i, i] * z[i]
+            z[i] = y[i]
+
+
+@numba.njit(cache=True)
+def run(z, tol, n_steps, out):
+    w = halve_work()
+    for step in range(n_steps):
+        z[0] += 3.0
+        halve(z, tol, w)
+        out[step] = z[0]
+
+
+@numba.njit(cache=True)
+def big(z, tol):
+    J = np.empty((9, 9))
+    piv = np.empty(9, dtype=np.int64)
+    w = halve_work()
+    lu_factor(J, piv)
+    halve(z, tol, w)
+
+
+@numba.njit(cache=True)
+def leaks(z, tol):
+    w = halve_work()
+    halve(z, tol, w)
+    return w
+'''
+
+
+def test_a_helper_handed_a_work_tuple_is_inlined_with_one_array_per_entry() -> None:
+    """``w = halve_work()`` becomes one allocation per array, ``halve`` is inlined with its
+    ``return`` made a ``break`` of its last loop; the loop then computes what the source as
+    written computes, and the hand iteration (z = (0, 40), tol = 1): step 0, z0 = 3, five
+    halvings (the cap: |z1| = 1.25 still > 1) give 0.09375; step 1, z0 = 3.09375, two halvings
+    (|z| <= 1 after the second: the early exit) give 0.7734375; step 2, z0 = 3.7734375, two
+    halvings give 0.943359375. A tuple that leaves the function is left alone, and so is a
+    loop whose own solve stays looped (9 x 9, over the unrolled sizes: its integer pivots keep
+    it off the tape anyway)."""
+    from dirac.codegen.flatten import function_text, inline_worked_helpers
+
+    text = inline_worked_helpers(_WORKED, function_text(_WORKED, "run") or "")
+    assert text is not None and "halve(" not in text and "halve_work" not in text and "break" in text
+    assert "w_y = np.empty(2)" in text and "w_M = np.empty((2, 2))" in text
+    written = interpret_source(_WORKED)
+    inlined = interpret_source(_WORKED)
+    exec(compile(text, "<inlined>", "exec"), inlined.__dict__)
+    results = []
+    for module in (written, inlined):
+        z, out = np.array([0.0, 40.0]), np.zeros(3)
+        module.run(z, 1.0, 3, out)
+        results.append((z.tolist(), out.tolist()))
+    assert results[0] == results[1]
+    assert results[1][1] == [0.09375, 0.7734375, 0.943359375]
+    assert inline_worked_helpers(_WORKED, function_text(_WORKED, "leaks") or "") is None
+    assert inline_worked_helpers(_WORKED, function_text(_WORKED, "big") or "") is None
+    small = _WORKED.replace("(9, 9)", "(2, 2)")
+    assert inline_worked_helpers(small, function_text(small, "big") or "") is not None

@@ -86,16 +86,19 @@ def test_a_time_dependent_system_runs_on_the_tape_with_the_interpreters_bits(mon
 
 
 
-@pytest.mark.parametrize("model_name", ["relativistic_oscillator", "anharmonic_oscillator", "quartic_oscillator"])
+@pytest.mark.parametrize("model_name", ["relativistic_oscillator", "anharmonic_oscillator", "quartic_oscillator",
+                                        "pendulum_cartesian", "spherical_pendulum"])
 def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bits(model_name: str, monkeypatch) -> None:
     """The implicit midpoint loop of an analysed flow (its Newton matrix of size 2n, factored
     by an unrolled LU whose pivots the interpreted text holds as doubles): the relativistic
     oscillator (its square root of H, the constraints solved out of the flow) and a regular
     anharmonic oscillator ``L = x'^2/2 - k x^2/2 - x^4/4`` and the quartic one without a parameter
     (its loop never reads the empty parameter vector), 500 steps on the three tiers end on
-    the same state, evaluation count and residual. (A flow projected onto second-class
-    constraints after each step calls the projection as a function, and a mechanical
-    system's midpoint loop its field: those keep the two other roads.)"""
+    the same state, evaluation count and residual. Two flows projected onto their
+    second-class constraints after each step (the pendulum in Cartesian coordinates, z of
+    size 6 and 4 constraints; the spherical pendulum, 8 and 4), whose projection numba
+    compiles as a function and the interpreted text inlines
+    (:func:`~dirac.codegen.flatten.inline_worked_helpers`), likewise."""
     import dirac
     from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
     from dirac_systems.latency_models import MODELS
@@ -109,6 +112,13 @@ def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bit
                                                    parameters={"k": 1.5})
         analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
         z0 = np.array([0.5, 0.25])
+    elif model_name == "pendulum_cartesian":
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(MODELS[model_name]().system))
+        z0 = analysed.initial_state({"x": 0.8414709848078965, "y": -0.5403023058681398}, q_dot={"x": 0.0, "y": 0.0})
+    elif model_name == "spherical_pendulum":
+        analysed = AnalysedSystem.from_analysis(dirac.analyze(dirac.load_system(model_name)))
+        z0 = analysed.initial_state({"x": 0.8414709848078965, "y": 0.0, "z": -0.5403023058681398},
+                                    q_dot={"x": 0.0, "y": 1.0, "z": 0.0})
     else:  # no parameters: the loop never reads its (empty) parameter vector
         lagrangian = dirac.Lagrangian.from_strings(model_name, ["x"], "x_dot**2/2 - x**4/4")
         analysed = AnalysedSystem.from_analysis(dirac.analyze(lagrangian))
@@ -118,6 +128,11 @@ def test_the_midpoint_loop_runs_on_the_tape_with_the_interpreters_and_numbas_bit
     from dirac.codegen.tape_source import translate
 
     assert translate(module._texts[name], name, reasons) is not None, reasons
+    if model_name in ("pendulum_cartesian", "spherical_pendulum"):  # numba's text still calls the projection
+        from dirac.codegen.flatten import function_text
+
+        assert "project(z, " in (function_text(module.source, name) or "")
+        assert "project(" not in module._texts[name]
     tape = module.tape_function(name)
     assert tape is not None
     finals = {}
@@ -268,3 +283,45 @@ def test_choose_road_with_a_tape_follows_its_table(interpreted, compile_seconds,
     """choose_road against its table, worked by hand with COMPILE_SECONDS = 1 and WAIT_FACTOR = 2."""
     assert tiers.COMPILE_SECONDS == 1.0 and tiers.WAIT_FACTOR == 2.0
     assert tiers.choose_road(interpreted, compile_seconds, background, tape) == road
+
+
+def test_a_mechanical_midpoint_loop_keeps_its_field_a_call_with_numbas_bits(monkeypatch) -> None:
+    """The midpoint loop of a mechanical system (the Cartesian pendulum, ``ConstrainedProblem``)
+    hands ``field_into`` a tuple of 17 work arrays, but the field takes views ``z[:n]`` (and
+    calls ``dirac_projection``), which the tape does not translate: the interpreted text keeps
+    the call (inlining it only made a first run dearer), the tape declines the loop, and 500
+    steps interpreted end on numba's z and info."""
+    import dirac
+    from dirac.codegen.flatten import function_text
+    from dirac.codegen.tape_source import translate
+    from dirac_systems.latency_models import MODELS
+
+    model = MODELS["pendulum_cartesian"]()
+    problem = ConstrainedProblem(model.system, model.state[:2], model.state[2:])
+    captured: list[tuple[tiers.TieredModule, str, tuple]] = []
+    original = tiers.TieredFunction.run_steps
+
+    def spy(self, steps, planned, *args):
+        if not captured and self.name == "midpoint_run":
+            captured.append((self.module, self.name, tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args)))
+        return original(self, steps, planned, *args)
+
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", spy)
+    monkeypatch.setenv("DIRAC_TAPE", "0")
+    dirac.integrate(problem, "midpoint", dt=1e-3, t_end=0.005)
+    monkeypatch.setattr(tiers.TieredFunction, "run_steps", original)
+    module, name, args = captured[0]
+    assert "field_into(zz, " in (function_text(module.source, name) or "")
+    assert "field_into(zz, " in module._texts[name]
+    reasons: list[str] = []
+    assert translate(module._texts[name], name, reasons) is None and reasons
+    finals = {}
+    for tier, function in {"interpreted": module.interpreted_function(name),
+                           "compiled": getattr(module.compiled, name)}.items():
+        state = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+        state[4] = 500  # midpoint_run(z, t, c, dt, n_steps, tol, max_iter, info)
+        function(*state)
+        finals[tier] = state
+    for position in (0, 7):
+        assert np.array_equal(finals["compiled"][position], finals["interpreted"][position]), position
+    assert finals["compiled"][7][0] == 500 and finals["compiled"][7][1] == 0.0
