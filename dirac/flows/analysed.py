@@ -58,6 +58,12 @@ class AnalysedSystem:
     analysis: ConstraintAnalysis = field(repr=False)
     momenta: Callable[..., np.ndarray] = field(repr=False)
     gauge_multipliers: dict[str, str] = field(default_factory=dict)
+    #: the Hamiltonian of the flow (``H_c`` plus the chosen free multipliers times their constraints), sympy
+    hamiltonian: Any = field(default=sympy.S.Zero, repr=False)
+    #: the second-class constraints ``Phi`` of the flow, sympy
+    constraints: tuple[Any, ...] = field(default=(), repr=False)
+    #: the parameters that take the values ``params`` at run time, in that order (sympy symbols)
+    parameter_symbols: tuple[Any, ...] = field(default=(), repr=False)
 
     @classmethod
     def from_lagrangian(cls, lagrangian: Lagrangian, parameters: Mapping[str, float] | None = None) -> AnalysedSystem:
@@ -149,6 +155,9 @@ class AnalysedSystem:
             analysis=analysis,
             momenta=momenta,
             gauge_multipliers={name: str(v) for name, (v, _) in chosen.items()},
+            hamiltonian=H_flow,
+            constraints=tuple(constraints),
+            parameter_symbols=tuple(defaults),
         )
 
     def energy(self, z: np.ndarray, time: float = 0.0) -> float:

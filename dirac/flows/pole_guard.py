@@ -36,6 +36,16 @@ denominator is read only where the expression grows toward its zero set (:func:`
 function whose derivative has one: only sums, products, positive integer powers, ``sin``,
 ``cos`` and ``exp``) have no guard and run exactly as before, without a symbolic
 derivative taken.
+
+An analysed system (:class:`~dirac.flows.analysed.AnalysedSystem`, the flow on the whole phase
+space) has the same guard over its state ``z`` (:func:`analysed_pole_guard`): the factors of the
+denominators of ``grad H``, of the second-class constraints' gradients and of their time
+derivatives, momenta and multipliers included. When an implicit step fails (its Newton
+iteration) the run stops at the pole if the factor that falls fastest would reach zero within
+:data:`READINGS_PER_APPROACH` steps at the rate of the last interval, or if it falls as
+``(t* - t)^COLLAPSE_EXPONENT`` through the last two readings (that rate is a secant, which lags a
+fall that speeds up); a failed step cannot tell a fall into the pole from a close pass that a
+smaller step resolves, so that message says both.
 """
 
 from __future__ import annotations
@@ -48,12 +58,18 @@ import numpy as np
 
 from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS, built_once
 
-__all__ = ["PoleGuard", "pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH", "REMEDY"]
+__all__ = ["PoleGuard", "pole_guard", "analysed_pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH",
+           "COLLAPSE_EXPONENT", "REMEDY"]
 
 #: readings per predicted approach: the guard is read again after half the steps the fastest-falling factor
 #: needs to reach zero at its last rate (the rate grows near an attracting pole: ``x ~ (t* - t)^(2/3)`` for
 #: ``V = -1/x``, so the linear prediction is too late by a factor 3/2, and half of it comes before the pole)
 READINGS_PER_APPROACH = 2
+
+#: exponent ``a`` of the fastest approach to a pole that a failed step is judged by, ``f ~ (t* - t)^a``: the fall
+#: into an attracting ``1/r`` pole (Kepler's collision orbit: ``r^(3/2) ~ t* - t``) and into ``V = tan(q)`` at
+#: ``cos(q) = 0``; a logarithmic well comes in about linearly (``a`` near 1)
+COLLAPSE_EXPONENT = 2.0 / 3.0
 
 REMEDY = (
     "a smaller step does not cure this: the motion reaches a singularity of its equations (the potential, the "
@@ -112,6 +128,9 @@ class PoleGuard:
         #: steps in which the factor that falls fastest reaches zero at the rate of the last interval (inf: none falls)
         self.steps_to_pole = math.inf
         self._nearest = (0, 0, math.nan)
+        #: steps in which a factor reaches zero if it falls as ``(t* - t)^COLLAPSE_EXPONENT`` (inf: none falls)
+        self.steps_to_collapse = math.inf
+        self._collapsing = (0, 0, math.nan)
 
     def _flat(self, q: np.ndarray, t: float) -> list[float]:
         """The factors' values at a batch of configurations, flat over (member, factor); NaN where undefined."""
@@ -139,7 +158,7 @@ class PoleGuard:
             The initial state is on a pole (a factor is zero there).
         """
         self._last = None
-        self.steps_to_pole = math.inf
+        self.steps_to_pole = self.steps_to_collapse = math.inf
         self.check(q, t, step, GUARD_STEPS)
 
     def check(self, q: np.ndarray, t: float, step: int, steps: int, at: float | None = None) -> int:
@@ -174,6 +193,7 @@ class PoleGuard:
         span = max(steps, 1)
         mean_span = 0.5 * (span + self._span)
         rates, etas, accelerating = [], [], []
+        collapse, collapsing = math.inf, -1
         for i, (f, g) in enumerate(zip(now, last)):
             if f == 0.0 or (f > 0.0 and g < 0.0) or (f < 0.0 and g > 0.0):  # at the pole, or across it
                 # an approach that was slowing down may be a repelling pole the step overshot: hedged
@@ -189,7 +209,14 @@ class PoleGuard:
             rates.append(rate)
             etas.append(b / rate if rate > 0.0 and not turns else math.inf)
             accelerating.append(not change < 0.0)
+            if rate > 0.0 and b > 0.0:  # f ~ (t* - t)^a through both readings: t* - t = span / ((a/b)^(1/a) - 1)
+                left = span / max((a / b) ** (1.0 / COLLAPSE_EXPONENT) - 1.0, 1e-300)
+                if left < collapse:
+                    collapse, collapsing = left, i
         self._rate, self._eta, self._accelerating, self._span = rates, etas, accelerating, span
+        self.steps_to_collapse = collapse
+        if collapsing >= 0:
+            self._collapsing = (collapsing // len(self.factors), collapsing % len(self.factors), now[collapsing])
         self._last, self._last_time, self._last_step = now, t, step
         return self.next_reading(now, span)
 
@@ -218,9 +245,10 @@ class PoleGuard:
         member, k, _ = self._nearest
         return self._accelerating[member * len(self.factors) + k]
 
-    def nearest(self) -> str:
-        """The factor that fell fastest towards zero at the last reading, its value and what it is a denominator of."""
-        member, k, value = self._nearest
+    def nearest(self, collapsing: bool = False) -> str:
+        """The factor that fell fastest towards zero at the last reading (``collapsing``: the one a fall as a power
+        :data:`COLLAPSE_EXPONENT` of the time left brings to zero first), its value and what it is a denominator of."""
+        member, k, value = self._collapsing if collapsing else self._nearest
         who = f" of member {member}" if self._members > 1 else ""
         return f"{self.factors[k]} = {value:.3g}{who}, a denominator of {self.origins[k]}"
 
@@ -280,6 +308,18 @@ def _may_have_poles(exprs: list[Any]) -> bool:
     return False
 
 
+def _rational(expr: Any) -> bool:
+    """Whether ``expr`` is a rational function: sums, products and integer powers of symbols and numbers only."""
+    import sympy
+
+    for node in _nodes(expr):
+        if isinstance(node, sympy.Pow) and not node.exp.is_Integer:
+            return False
+        if isinstance(node, sympy.Function):
+            return False
+    return True
+
+
 def _quotients(expr: Any) -> Any:
     """``expr`` with ``tan``, ``cot``, ``sec``, ``csc`` (and ``tanh``, ``coth``) written as quotients of sines
     and cosines: the same function, whose derivatives show the denominators."""
@@ -320,9 +360,6 @@ def _build(mechanics: Any) -> PoleGuard | None:
     # tan(u) = sin(u)/cos(u) and its kin: their derivatives (1 + tan(u)**2) hide the denominator
     V, M, chis, forces = (_quotients(V), [_quotients(e) for e in M], [_quotients(e) for e in chis],
                           [_quotients(e) for e in forces])
-
-    from dirac.analysis.core.divisors import denominator_factors
-
     sources: list[tuple[str, list[Any]]] = [
         ("the force -dV/dq", [sympy.diff(V, x) for x in q]),
         ("the mass matrix or its derivatives", [*M, *(sympy.diff(e, x) for e in M for x in q)]),
@@ -336,20 +373,34 @@ def _build(mechanics: Any) -> PoleGuard | None:
     if time is not None:
         sources.append(("the time derivative of the potential", [sympy.diff(V, time)]))
     params = list(symbolic.get("parameters") or ())
-    values = dict(zip(params, (float(c) for c in mechanics.params)))
+    return _guard_of(sources, variables, params, np.asarray(mechanics.params, dtype=float), [V, *M, *chis, *forces],
+                     time is not None, skip=velocities)
+
+
+def _guard_of(sources: list[tuple[str, list[Any]]], variables: list[Any], params: list[Any], values: np.ndarray,
+              domain: list[Any], time: bool, skip: set[Any] | frozenset[Any] = frozenset()) -> PoleGuard | None:
+    """The guard of the factors of the denominators of ``sources`` (``(origin, expressions)`` pairs) that can vanish
+    and make an expression unbounded, compiled as one function of ``variables`` (the time last when ``time``) and
+    ``params`` (at ``values``); ``None`` when there is none. Factors in a symbol of ``skip`` are not read;
+    ``domain`` holds the expressions whose logarithms and roots bound the real domain."""
+    import sympy
+
+    from dirac.analysis.core.divisors import denominator_factors
+
+    at = dict(zip(params, (float(c) for c in values)))
     found: dict[Any, list[str]] = {}
     for origin, exprs in sources:
         for e in exprs:
             e = sympy.sympify(e)
             for f in denominator_factors(e, variables):
-                if f.free_symbols & velocities:
+                if f.free_symbols & skip:
                     continue  # a factor in the velocities is not read (module docstring)
-                if origin in found.get(f, []) or not _unbounded_at(e, f, variables, values):
+                if origin in found.get(f, []) or not _unbounded_at(e, f, variables, at):
                     continue  # already found, or e stays bounded where f vanishes (sin(x)/x at x = 0)
                 found.setdefault(f, []).append(origin)
     if not found:
         return None
-    bounds = _domain_bounds([V, *M, *chis, *forces], variables)
+    bounds = _domain_bounds(domain, variables)
     from dirac.codegen.scalar_backend import scalar_function
 
     factors = list(found)
@@ -358,9 +409,48 @@ def _build(mechanics: Any) -> PoleGuard | None:
     except Exception:  # an unusual function: no guard (the run is as before)  # noqa: BLE001
         return None
     guard = PoleGuard(compiled, [str(f) for f in factors], [" and of ".join(found[f]) for f in factors],
-                      time is not None, mechanics.params, [f in bounds for f in factors])
+                      time, values, [f in bounds for f in factors])
     guard.expressions = factors
     return guard
+
+
+def _build_analysed(analysed: Any) -> PoleGuard | None:
+    """The guard of an :class:`~dirac.flows.analysed.AnalysedSystem`, over its whole phase space ``z``, or ``None``.
+
+    Its flow ``z_dot = J grad H - J grad Phi^T C^{-1} (grad Phi J grad H + d_t Phi)``
+    (:mod:`dirac.flows.analysed`) evaluates ``grad H``, ``grad Phi`` and ``d_t Phi``; the
+    factors of their denominators are the poles read (in the coordinates, the multipliers
+    and the momenta alike: the state is all of ``z``). Where ``C`` alone becomes singular
+    the structure of the constraints changes; that is not a pole of an expression, and the
+    midpoint step's own solve reports it.
+    """
+    import sympy
+
+    analysis = analysed.analysis
+    z = list(analysis.phase_space)
+    time = getattr(analysis, "time", None)
+    variables = [*z, *([time] if time is not None else [])]
+    H = sympy.sympify(analysed.hamiltonian)
+    constraints = [sympy.sympify(c) for c in analysed.constraints]
+    if not _may_have_poles([H, *constraints]):
+        return None  # polynomials in z, sines, cosines and exponentials: no denominator anywhere
+    H, constraints = _quotients(H), [_quotients(c) for c in constraints]
+
+    def derivatives(e: Any, by: list[Any]) -> list[Any]:
+        # a rational function's derivatives have the factors of its own reduced denominator, d(a/b) = (a' b - a b')/b^2:
+        # it is read as it is (differentiating the constraints of the rigid body's (228), 24 x 30 derivatives,
+        # took 100 s of sympy)
+        return [e] if _rational(e) else [sympy.diff(e, x) for x in by]
+
+    sources: list[tuple[str, list[Any]]] = [("the gradient of the Hamiltonian", derivatives(H, z))]
+    if constraints:
+        sources.append(("the gradients of the second-class constraints",
+                        [d for c in constraints for d in derivatives(c, z)]))
+        if time is not None:
+            sources.append(("the time derivatives of the second-class constraints",
+                            [d for c in constraints for d in derivatives(c, [time])]))
+    return _guard_of(sources, variables, list(analysed.parameter_symbols), np.asarray(analysed.params, dtype=float),
+                     [H, *constraints], time is not None)
 
 
 #: points of ``f = 0`` at which an expression's growth toward the zero set is measured
@@ -455,13 +545,23 @@ def pole_guard(mechanics: Any) -> PoleGuard | None:
     The factors are found and compiled once per system (kept on it); each call gives a guard
     with no reading yet.
     """
-    cached = built_once(mechanics, "_pole_guard", _build)
+    return _fresh(built_once(mechanics, "_pole_guard", _build))
+
+
+def _fresh(cached: Any) -> PoleGuard | None:
+    """A guard with no reading yet of the factors of ``cached`` (a guard built once), or ``None``."""
     if not isinstance(cached, PoleGuard):
         return None
     guard = PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
                       cached.bounds)
     guard.expressions = cached.expressions
     return guard
+
+
+def analysed_pole_guard(analysed: Any) -> PoleGuard | None:
+    """A fresh :class:`PoleGuard` of an :class:`~dirac.flows.analysed.AnalysedSystem` for one run (read at its
+    state ``z``), or ``None``; built once per system, as :func:`pole_guard`."""
+    return _fresh(built_once(analysed, "_pole_guard", _build_analysed))
 
 
 def message(system: str, crossing: PoleCrossing, method: str) -> str:

@@ -243,3 +243,46 @@ def test_a_pole_under_a_root_is_still_a_pole():
     root = dirac.Lagrangian.from_strings("quarter", ["x"], "x_dot**2/2 + (x**2)**(1/4)", [], parameters={})
     guard = pole_guard(ConstrainedProblem(root, q0=[1.0], qdot0=[0.0]).mechanics)
     assert guard is not None and guard.factors == ["Abs(x)"]
+
+
+#: ``V = -1/x`` from ``x = 1`` at rest reaches ``x = 0`` at ``t* = pi / (2 sqrt(2))`` (by hand: the radial
+#: Kepler fall, ``t* = (pi/2) sqrt(x0^3 / (2 k))`` with ``k = 1``)
+T_FALL = math.pi / (2.0 * math.sqrt(2.0))
+
+
+def _fall(road: str, potential: str = "-1/x"):
+    L = dirac.Lagrangian.from_strings("fall", ["x"], f"x_dot**2/2 - ({potential})", [], parameters={})
+    if road == "constrained":
+        return ConstrainedProblem(L, q0=[1.0], qdot0=[0.0])
+    from dirac.flows.analysed import AnalysedProblem, AnalysedSystem
+
+    analysed = AnalysedSystem.from_analysis(dirac.analyze(L))
+    return AnalysedProblem(analysed, analysed.initial_state({"x": 1.0}, q_dot={"x": 0.0}))
+
+
+@pytest.mark.parametrize("road", ["constrained", "analysed"])
+def test_a_failed_step_in_a_fall_into_a_1_over_r_pole_names_the_pole(road):
+    """``V = -1/x`` from ``x = 1`` at rest with ``midpoint``, ``dt = 0.01``: the Newton iteration fails at
+    ``x = 0.078``, about one step before ``t*`` (module constant), where the rate of the last steps (a
+    secant, which lags the fall ``x ~ (t* - t)^(2/3)``) put the pole three steps away and the run used to
+    stop with "reduce dt". It stops with a PoleError at the step before ``t*``, judged by that fall, and
+    with the hedge that a smaller step resolves a turn before the pole."""
+    with pytest.raises(PoleError, match=r"falls as \(t\* - t\)\^0\.67") as caught:
+        integrate(_fall(road), "midpoint", t_end=3.0, dt=0.01, samples=7)
+    text = str(caught.value)
+    failed = float(text.split("a step failed at t = ")[1].split(" ")[0])
+    assert failed <= T_FALL <= failed + 2 * 0.01
+    assert "pole of the equations of motion (x = " in text and "a smaller dt resolves the turn" in text
+
+
+def test_a_close_pass_a_step_fails_at_is_named_with_the_smaller_step():
+    """``V = -1/x + 0.01/x^2`` from ``x = 1`` at rest: energy ``-0.99`` turns the motion at
+    ``x_min = (1 - sqrt(1 - 0.0396)) / 1.98 = 0.0101`` (by hand), a close pass, not a fall into ``x = 0``.
+    With ``dt = 0.01`` the midpoint step fails next to it; the PoleError hedges that a smaller step
+    resolves a turn, and with ``dt = 1e-4`` the run passes and keeps the energy to 1e-6."""
+    with pytest.raises(PoleError, match=r"a step failed at t = .* next to a pole") as caught:
+        integrate(_fall("constrained", "-1/x + 0.01/x**2"), "midpoint", t_end=1.5, dt=0.01, samples=4)
+    assert "a smaller dt resolves the turn" in str(caught.value)
+    solution = integrate(_fall("constrained", "-1/x + 0.01/x**2"), "midpoint", t_end=1.5, dt=1e-4, samples=4)
+    assert solution.complete
+    assert np.max(np.abs(solution.outputs["energy"] + 0.99)) < 1e-6
