@@ -308,6 +308,13 @@ def _may_have_poles(exprs: list[Any]) -> bool:
     return False
 
 
+def _definite(f: Any, values: dict[Any, float]) -> bool:
+    """Whether sympy shows ``f`` (the parameters at ``values``) positive or negative for all real values of its
+    symbols (declared real): a factor with no real zero, which no motion reaches."""
+    fixed = f.subs({k: v for k, v in values.items() if k in f.free_symbols})
+    return bool(fixed.is_positive) or bool(fixed.is_negative)
+
+
 def _rational(expr: Any) -> bool:
     """Whether ``expr`` is a rational function: sums, products and integer powers of symbols and numbers only."""
     import sympy
@@ -395,8 +402,10 @@ def _guard_of(sources: list[tuple[str, list[Any]]], variables: list[Any], params
             for f in denominator_factors(e, variables):
                 if f.free_symbols & skip:
                     continue  # a factor in the velocities is not read (module docstring)
-                if origin in found.get(f, []) or not _unbounded_at(e, f, variables, at):
-                    continue  # already found, or e stays bounded where f vanishes (sin(x)/x at x = 0)
+                if origin in found.get(f, []) or _definite(f, at) or not _unbounded_at(e, f, variables, at):
+                    # already found, a factor of one sign on real values (c**2*m**2 + p**2 of a relativistic
+                    # particle: no zero to reach), or e stays bounded where f vanishes (sin(x)/x at x = 0)
+                    continue
                 found.setdefault(f, []).append(origin)
     if not found:
         return None

@@ -100,3 +100,12 @@ def test_a_pole_the_analysed_motion_stays_away_from_changes_no_bit(monkeypatch):
 def test_an_analysed_system_without_denominators_has_no_guard():
     """The harmonic oscillator: ``grad H`` is linear, so no guard (and no derivative is taken)."""
     assert analysed_pole_guard(_analysed("x_dot**2/2 - x**2/2")) is None
+
+
+def test_a_denominator_without_a_real_zero_is_not_read():
+    """The relativistic oscillator ``L = -m c^2 sqrt(1 - x_dot^2/c^2) - k x^2/2``: ``H = sqrt(p^2 c^2 + m^2 c^4)
+    + k x^2/2`` and ``dH/dp = p c^2 / sqrt(p^2 c^2 + m^2 c^4)``, whose denominator ``c^2 m^2 + p_x^2`` (with
+    the values of ``m`` and ``c``) is positive for every real ``p_x``: no motion reaches a zero of it, so
+    there is nothing to read and no guard."""
+    analysed = _analysed("-m*c**2*sqrt(1 - x_dot**2/c**2) - k*x**2/2", {"m": 1.0, "c": 1.0, "k": 1.0})
+    assert analysed_pole_guard(analysed) is None
