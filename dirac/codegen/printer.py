@@ -145,6 +145,51 @@ def input_name(symbol: sympy.Symbol, index: int, taken: set[str]) -> str:
     return f"a{index}_"
 
 
+#: an expression of more distinct sub-expressions than this is left as it is by the preprocessing of cse's "basic"
+#: optimizations (sympy's ``factor_terms`` and its sign normalisation), whose cost grows much faster than the size:
+#: compiling the analysed flow of the rigid body's (228) (``AnalysedSystem.from_analysis``) spent 145 s of its 187 s
+#: in ``factor_terms``, all of it on the 241 of its 1054 expressions above 100 such nodes (0.6 s each); with the
+#: bound it took 31 s. The kernels of the latency corpus (at most 46 nodes an expression) and of (78) (89) are
+#: printed as before; (19)'s expressions above 100 nodes (up to 190) are shared unfactored.
+BASIC_CSE_NODES = 100
+
+
+def _within(expr: sympy.Basic, limit: int) -> bool:
+    """Whether ``expr`` has at most ``limit`` distinct sub-expressions (one walk, stopped at the limit)."""
+    seen: set[sympy.Basic] = set()
+    stack = [expr]
+    while stack:
+        node = stack.pop()
+        if node in seen:
+            continue
+        seen.add(node)
+        if len(seen) > limit:
+            return False
+        stack.extend(node.args)
+    return True
+
+
+def _bounded(pre: Any) -> Any:
+    """``pre`` (a preprocessor of :func:`sympy.cse`) for expressions within :data:`BASIC_CSE_NODES`, else identity."""
+
+    def run(expr: sympy.Basic) -> sympy.Basic:
+        return pre(expr) if _within(expr, BASIC_CSE_NODES) else expr
+
+    return run
+
+
+def _basic_optimizations() -> list[tuple[Any, Any]]:
+    """sympy's ``optimizations="basic"`` of :func:`sympy.cse`, each preprocessor bounded by :func:`_bounded`
+    (the postprocessor only undoes the marks the sign normalisation leaves, so it runs as it is)."""
+    from importlib import import_module
+
+    cse_main = import_module("sympy.simplify.cse_main")  # sympy.simplify is also a function's name
+    return [(None if pre is None else _bounded(pre), post) for pre, post in cse_main.basic_optimizations]
+
+
+_BOUNDED_BASIC = _basic_optimizations()
+
+
 def flat_expressions(expressions: Iterable[object]) -> list[sympy.Expr]:
     """The expressions as a flat list (a matrix in C order, i.e. row by row)."""
     return [sympy.sympify(e) for e in expressions]
@@ -205,7 +250,8 @@ def straight_line(
         return StraightLineCode((), tuple(printer.doprint(e) for e in flat_expressions(localised)))
     if target == "math":
         outputs = flat_expressions(localised)
-        replacements, reduced = sympy.cse(outputs, symbols=sympy.numbered_symbols("t", real=True), optimizations="basic")
+        replacements, reduced = sympy.cse(outputs, symbols=sympy.numbered_symbols("t", real=True),
+                                          optimizations=_BOUNDED_BASIC)
     else:  # lambdify's cse=True
         replacements, reduced = sympy.cse(localised, list=False)
     assignments = tuple((symbol.name, printer.doprint(value)) for symbol, value in replacements)

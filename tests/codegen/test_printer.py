@@ -64,3 +64,25 @@ def test_unknown_target_and_sharing_are_named():
         straight_line(INPUTS, [x], "fortran", "cse")  # type: ignore[arg-type]  # an unknown target, on purpose
     with pytest.raises(ValueError, match="sharing"):
         straight_line(INPUTS, [x], "math", "global")  # type: ignore[arg-type]  # an unknown sharing mode, on purpose
+
+
+def test_a_large_expression_skips_the_basic_preprocessing_and_keeps_its_value(monkeypatch):
+    """cse's "basic" preprocessing (sympy's ``factor_terms`` and its sign normalisation) runs on expressions
+    within ``BASIC_CSE_NODES`` distinct sub-expressions only; a larger one is shared as it is. With the limit
+    lowered below the size of ``x*y - x*y**2`` (8 distinct nodes: the sum, two products, a power, ``x``, ``y``,
+    ``-1``, ``2``), ``factor_terms`` no longer pulls out ``x*y``; the printed code evaluates to the
+    expression's value either way."""
+    import math
+
+    import dirac.codegen.printer as printer
+
+    expr = x * y - x * y**2
+    assert printer._within(expr, 8) and not printer._within(expr, 7)
+    whole = straight_line(INPUTS, [expr], "math", "cse")
+    assert whole.outputs == ("a0*a1*(1.0 - a1)",)
+    monkeypatch.setattr(printer, "BASIC_CSE_NODES", 7)
+    plain = straight_line(INPUTS, [expr], "math", "cse")
+    assert plain.outputs == ("-a0*((a1)*(a1)) + a0*a1",)
+    for code in (whole, plain):
+        value = eval(code.outputs[0], {"math": math, "a0": 0.7, "a1": -1.3})  # noqa: S307 (generated from sympy)
+        assert value == pytest.approx(0.7 * -1.3 - 0.7 * 1.69, rel=1e-15)
