@@ -198,12 +198,14 @@ def grad_potential(q, t, c, out):
     inputs.update({s: f"c[{k}]" for k, s in enumerate(parameters)})
     if time is not None:
         inputs[time] = "t"
-    code = straight_line(inputs, [potential, *inverse_mass_diagonal], "math", "cse", "potential")
+    # two codes: inverse_mass has no q, so it cannot run the potential's shared sub-expressions
+    code = straight_line(inputs, [potential], "math", "cse", "potential")
     out.append("\n@numba.njit(cache=True)\ndef potential(q, t, c):\n    \"\"\"V(q, t).\"\"\"\n"
                + "\n".join(code.body()) + f"\n    return {code.outputs[0]}\n")
+    code = straight_line(inputs, list(inverse_mass_diagonal), "math", "cse", "the inverse mass")
     out.append("\n@numba.njit(cache=True)\ndef inverse_mass(c, out):\n    \"\"\"The diagonal of M^{-1}, (n,).\"\"\"\n"
                + "\n".join(code.body()) + "\n"
-               + "\n".join(f"    out[{i}] = {value}" for i, value in enumerate(code.outputs[1:])) + "\n")
+               + "\n".join(f"    out[{i}] = {value}" for i, value in enumerate(code.outputs)) + "\n")
     # ------------------------------------------------------------ pairs of rows sharing a column: J's pattern
     rows_of: dict[int, list[tuple[int, int]]] = {}
     for a, cols in enumerate(columns[:m]):
