@@ -186,6 +186,9 @@ class RankUse:
     surface: Sequence[sympy.Expr] | None = None
     #: the free symbols of ``block`` when the caller knows them (a walk of a large block's shared sub-trees is not free)
     symbols: frozenset | None = None
+    #: ``matrix`` is a bracket matrix (``C_ba = -C_ab``, zero diagonal): the numeric scan evaluates the entries above
+    #: its diagonal only (:mod:`dirac.analysis.core.antisymmetric`)
+    antisymmetric: bool = False
 
     def block_symbols(self) -> frozenset:
         """The free symbols of ``block`` (:func:`~dirac.analysis.core.phase_space.free_symbols_of`)."""
@@ -510,6 +513,37 @@ class _Scanner:
         self.entries = list(use.matrix)
         self.numerics = (Numerics(space, generic, seed=seed, time=time) if compiled is None
                          else compiled.sharing_compiled(generic, seed))
+        #: the positions above the diagonal, whose entries alone are evaluated for an antisymmetric matrix
+        self.upper: tuple[np.ndarray, np.ndarray] | None = None
+        k, columns = use.matrix.shape
+        if use.antisymmetric and k == columns and all(use.matrix[i, i] == 0 for i in range(k)):
+            self.upper = np.triu_indices(k, 1)
+
+    def _values(self, points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The term sizes and the values of the matrix's entries at ``points`` (rows: points; entries in row-major order).
+
+        For an antisymmetric matrix the entries above the diagonal are evaluated, and those
+        below are their mirrors negated with their mirrors' sizes; the diagonal's zeros
+        have size 1 and value 0, as :meth:`~dirac.analysis.core.numeric.Numerics.term_scale`
+        and :meth:`~dirac.analysis.core.numeric.Numerics.evaluate` give them for a zero.
+        """
+        numerics = self.numerics
+        if self.upper is None:
+            scales = numerics.term_scale(self.entries, points)  # first: the values below come with the sizes
+            return scales, numerics.evaluate(self.entries, points)
+        matrix = self.use.matrix
+        rows, cols = self.upper
+        above = [matrix[int(i), int(j)] for i, j in zip(rows, cols)]
+        upper_scales = numerics.term_scale(above, points)  # first: the values below come with the sizes
+        upper_values = numerics.evaluate(above, points)
+        k = matrix.shape[0]
+        scales = np.ones((len(points), k, k))
+        values = np.zeros((len(points), k, k))
+        scales[:, rows, cols] = upper_scales
+        scales[:, cols, rows] = upper_scales
+        values[:, rows, cols] = upper_values
+        values[:, cols, rows] = -upper_values
+        return scales.reshape(len(points), k * k), values.reshape(len(points), k * k)
 
     def rank(self, p: sympy.Symbol, value: float) -> int | None:
         """Rank with ``p = value`` (others generic); ``UNDEFINED`` where the entries are not finite; None: no surface point."""
@@ -528,8 +562,7 @@ class _Scanner:
                 return None
         else:
             points = [numerics.random_point() for _ in range(SCAN_POINTS)]
-        scales = numerics.term_scale(self.entries, points)  # first: the values below come with the sizes
-        values = numerics.evaluate(self.entries, points)
+        scales, values = self._values(points)
         ranks = []
         for v, sc in zip(values, scales):
             if not (np.all(np.isfinite(v)) and np.all(np.isfinite(sc))):
