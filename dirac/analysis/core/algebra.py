@@ -394,7 +394,7 @@ def tidy(expr: sympy.Expr, variables: Sequence[sympy.Symbol] = (), sign: bool = 
             reduced = value.numer, value.denom
         num = _poly_to_expr(reduced[0], variables, others, back)
         den = _poly_to_expr(reduced[1], variables, others, back)
-        if den.could_extract_minus_sign():
+        if _minus_sign_first(den):
             num, den = -num, -den
         out = num / sympy.factor(den) if den != 1 else num
     if sign and _minus_sign_first(out):
@@ -415,7 +415,7 @@ def _minus_sign_first(expr: sympy.Expr) -> bool:
     """
     if not expr.is_Add:
         return expr.could_extract_minus_sign()
-    negative = sum(1 for a in expr.args if a.could_extract_minus_sign())
+    negative = sum(1 for a in expr.args if _negative_term(a))
     positive = len(expr.args) - negative
     if positive != negative:
         return positive < negative
@@ -423,6 +423,23 @@ def _minus_sign_first(expr: sympy.Expr) -> bool:
         return expr.could_extract_minus_sign()
     first = expr.as_ordered_terms()[0]
     return bool(sympy.default_sort_key(first) < sympy.default_sort_key(-first))
+
+
+def _negative_term(term: sympy.Expr) -> bool:
+    """``term.could_extract_minus_sign()`` for a term of a sum, a product's answer without building ``-term``.
+
+    sympy's ``Mul.could_extract_minus_sign`` is ``False`` when ``term == -term``, else
+    whether the leading argument is a negative number; it builds ``-term`` (a flatten of
+    the product) to compare, about 45 microseconds a term: 0.12 s of (19)'s analysis,
+    measured in a fresh process. A product whose leading argument is a negative number
+    (a rational, a float, ``-oo``) is never its own negative (the negation changes that
+    coefficient), and one whose leading argument is not is ``False`` either way; so the
+    leading argument alone answers. Other terms ask sympy.
+    """
+    if term.is_Mul:
+        lead = term.args[0]
+        return bool(lead.is_Number and lead.is_extended_negative)
+    return bool(term.could_extract_minus_sign())
 
 
 def negated(expr: sympy.Expr) -> sympy.Expr:
