@@ -343,7 +343,58 @@ def _reduced_product(work: sympy.Expr, gens: Mapping, ring: PolyRing) -> tuple[A
         return None
     if not denom:
         return None  # a division by zero: the field raises it
-    return numer.cancel(denom)
+    return _cancelled(numer, denom)
+
+
+def _cancelled(numer: Any, denom: Any) -> tuple[Any, Any]:
+    """``numer.cancel(denom)`` (sparse polynomials over ``QQ``), the common factor found in the denominator's generators.
+
+    A common factor of ``numer`` and ``denom`` is a polynomial in the generators ``Y``
+    that ``denom`` contains; written ``numer = sum_m c_m(Y) X^m`` over the other
+    generators ``X``, it divides ``numer`` exactly when it divides every ``c_m`` (the
+    monomials ``X^m`` are independent over ``K[Y]``). So ``gcd(numer, denom) = gcd(denom,
+    c_1, c_2, ...)`` over ``ZZ[Y]`` (after clearing denominators), stopping at a unit.
+    ``cancel`` computes the same gcd in the ring of all the generators, where sympy's
+    heuristic gcd evaluates one generator after another and builds a ring for each
+    (PolyRing code generation): on the multipliers of (78), 30 generators, 0.17 s of the
+    report's 0.75 s, against a ring of the few generators of the denominator here. The
+    gcd is the same up to its sign, so the cofactors are, and the pair is made canonical
+    as ``cancel`` makes it (integer contents, the denominator's leading coefficient
+    positive): the same ``(p, q)``.
+    """
+    ring = numer.ring
+    domain = ring.domain
+    if not numer or not domain.is_QQ:
+        return numer.cancel(denom)
+    in_denominator = sorted({i for monom in denom.itermonoms() for i, e in enumerate(monom) if e})
+    if len(in_denominator) == ring.ngens:
+        return numer.cancel(denom)
+    integers = ring.clone(domain=domain.get_ring())
+    cq, f = numer.clear_denoms()
+    cp, g = denom.clear_denoms()
+    f = f.set_ring(integers)
+    g = g.set_ring(integers)
+    small = PolyRing([ring.symbols[i] for i in in_denominator], integers.domain)
+    outside = [i for i in range(ring.ngens) if i not in set(in_denominator)]
+    coefficients: dict[tuple, dict] = {}
+    for monom, c in f.iterterms():
+        inner = tuple(monom[i] for i in in_denominator)
+        coefficients.setdefault(tuple(monom[i] for i in outside), {})[inner] = c
+    h = small.from_dict({tuple(monom[i] for i in in_denominator): c for monom, c in g.iterterms()})
+    for terms in coefficients.values():
+        h = h.gcd(small.from_dict(terms))
+        if h.is_ground and abs(h.LC) == 1:  # a unit: nothing is common
+            break
+    common = integers.from_dict(
+        {tuple(monom[in_denominator.index(i)] if i in in_denominator else 0 for i in range(ring.ngens)): c for monom, c in h.iterterms()}
+    )
+    p, q = (f, g) if common == integers.one else (f.exquo(common), g.exquo(common))
+    _, cp, cq = integers.domain.cofactors(cp, cq)
+    p = p.set_ring(ring).mul_ground(cp)
+    q = q.set_ring(ring).mul_ground(cq)
+    if domain.canonical_unit(q.LC) == -domain.one:
+        p, q = -p, -q
+    return p, q
 
 
 #: sums of more terms than this are expanded term by term (:func:`_tidy_by_term`)

@@ -67,3 +67,42 @@ def test_a_sum_of_fractions_is_left_to_the_field() -> None:
     expr = x / y + y / x
     assert _reduced_product(expr, dict(zip(gens, ring.gens)), ring) is None
     assert tidy(expr, [x, y]) == (x**2 + y**2) / (x * y)
+
+
+def test_cancelled_gives_the_pair_of_sympys_cancel():
+    """``_cancelled`` returns the very pair of sympy's ``cancel`` on random fractions with common factors.
+
+    The factors are polynomials in a few generators (those of the denominator), with
+    integer and rational contents and both signs, times numerators in more generators.
+    """
+    import random
+
+    from sympy.polys.rings import PolyRing
+
+    from dirac.analysis.core.algebra import _cancelled
+
+    rnd = random.Random(1)
+    ring = PolyRing(sympy.symbols("g0:7"), sympy.QQ)
+
+    def polynomial(terms, gens, degree=2):
+        out = ring.zero
+        for _ in range(terms):
+            term = ring(sympy.QQ(rnd.randint(-5, 5), rnd.randint(1, 4)))
+            for g in gens:
+                term *= g ** rnd.randint(0, degree)
+            out += term
+        return out
+
+    compared = cancelled = 0
+    for _ in range(300):
+        few = rnd.sample(ring.gens, rnd.randint(1, 3))
+        common = (polynomial(rnd.randint(1, 3), few) or ring.one) * rnd.choice([1, 2, -3, sympy.QQ(1, 2)])
+        numer = polynomial(rnd.randint(1, 6), ring.gens[: rnd.randint(2, 7)]) * common
+        denom = polynomial(rnd.randint(1, 3), few) * common * rnd.choice([1, -1, 6])
+        if not numer or not denom:
+            continue
+        expected = numer.cancel(denom)
+        assert _cancelled(numer, denom) == expected, (numer, denom)
+        compared += 1
+        cancelled += expected[1] != denom
+    assert compared > 250 and cancelled > 100  # most had a factor to cancel
