@@ -106,3 +106,38 @@ def test_cancelled_gives_the_pair_of_sympys_cancel():
         compared += 1
         cancelled += expected[1] != denom
     assert compared > 250 and cancelled > 100  # most had a factor to cancel
+
+
+def _split_by_whole_walk(expr, variables):
+    """The former walk of :func:`_split_denominators`: every tree node by ``sympy.preorder_traversal``."""
+    replacements: dict = {}
+    back: dict = {}
+    for node in sympy.preorder_traversal(expr):
+        if node.is_Pow and node.exp.is_Integer and node.exp < 0 and not (node.base.free_symbols & variables):
+            base = node.base
+            if base not in back.values():
+                back[sympy.Dummy(f"d{len(back)}")] = base
+            d = next(k for k, v in back.items() if v == base)
+            replacements[node] = d ** int(-node.exp)
+    if not replacements:
+        return expr, {}, []
+    return expr.xreplace(replacements), {d: 1 / v for d, v in back.items()}, list(back)
+
+
+def test_denominators_are_split_as_a_walk_of_the_whole_tree_splits_them():
+    import random
+
+    from dirac.analysis.core.algebra import _split_denominators
+
+    rnd = random.Random(3)
+    m, g, k = sympy.symbols("m g k", positive=True)
+    pieces = [x, y, x * y, x + y, 1 / m, 1 / (m + g), g / (k - m) ** 2, x / (m * g), (x + 1) / (k + 1), 1 / x]
+    for _ in range(200):
+        shared = sympy.Add(*rnd.sample(pieces, 3)) * rnd.choice(pieces)
+        expr = sympy.Add(*[rnd.choice(pieces) * shared ** rnd.randint(1, 2) + rnd.choice(pieces) for _ in range(rnd.randint(1, 4))])
+        new, old = _split_denominators(expr, {x, y}), _split_by_whole_walk(expr, {x, y})
+        named = [{d: sympy.Symbol(f"D{i}") for i, d in enumerate(found[2])} for found in (new, old)]
+        assert len(new[2]) == len(old[2])
+        assert new[0].xreplace(named[0]) == old[0].xreplace(named[1])
+        assert {named[0][d]: v for d, v in new[1].items()} == {named[1][d]: v for d, v in old[1].items()}
+        assert [d.name for d in new[2]] == [d.name for d in old[2]]
