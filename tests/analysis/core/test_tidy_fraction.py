@@ -106,6 +106,9 @@ def test_cancelled_gives_the_pair_of_sympys_cancel():
         compared += 1
         cancelled += expected[1] != denom
     assert compared > 250 and cancelled > 100  # most had a factor to cancel
+    g0, g1 = ring.gens[:2]
+    for numer, denom in [(g0 * g1 + 1, ring(2)), (g0 * g1 / 3 + 1, ring(sympy.QQ(-4, 3))), (2 * g0, ring.one)]:
+        assert _cancelled(numer, denom) == numer.cancel(denom)  # constant denominators: contents and sign only
 
 
 def _split_by_whole_walk(expr, variables):
