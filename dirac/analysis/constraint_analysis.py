@@ -495,7 +495,7 @@ class ConstraintAnalysis:
                                     symbols=free_symbols_of(A[P, Q], memo)))
         if second and involves(C[second, second]):
             uses.append(RankUse("bracket matrix C", C[second, second], C, len(second), on_surface=True,
-                                symbols=free_symbols_of(C[second, second], memo)))
+                                symbols=free_symbols_of(C[second, second], memo), antisymmetric=True))
         found, skipped = special_parameter_values(
             space, self._generic, uses, lambda sub: [c.subs(sub) for c in everything], seed, time=self.time,
             compiled=self._numerics, starts=chain.points,

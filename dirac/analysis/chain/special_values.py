@@ -35,8 +35,9 @@ values :data:`SCAN_VALUES` instead, and a note says what was not searched.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import sympy
@@ -186,6 +187,9 @@ class RankUse:
     surface: Sequence[sympy.Expr] | None = None
     #: the free symbols of ``block`` when the caller knows them (a walk of a large block's shared sub-trees is not free)
     symbols: frozenset | None = None
+    #: ``matrix`` is a bracket matrix (``C_ba = -C_ab``, zero diagonal): the numeric scan evaluates the entries above
+    #: its diagonal only (:mod:`dirac.analysis.core.antisymmetric`)
+    antisymmetric: bool = False
 
     def block_symbols(self) -> frozenset:
         """The free symbols of ``block`` (:func:`~dirac.analysis.core.phase_space.free_symbols_of`)."""
@@ -368,6 +372,48 @@ def _candidates(
     return found
 
 
+class _Projections:
+    """Surface points found by the scan of one rank decision, handed to the next one that asks for the same.
+
+    The decisions on the final surface (the consistency matrix ``{Phi_a, phi_k}`` and the
+    bracket matrix ``C``) are scanned at the same parameter values onto the same
+    constraints, each with a :class:`~dirac.analysis.core.numeric.Numerics` of the same
+    seed, in the same order: their projections are the same computation. A projection is
+    a function of the constraints, the arguments, the parameter values, the held
+    variables, the expressions avoided and the state of the random generator; with all of
+    these in the key, the points (or the refusal) and the generator's state after the call
+    are replayed bit for bit. On (228) the two scans of 21 parameter values each spent
+    about half their time projecting.
+    """
+
+    def __init__(self) -> None:
+        self._found: dict[tuple, tuple[list[np.ndarray] | AnalysisError, Mapping[str, Any]]] = {}
+
+    def surface_points(self, numerics: Numerics, constraints: Sequence[sympy.Expr], count: int, **options: Any) -> list[np.ndarray]:
+        """:meth:`Numerics.surface_points` ``(constraints, count, **options)``, or its replay."""
+        start = options.get("start")
+        key = (
+            tuple(constraints), count, tuple(sorted((k, v) for k, v in options.items() if k != "start")),
+            None if start is None else np.asarray(start, dtype=float).tobytes(),
+            numerics.parameter_vector.tobytes(), numerics.time, tuple(numerics.hold), tuple(numerics.avoid),
+            repr(numerics.rng.bit_generator.state),
+        )
+        hit = self._found.get(key)
+        if hit is not None:
+            outcome, after = hit
+            numerics.rng.bit_generator.state = after
+            if isinstance(outcome, AnalysisError):
+                raise outcome
+            return [z.copy() for z in outcome]
+        try:
+            points = numerics.surface_points(constraints, count, **options)
+        except AnalysisError as error:
+            self._found[key] = (error, numerics.rng.bit_generator.state)
+            raise
+        self._found[key] = ([z.copy() for z in points], numerics.rng.bit_generator.state)
+        return points
+
+
 def special_parameter_values(
     space: PhaseSpace,
     generic: dict[sympy.Symbol, float],
@@ -430,6 +476,7 @@ def special_parameter_values(
     values: dict[str, SpecialValue] = {}
     notes: list[str] = []
     clock = CpuBudget(SEARCH_SECONDS if budget is None else budget)
+    projections = _Projections()  # the decisions on one surface project onto it at the same values: once
 
     def record(use: RankUse, p: sympy.Symbol, value: sympy.Expr, at: int | None, curve_factor: sympy.Expr | None) -> None:
         change = f"rank of the {use.label} drops from {use.rank} to {at}" if at is not None else (
@@ -466,7 +513,7 @@ def special_parameter_values(
             for p, value in solutions:
                 try:
                     with clock.interrupting():
-                        at = _rank_at(space, generic, use, {p: value}, constraints_at, seed, time)
+                        at = _rank_at(space, generic, use, {p: value}, constraints_at, seed, time, projections)
                 except OverBudget:
                     unchecked.append(f"{factor} = 0" if curve else _equation(p, value))
                     continue
@@ -484,11 +531,11 @@ def special_parameter_values(
         scan = CpuBudget(SCAN_SECONDS if scan_budget is None else scan_budget)
         for use in cut:
             why = f"the symbolic search in the {use.label} ran over its budget of {clock.seconds:g} s CPU and was not finished"
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled, starts))
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled, starts, projections))
         for use in large:
             n = use.block.shape[0]
             why = f"the {use.label} was not searched symbolically (its {n}x{n} block is larger than {MAX_BLOCK}x{MAX_BLOCK})"
-            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled, starts))
+            notes.append(_scan(space, generic, use, constraints_at, seed, time, why, scan, record, compiled, starts, projections))
     return [replace(values[key], where="; ".join(w)) for key, w in found.items()], notes
 
 
@@ -503,13 +550,46 @@ class _Scanner:
 
     def __init__(self, space: PhaseSpace, generic: dict[sympy.Symbol, float], use: RankUse,
                  constraints: list[sympy.Expr], seed: int, time: sympy.Symbol | None,
-                 compiled: Numerics | None = None, starts: Sequence[np.ndarray] = ()) -> None:
+                 compiled: Numerics | None = None, starts: Sequence[np.ndarray] = (),
+                 projections: _Projections | None = None) -> None:
         self.space, self.generic, self.use, self.constraints = space, generic, use, constraints
+        self.projections = _Projections() if projections is None else projections
         self.seed, self.time = seed, time
         self.starts = list(starts)[:SCAN_POINTS]
         self.entries = list(use.matrix)
         self.numerics = (Numerics(space, generic, seed=seed, time=time) if compiled is None
                          else compiled.sharing_compiled(generic, seed))
+        #: the positions above the diagonal, whose entries alone are evaluated for an antisymmetric matrix
+        self.upper: tuple[np.ndarray, np.ndarray] | None = None
+        k, columns = use.matrix.shape
+        if use.antisymmetric and k == columns and all(use.matrix[i, i] == 0 for i in range(k)):
+            self.upper = np.triu_indices(k, 1)
+
+    def _values(self, points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The term sizes and the values of the matrix's entries at ``points`` (rows: points; entries in row-major order).
+
+        For an antisymmetric matrix the entries above the diagonal are evaluated, and those
+        below are their mirrors negated with their mirrors' sizes; the diagonal's zeros
+        have size 1 and value 0, as :meth:`~dirac.analysis.core.numeric.Numerics.term_scale`
+        and :meth:`~dirac.analysis.core.numeric.Numerics.evaluate` give them for a zero.
+        """
+        numerics = self.numerics
+        if self.upper is None:
+            scales = numerics.term_scale(self.entries, points)  # first: the values below come with the sizes
+            return scales, numerics.evaluate(self.entries, points)
+        matrix = self.use.matrix
+        rows, cols = self.upper
+        above = [matrix[int(i), int(j)] for i, j in zip(rows, cols)]
+        upper_scales = numerics.term_scale(above, points)  # first: the values below come with the sizes
+        upper_values = numerics.evaluate(above, points)
+        k = matrix.shape[0]
+        scales = np.ones((len(points), k, k))
+        values = np.zeros((len(points), k, k))
+        scales[:, rows, cols] = upper_scales
+        scales[:, cols, rows] = upper_scales
+        values[:, rows, cols] = upper_values
+        values[:, cols, rows] = -upper_values
+        return scales.reshape(len(points), k * k), values.reshape(len(points), k * k)
 
     def rank(self, p: sympy.Symbol, value: float) -> int | None:
         """Rank with ``p = value`` (others generic); ``UNDEFINED`` where the entries are not finite; None: no surface point."""
@@ -517,19 +597,19 @@ class _Scanner:
         numerics.parameter_vector = np.array([value if q == p else float(self.generic[q]) for q in numerics.parameters])
         if self.use.on_surface:
             points = []
+            project = self.projections.surface_points
             for start in self.starts:  # from the generic surface: the surface at this value is near (or empty)
                 try:
-                    points += numerics.surface_points(self.constraints, 1, attempts=1, start=start)
+                    points += project(numerics, self.constraints, 1, attempts=1, start=start)
                 except AnalysisError:
                     continue
             try:
-                points += numerics.surface_points(self.constraints, SCAN_POINTS - len(points), attempts=20) if len(points) < SCAN_POINTS else []
+                points += project(numerics, self.constraints, SCAN_POINTS - len(points), attempts=20) if len(points) < SCAN_POINTS else []
             except AnalysisError:
                 return None
         else:
             points = [numerics.random_point() for _ in range(SCAN_POINTS)]
-        scales = numerics.term_scale(self.entries, points)  # first: the values below come with the sizes
-        values = numerics.evaluate(self.entries, points)
+        scales, values = self._values(points)
         ranks = []
         for v, sc in zip(values, scales):
             if not (np.all(np.isfinite(v)) and np.all(np.isfinite(sc))):
@@ -551,6 +631,7 @@ def _scan(
     record: Callable[[RankUse, sympy.Symbol, sympy.Expr, int | None, sympy.Expr | None], None],
     compiled: Numerics | None = None,
     starts: Sequence[np.ndarray] = (),
+    projections: _Projections | None = None,
 ) -> str:
     """The numeric road of a block not searched symbolically (over the budget, or too large); returns the note.
 
@@ -561,7 +642,7 @@ def _scan(
     params = sorted(use.block_symbols() & set(space.parameters), key=lambda s: s.name)
     scanned: list[str] = []
     left_out: list[str] = []
-    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time, compiled, starts)
+    scanner = _Scanner(space, generic, use, use.constraints(constraints_at, {}), seed, time, compiled, starts, projections)
     for p in params:
         done = True
         for value in (v for v in SCAN_VALUES if admissible(p, v)):
@@ -631,6 +712,7 @@ def _rank_at(
     constraints_at: Callable[[dict], list[sympy.Expr]],
     seed: int,
     time: sympy.Symbol | None = None,
+    projections: _Projections | None = None,
 ) -> int | None:
     """Rank of ``use.matrix`` with ``substitution``, at points of the surface there (None: no point found).
 
@@ -655,7 +737,7 @@ def _rank_at(
     numerics = Numerics(space, numbers, seed=seed, time=time)
     if use.on_surface:
         try:
-            points = numerics.surface_points(constraints, 4, attempts=20)
+            points = (projections or _Projections()).surface_points(numerics, constraints, 4, attempts=20)
         except AnalysisError:
             return None
     else:

@@ -12,12 +12,14 @@ block).
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import sympy
 
 from dirac.analysis.core.algebra import negated
+from dirac.analysis.core.antisymmetric import mirrored
 from dirac.analysis.core.linear_solve import weak_solve
 from dirac.analysis.core.numeric import Numerics, independent_rows, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace
@@ -66,6 +68,24 @@ def bracket_matrix(space: PhaseSpace, constraints: list[sympy.Expr]) -> sympy.Ma
 
 #: from this many constraints :func:`bracket_matrix` returns a ``sympy.SparseMatrix`` (most entries are zero)
 SPARSE_BRACKETS = 64
+
+
+def bracket_values(numerics: Numerics, C: Mapping[tuple[int, int], sympy.Expr], where: Sequence[tuple[int, int]],
+                   points: Sequence[np.ndarray]) -> np.ndarray:
+    """Values of the bracket matrix entries ``C[k]``, ``k`` in ``where``, at ``points``: ``(len(points), len(where))``.
+
+    Only the entries above the diagonal are compiled and evaluated; those below are their
+    mirrors' values negated (``C_ba = -C_ab``, :mod:`dirac.analysis.core.antisymmetric`).
+    A pattern that is not antisymmetric is evaluated entry by entry.
+    """
+    if not where:
+        return np.zeros((len(points), 0))
+    reading = mirrored(where)
+    if reading is None:
+        return numerics.evaluate([C[k] for k in where], points)
+    upper, pick, sign = reading
+    values = numerics.evaluate([C[where[k]] for k in upper], points)
+    return values[:, pick] * sign
 
 
 def _rank_by_blocks(m: int, rows: np.ndarray, cols: np.ndarray, values: np.ndarray) -> int:
@@ -141,7 +161,7 @@ def classify(space: PhaseSpace, numerics: Numerics, constraints: list[sympy.Expr
         C = bracket_matrix(space, constraints)
     nonzero = C.todok()  # only the non-zero entries are compiled and evaluated (most, for a local system, are zero)
     where = list(nonzero)
-    at = numerics.evaluate([nonzero[k] for k in where], points) if where else np.zeros((len(points), 0))
+    at = bracket_values(numerics, nonzero, where, points)
     rows = np.array([i for i, _ in where], dtype=int)
     cols = np.array([j for _, j in where], dtype=int)
     scale = 1.0 + np.max(np.abs(at), axis=1, initial=0.0)

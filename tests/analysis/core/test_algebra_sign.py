@@ -51,3 +51,19 @@ def test_negated_is_sympy_negation():
             for _ in range(rnd.randint(1, 6))
         ])
         assert sympy.srepr(negated(e)) == sympy.srepr(-e)
+
+
+def test_the_sign_of_a_term_is_sympys():
+    from dirac.analysis.core.algebra import _negative_term
+
+    rnd = random.Random(5)
+    special = [sympy.oo, -sympy.oo, sympy.zoo, sympy.nan, sympy.Float(-2.5), sympy.Float(0.5), sympy.S.NegativeOne]
+    terms = [-x, x, -x * y, 2 * x, -sympy.Rational(1, 3) * x * y**2, -(m + g) * x, (m - g) * x, sympy.sqrt(2) * x,
+             -sympy.sqrt(2) * x, -x / m, sympy.I * x, -sympy.I * x, -sympy.sin(x), x**2, sympy.Integer(-3), *[s * x for s in special], *special]
+    for _ in range(500):
+        terms.append(sympy.Mul(
+            rnd.choice([-3, -1, 1, 2, sympy.Rational(-1, 2), sympy.Float(-0.25), sympy.sqrt(3), -sympy.sqrt(3)]),
+            rnd.choice([1, m, 1 / m, g - m, sympy.sin(y)]), x ** rnd.randint(0, 2), z ** rnd.randint(0, 1),
+        ))
+    for t in terms:
+        assert _negative_term(t) == bool(t.could_extract_minus_sign()), t
