@@ -1,4 +1,4 @@
-"""Copies and dead writes taken out of a tape, the same operations left in the same order.
+"""Copies, repeated operations and dead writes taken out of a tape; what stays runs in its order.
 
 The translation (:mod:`dirac.codegen.tape_source`) gives one instruction per operation of the
 source, and the generated step loops are full of plain copies: the locals of an inlined helper
@@ -6,9 +6,14 @@ bound to its arguments (``_i1_v0_ = _a_x_0``), loop variables nobody reads, book
 the unrolling (``i = 1`` after an unrolled loop). On the RATTLE loop of a double pendulum in its
 angles, ``MOV`` was 23 % of the 20,700 instructions a ``rattle-8`` step executes, and the
 machine costs about 6 ns an instruction whatever it does (a switch over the operation numbers:
-:mod:`dirac.codegen.tape_machine`). Two classical passes over the tape's control-flow graph
+:mod:`dirac.codegen.tape_machine`). Three classical passes over the tape's control-flow graph
 (Aho, Lam, Sethi & Ullman, *Compilers*, 2nd ed., Sect. 8.5, 9.1 and 9.2) remove them:
 
+* local value numbering: an operation repeated in a basic block on registers none of which was
+  written since (``0.5 * h`` in every row of a Newton matrix, the index ``o + 0`` of an unrolled
+  loop) becomes a copy of its first result; the same IEEE 754 operation on the same values
+  gives the same double (operands are never commuted: ``a + b`` and ``b + a`` may carry
+  different NaN payloads), and one that can stop the machine stopped it the first time;
 * copy propagation within a basic block: where ``MOV a, b`` is followed in its block by a read
   of ``a`` with neither ``a`` nor ``b`` written in between, the read takes ``b``; a copy is the
   exact value, bits, signed zero and NaN alike, so the operation reading it gives the same
@@ -20,17 +25,20 @@ machine costs about 6 ns an instruction whatever it does (a switch over the oper
   so the machine stops where it stopped and the caller reruns the call interpreted as before.
 
 Then a jump to a jump goes straight to the final target, and a jump to the next instruction
-goes. What is left performs the floating-point operations of the tape in its order, on the same
-values: the results are the interpreter's to the last bit (checked by the tests against the
-unoptimised tape and the interpreter on the step loops of the corpus). The arrays, the
-registers the call fills (parameters, lengths, constants) and the memory written are unchanged;
-only the registers' values at the end, which nobody reads, may differ.
+goes. Every value the tape stores is computed by the same operations on the same operands as
+before, in the same order: the results are the interpreter's to the last bit (checked by the
+tests against the unoptimised tape and Python on programs made to defeat each pass, random
+programs and the step loops of the corpus). The arrays, the registers the call fills
+(parameters, lengths, constants) and the memory written are unchanged; only the registers'
+values at the end, which nobody reads, may differ.
 
-Measured on that loop: 17,800 instructions a step instead of 20,700 (``MOV`` 2,200 instead of
-4,800) and 0.85 times the time of a step on the machine compiled at the install (median of 7
-alternated calls of 100 steps); 0.86 on the heavy top in Euler angles, 0.89 on the triple
-pendulum, 0.97 on the Cartesian double pendulum, whose constant-mass loop is mostly products.
-The passes take 4-8 ms per loop, once per process, next to 25-50 ms of translation.
+Measured (instructions executed per ``rattle-8`` step, plain -> optimised, at ``dt = 0.0244``,
+the step ``auto`` takes for ``t_end = 100`` of the double pendulum, and 0.01): the double pendulum in its angles 20,700 -> 17,200 (``MOV`` 4,800 ->
+2,200 of them), the heavy top in Euler angles 20,700 -> 17,400, the triple pendulum in angles
+35,500 -> 30,200, the Cartesian double pendulum 9,300 -> 8,700 (its constant-mass loop is mostly
+products); the time of a step on the machine compiled at the install, optimised / plain (21
+alternated calls of 100 steps, median of the ratios, load 3.5): 0.78, 0.84, 0.80 and 0.94.
+The passes take 4-12 ms per loop, once per process, next to 17-55 ms of translation.
 """
 
 from __future__ import annotations
@@ -144,6 +152,42 @@ def _propagate_copies(code: list[Instruction]) -> list[Instruction]:
     return out
 
 
+#: operations whose result depends on their operand registers alone, and that give the same
+#: result when repeated on the same values (one that stops the machine stopped it the first time)
+_PURE = frozenset({_ADD, _SUB, _MUL, _DIV, _NEG, _ABS, _ATAN2, *range(15, 27)})
+
+
+def _reuse_values(code: list[Instruction]) -> list[Instruction]:
+    """Within a basic block, an operation repeated on the same registers with none of them
+    written since (``0.5 * h`` of every row of a Newton matrix) becomes a copy of the first
+    result (local value numbering, without commuting operands: ``a + b`` and ``b + a`` may
+    carry different NaN payloads); copy propagation and dead-code elimination then take it."""
+    starts, _ = _blocks(code)
+    out = list(code)
+    for start, end in zip(starts, starts[1:]):
+        held: dict[tuple[int, int, int], int] = {}  # (op, b, c) -> the register holding the result
+        keys: dict[int, list[tuple[int, int, int]]] = {}  # register -> the entries that name it
+        for position in range(start, end):
+            instruction = out[position]
+            op, a, b, c, _ = instruction
+            target = _defined(instruction)
+            key = (op, b, c if op in (_ADD, _SUB, _MUL, _DIV, _ATAN2) else -1)
+            holder = held.get(key) if op in _PURE else None
+            if holder is not None:  # a copy (to itself when a holds the value already: dead-code elimination takes it)
+                out[position] = (_MOV, a, holder, 0, 0)
+                if holder == a:
+                    continue
+            if target < 0:
+                continue
+            for stale in keys.pop(target, ()):
+                held.pop(stale, None)
+            if op in _PURE and holder is None and target != b and (key[2] < 0 or target != c):
+                held[key] = target
+                for register in {b, key[2], target} - {-1}:
+                    keys.setdefault(register, []).append(key)
+    return out
+
+
 def _remove_dead(code: list[Instruction]) -> list[Instruction] | None:
     """``code`` without the writes nobody reads (of operations that cannot stop the machine),
     jumps renumbered; None when there is none."""
@@ -239,10 +283,11 @@ def _thread_jumps(code: list[Instruction]) -> list[Instruction]:
 
 
 def optimise(code: list[Instruction], rounds: int = 4) -> list[Instruction]:
-    """``code`` with copies propagated, dead writes removed and jumps threaded (see the module
-    docstring), repeated while it shrinks (a copy of a copy: at most ``rounds`` times)."""
+    """``code`` with repeated operations reused, copies propagated, dead writes removed and
+    jumps threaded (see the module docstring), repeated while it shrinks (a copy of a copy, an
+    operation repeated on copies: at most ``rounds`` times)."""
     for _ in range(rounds):
-        propagated = _propagate_copies(code)
+        propagated = _propagate_copies(_reuse_values(code))
         smaller = _remove_dead(propagated)
         if smaller is None:
             code = propagated
