@@ -39,7 +39,7 @@ import itertools
 from collections.abc import Callable
 from typing import Any, TypeVar, cast
 
-from dirac.codegen.flatten import replace_children, walk
+from dirac.codegen.flatten import replace_children, unparse, walk
 
 __all__ = ["scalar_function", "unroll_loops", "scalarise_arrays", "item_loads", "UNROLL_MAX"]
 
@@ -389,5 +389,4 @@ def scalar_function(text: str, name: str) -> str | None:
     changed = item_loads(function) or changed
     if not changed:
         return None
-    ast.fix_missing_locations(tree)
-    return ast.unparse(tree) + "\n"
+    return unparse(tree) + "\n"

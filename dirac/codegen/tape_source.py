@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from typing import cast
 
 from dirac.codegen.flatten import replace_children, walk
+from dirac.codegen.tape_optimise import optimise
 
 __all__ = ["Tape", "translate", "OPS", "UNARY"]
 
@@ -659,10 +660,12 @@ class _Lengths:
         return node
 
 
-def translate(source: str, name: str, reasons: list[str] | None = None) -> Tape | None:
+def translate(source: str, name: str, reasons: list[str] | None = None, optimised: bool = True) -> Tape | None:
     """The tape of function ``name`` of ``source`` (Python text), or None when the function
     uses a construct the tape does not translate (the other tiers then run it; the reason is
-    appended to ``reasons`` when given)."""
+    appended to ``reasons`` when given). ``optimised``: its copies and dead writes taken out
+    (:func:`~dirac.codegen.tape_optimise.optimise`, the same operations in the same order);
+    False gives the instruction-for-instruction translation."""
     try:
         module = ast.parse(source)
     except SyntaxError:
@@ -688,6 +691,8 @@ def translate(source: str, name: str, reasons: list[str] | None = None) -> Tape 
             # an argument's length comes with the call; a local array's is its constant rows,
             # which the call sets the same way (TapeFunction: reg[length] = rows[slot])
             tape.lengths[translator.array_names[array]] = translator.names[f"_len_{array}"]
+        if optimised:
+            tape.code = optimise(tape.code)
     except (Decline, RecursionError) as error:
         if reasons is not None:
             reasons.append(str(error) or type(error).__name__)

@@ -68,7 +68,7 @@ from dirac.codegen.tape_source import translate
 from dirac.errors import inform
 
 __all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TAPE_SPEEDUP", "TAPE_MACHINE_SECONDS", "TAPE_LOAD_SECONDS",
-           "TAPE_TRANSLATE_SECONDS",
+           "TAPE_TRANSLATE_SECONDS", "TAPE_TRANSLATE_SECONDS_PER_CHAR", "TAPE_TRANSLATE_FLOOR",
            "TAPE_PROBE_STEPS", "TAPE_RATE_STEPS", "tape_enabled", "NUMBA_IMPORT_SECONDS", "CACHE_LOAD_SECONDS", "SHARED_CORE_FACTOR",
            "CHECK_SECONDS",
            "WARM_UP_STEPS", "WARM_UP_UNTIMED_STEPS", "WAIT_FACTOR", "choose_road", "background_enabled", "spare_core",
@@ -87,6 +87,18 @@ TAPE_LOAD_SECONDS = 0.3
 #: 53-62 ms measured for the RATTLE loops of the triple pendulum, the tops in Euler angles and
 #: the Cartesian double pendulum, about 20,000 characters each): the tape must save more
 TAPE_TRANSLATE_SECONDS = 0.1
+#: the same per character of a loop's interpreted text, once that text is made (its first
+#: interpreted call): translation and optimisation of the RATTLE loops took 1.6-2.4 us a character
+#: for the double pendulum in angles (13,300 characters), 2.1-2.9 for the symmetric top in Euler
+#: angles (18,000), 2.6-3.3 for the triple pendulum (20,700), 2.7-5.2 for the Cartesian double
+#: pendulum (7,400), CPU at load 2-4. Taken as 3 us, and at least :data:`TAPE_TRANSLATE_FLOOR`
+#: (:meth:`TieredFunction.translate_estimate`)
+TAPE_TRANSLATE_SECONDS_PER_CHAR = 3e-6
+#: the least translation estimate: a loop of 430 characters translates in 0.66 ms, but a loop's
+#: rate is first measured on its cold first call (the sine loop of the tests: 0.16 ms for its
+#: first step, 2 us for each next one), which can promise the few steps of a small loop a saving
+#: its translation does not bring; every RATTLE loop of the corpus is estimated above it
+TAPE_TRANSLATE_FLOOR = 0.02
 #: steps of the first part a loop runs on the tape, which measures the tape's own rate
 TAPE_PROBE_STEPS = 256
 #: parts of fewer steps do not count in the tape's rate (each call costs some microseconds of
@@ -479,6 +491,18 @@ class TieredFunction:
             wait += 0.0 if "numba" in sys.modules else NUMBA_IMPORT_SECONDS
         return wait + rate * planned
 
+    def translate_estimate(self) -> float:
+        """Estimated CPU seconds to translate this loop to a tape: the length of the text the
+        interpreted tier runs (made at its first interpreted call) times
+        :data:`TAPE_TRANSLATE_SECONDS_PER_CHAR`, at least :data:`TAPE_TRANSLATE_FLOOR`;
+        :data:`TAPE_TRANSLATE_SECONDS` before that text exists, 0 once translated."""
+        if self.name in self.module._tapes:
+            return 0.0
+        text = self.module._texts.get(self.name)
+        if text is None:
+            return TAPE_TRANSLATE_SECONDS
+        return max(TAPE_TRANSLATE_FLOOR, TAPE_TRANSLATE_SECONDS_PER_CHAR * len(text))
+
     def kernel_chars(self) -> int:
         """The size of what numba compiles for this function (:func:`kernel_chars`)."""
         if self._chars is None:
@@ -633,10 +657,14 @@ class TieredFunction:
             # no compilation pays; the tape does when the machine costs nothing to get (compiled
             # at the install, or loaded in this process) and it saves more than its translation,
             # which is paid once: a loop called again and again for short runs (the pilots of
-            # auto) translates once it has spent that long interpreted (the rent-or-buy rule)
-            if machine_loaded() and (remaining > TAPE_TRANSLATE_SECONDS or self.interpreted_seconds >= TAPE_TRANSLATE_SECONDS):
+            # auto) translates once it has spent that long interpreted (the rent-or-buy rule),
+            # the translation's price estimated from the loop's own text: at the fixed 0.1 s, the
+            # pilots of a double pendulum in angles ran 0.1 s interpreted before a translation of
+            # 25-30 ms, and auto's pilots took 0.27 s of CPU where they take 0.17 with the estimate
+            translation = self.translate_estimate()
+            if machine_loaded() and (remaining > translation or self.interpreted_seconds >= translation):
                 translated = self.name in self.module._tapes
-                cost = 0.0 if translated or self.interpreted_seconds >= TAPE_TRANSLATE_SECONDS else TAPE_TRANSLATE_SECONDS
+                cost = 0.0 if translated or self.interpreted_seconds >= translation else translation
                 tape = self.tape_estimate(planned, args)
                 if tape is not None and tape + cost < remaining:
                     self.on_tape = True

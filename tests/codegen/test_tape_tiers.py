@@ -211,6 +211,42 @@ def test_a_short_loop_stays_interpreted_without_the_machine(tmp_path, monkeypatc
     assert x[0] == hand_loop(0.5, 40)
 
 
+def test_the_translation_is_priced_by_the_loops_text(tmp_path, monkeypatch) -> None:
+    """The price of a translation: the fixed figure before the loop's interpreted text exists,
+    then its length times the measured cost of a character (at least the floor), nothing once
+    translated."""
+    function = _loop(tmp_path, monkeypatch)
+    assert function.translate_estimate() == tiers.TAPE_TRANSLATE_SECONDS
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
+    text = function.module._texts["run"]
+    assert function.translate_estimate() == max(tiers.TAPE_TRANSLATE_FLOOR,
+                                                tiers.TAPE_TRANSLATE_SECONDS_PER_CHAR * len(text))
+    function.module.tape_function("run")
+    assert function.translate_estimate() == 0.0
+
+
+def test_a_loop_run_again_and_again_buys_its_tape_once_it_has_spent_its_price(tmp_path, monkeypatch) -> None:
+    """Short runs of one loop (as auto's pilots make), each far below its translation: the loop
+    stays interpreted until the interpreted time spent reaches the translation's estimate
+    (rent or buy), then goes on the tape; the iterates are the hand loop's to the last bit."""
+    from dirac.codegen.tape_machine import machine
+
+    machine()
+    function = _loop(tmp_path, monkeypatch)
+    x, info = np.array([0.5]), np.zeros(4)
+    spent: list[float] = []  # the interpreted time before each run
+    while function.tier == "interpreted" and len(spent) < 100_000:
+        spent.append(function.interpreted_seconds)
+        function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
+    runs = len(spent)
+    assert function.tier == "tape" and runs >= 2
+    price = max(tiers.TAPE_TRANSLATE_FLOOR, tiers.TAPE_TRANSLATE_SECONDS_PER_CHAR * len(function.module._texts["run"]))
+    assert spent[-2] < price <= spent[-1]  # bought by the first run that started with the price spent
+    assert price < tiers.TAPE_TRANSLATE_SECONDS  # the small loop's text: not the fixed figure
+    assert x[0] == hand_loop(0.5, 40 * runs)
+
+
 def test_a_run_of_unknown_length_on_the_tape_compiles(tmp_path, monkeypatch) -> None:
     """Once on the tape, a run whose length is unknown has no tape estimate: it compiles (a
     long run ends on the compiled tier)."""
