@@ -27,8 +27,9 @@ from __future__ import annotations
 
 import builtins
 import keyword
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from itertools import islice
 from typing import Any, Literal
 
 import sympy
@@ -36,7 +37,8 @@ from sympy.printing.codeprinter import PrintMethodNotImplementedError
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-__all__ = ["StraightLineCode", "UnsupportedExpression", "flat_expressions", "input_name", "straight_line"]
+__all__ = ["StraightLineCode", "UnsupportedExpression", "distinct_nodes", "flat_expressions", "input_name",
+           "straight_line"]
 
 Target = Literal["math", "numpy"]
 Sharing = Literal["cse", "dag", "tree"]
@@ -154,8 +156,9 @@ def input_name(symbol: sympy.Symbol, index: int, taken: set[str]) -> str:
 BASIC_CSE_NODES = 100
 
 
-def _within(expr: sympy.Basic, limit: int) -> bool:
-    """Whether ``expr`` has at most ``limit`` distinct sub-expressions (one walk, stopped at the limit)."""
+def distinct_nodes(expr: sympy.Basic) -> Iterator[sympy.Basic]:
+    """The sub-expressions of ``expr`` in preorder, each distinct one once (a shared sub-tree met again is
+    skipped whole: its nodes were met at its first occurrence)."""
     seen: set[sympy.Basic] = set()
     stack = [expr]
     while stack:
@@ -163,10 +166,13 @@ def _within(expr: sympy.Basic, limit: int) -> bool:
         if node in seen:
             continue
         seen.add(node)
-        if len(seen) > limit:
-            return False
-        stack.extend(node.args)
-    return True
+        yield node
+        stack.extend(reversed(node.args))
+
+
+def _within(expr: sympy.Basic, limit: int) -> bool:
+    """Whether ``expr`` has at most ``limit`` distinct sub-expressions (one walk, stopped at the limit)."""
+    return sum(1 for _ in islice(distinct_nodes(expr), limit + 1)) <= limit
 
 
 def _bounded(pre: Any) -> Any:

@@ -18,6 +18,8 @@ from sympy.polys.fields import FracField
 from sympy.polys.rings import PolyRing
 from sympy.printing.str import StrPrinter
 
+from dirac.codegen.printer import distinct_nodes
+
 __all__ = ["NotInRing", "shared_xreplace", "tidy", "prints_shorter", "printed", "printed_at_most", "text_of", "present_in_order", "ring_value"]
 
 
@@ -226,13 +228,7 @@ def _split_denominators(expr: sympy.Expr, variables: set) -> tuple[sympy.Expr, d
     replacements: dict = {}
     back: dict = {}
     symbol_of: dict = {}  # base -> its d_i
-    seen: set = set()
-    stack = [expr]
-    while stack:
-        node = stack.pop()
-        if node in seen:
-            continue
-        seen.add(node)
+    for node in distinct_nodes(expr):
         if node.is_Pow and node.exp.is_Integer and node.exp < 0 and not (node.base.free_symbols & variables):
             base = node.base
             d = symbol_of.get(base)
@@ -240,7 +236,6 @@ def _split_denominators(expr: sympy.Expr, variables: set) -> tuple[sympy.Expr, d
                 d = symbol_of[base] = sympy.Dummy(f"d{len(back)}")
                 back[d] = base
             replacements[node] = d ** int(-node.exp)
-        stack.extend(reversed(node.args))
     if not replacements:
         return expr, {}, []
     return shared_xreplace(expr, replacements), {d: 1 / b for d, b in back.items()}, list(back)
