@@ -565,8 +565,9 @@ class _Loop:
                     "of the last steps"
         elif poles.steps_to_collapse <= READINGS_PER_APPROACH:
             # the rate of the last steps is a secant, which lags a fall that speeds up toward the pole (V = -1/x from
-            # x = 1 at rest, midpoint, dt = 0.01: the Newton iteration failed 1.2 steps before the pole by the fall
-            # as (t* - t)^(2/3), where the secant over the 10 steps since the reading before gave 3.0)
+            # x = 1 at rest, midpoint, dt = 0.01: the Newton iteration failed at t = 1.1, x = 0.078, 1.07 steps before
+            # t* = pi/(2 sqrt 2) by hand; the fall as (t* - t)^(2/3) gave 1.17 steps, the secant over the 10 steps
+            # since the reading before 2.85)
             where = (f"{poles.nearest(collapsing=True)}, reached within about {max(poles.steps_to_collapse, 1.0):.0f} "
                      f"more steps if it falls as (t* - t)^{COLLAPSE_EXPONENT:.2g}, as into a 1/r pole")
         else:
