@@ -60,8 +60,6 @@ class AnalysedSystem:
     gauge_multipliers: dict[str, str] = field(default_factory=dict)
     #: the Hamiltonian of the flow (``H_c`` plus the chosen free multipliers times their constraints), sympy
     hamiltonian: Any = field(default=sympy.S.Zero, repr=False)
-    #: the second-class constraints ``Phi`` of the flow, sympy
-    constraints: tuple[Any, ...] = field(default=(), repr=False)
     #: the parameters that take the values ``params`` at run time, in that order (sympy symbols)
     parameter_symbols: tuple[Any, ...] = field(default=(), repr=False)
 
@@ -156,7 +154,6 @@ class AnalysedSystem:
             momenta=momenta,
             gauge_multipliers={name: str(v) for name, (v, _) in chosen.items()},
             hamiltonian=H_flow,
-            constraints=tuple(constraints),
             parameter_symbols=tuple(defaults),
         )
 

@@ -539,9 +539,7 @@ class _Loop:
         from dirac.flows.pole_guard import PoleCrossing
         from dirac.flows.pole_guard import message as pole_message
 
-        # the configuration of a constrained stepper, the whole state of an analysed one
-        q = getattr(self.stepper, "z") if hasattr(self.problem, "analysed") else getattr(self.stepper, "q")  # noqa: B009
-        t = getattr(self.stepper, "time", self.t_now)
+        q, t = getattr(self.stepper, poles.state), getattr(self.stepper, "time", self.t_now)
         try:
             if start:
                 poles.start(q, t, self.stepper.steps)

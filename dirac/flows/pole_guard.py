@@ -114,6 +114,9 @@ class PoleGuard:
         self.bounds = list(bounds) if bounds is not None else [False] * len(factors)
         self._time = time
         self._params = tuple(float(c) for c in params)
+        #: the stepper's attribute the guard reads: the configuration ``q`` of a mechanical system, the whole
+        #: state ``z`` of an analysed one
+        self.state = "q"
         self._members = 1
         # the state of the readings, flat lists over (member, factor), plain floats: a reading of one
         # member costs a few microseconds (numpy's overhead on arrays this small would be ten times that)
@@ -440,7 +443,7 @@ def _build_analysed(analysed: Any) -> PoleGuard | None:
     time = getattr(analysis, "time", None)
     variables = [*z, *([time] if time is not None else [])]
     H = sympy.sympify(analysed.hamiltonian)
-    constraints = [sympy.sympify(c) for c in analysed.constraints]
+    constraints = [sympy.sympify(c) for c in analysis.second_class]
     if not _may_have_poles([H, *constraints]):
         return None  # polynomials in z, sines, cosines and exponentials: no denominator anywhere
     H, constraints = _quotients(H), [_quotients(c) for c in constraints]
@@ -458,8 +461,11 @@ def _build_analysed(analysed: Any) -> PoleGuard | None:
         if time is not None:
             sources.append(("the time derivatives of the second-class constraints",
                             [d for c in constraints for d in derivatives(c, [time])]))
-    return _guard_of(sources, variables, list(analysed.parameter_symbols), np.asarray(analysed.params, dtype=float),
-                     [H, *constraints], time is not None)
+    guard = _guard_of(sources, variables, list(analysed.parameter_symbols), np.asarray(analysed.params, dtype=float),
+                      [H, *constraints], time is not None)
+    if guard is not None:
+        guard.state = "z"
+    return guard
 
 
 #: points of ``f = 0`` at which an expression's growth toward the zero set is measured
@@ -563,7 +569,7 @@ def _fresh(cached: Any) -> PoleGuard | None:
         return None
     guard = PoleGuard(cached._values, cached.factors, cached.origins, cached._time, np.array(cached._params),
                       cached.bounds)
-    guard.expressions = cached.expressions
+    guard.expressions, guard.state = cached.expressions, cached.state
     return guard
 
 
