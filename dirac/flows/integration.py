@@ -28,6 +28,7 @@ import numpy as np
 
 from dirac.errors import CoordinateSingularityError, InputError, IntegrationError, PoleError
 from dirac.flows.chart_guard import GUARD_STEPS, STOP_DISTANCE, ChartGuard, chart_guard
+from dirac.flows.energy_watch import EnergyWatch, energy_watch
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
 from dirac.flows.methods.torqued import refuse_undriven
@@ -352,6 +353,7 @@ class _Loop:
         self.t_now = 0.0
         self.cpu = 0.0
         self._checked_at = 0
+        self.energy: EnergyWatch | None = None
 
     # ------------------------------------------------------------------ storage
     def _keep(self, index: int, values: dict[str, np.ndarray]) -> None:
@@ -363,6 +365,7 @@ class _Loop:
         self.stored = index + 1
 
     def _solution(self, complete: bool, message: str = "") -> Solution:
+        """The samples kept so far; ``message`` says why the run stopped, or what a complete run warned."""
         n = self.stored
         outputs = {}
         for name in self.outputs:
@@ -423,6 +426,9 @@ class _Loop:
             bar = _NoBar()
         start = time.process_time()
         try:
+            if kind != "exact":
+                self.energy = energy_watch(self.problem, self.stepper)
+                self._watch_energy(None)
             if kind == "exact":
                 self._run_exact(bar)
             elif kind == "fixed":
@@ -457,7 +463,29 @@ class _Loop:
         finally:
             bar.close()
         self.cpu = time.process_time() - start
-        return self._solution(True)
+        return self._solution(True, self._energy_report())
+
+    def _watch_energy(self, values: dict[str, np.ndarray] | None) -> None:
+        """Read the energy of a conservative run at a sample (``values``: the sample's outputs; None at the
+        start, before the first step)."""
+        if self.energy is not None:
+            energy = None if values is None else values.get("energy")
+            self.energy.read(self.stepper, self.t_now, None if energy is None else np.atleast_1d(energy))
+
+    def _energy_report(self) -> str:
+        """Warn when the run changed the energy of a conservative system by a finite amount
+        (:mod:`dirac.flows.energy_watch`); the text is also the solution's message."""
+        if self.energy is None:
+            return ""
+        text = self.energy.report(str(self.problem.system), self.method.name, self.method.order, self.dt,
+                                  self.problem.batched, chosen="auto" in self.extra)
+        if text is None:
+            return ""
+        from dirac.errors import warn
+
+        self.extra["energy_change"] = self.energy.extra()
+        warn(text)
+        return text
 
     def _intervals(self) -> list[tuple[float, float, int]]:
         """(start, end, steps) of each sampling interval (one for ``samples = 1``); sets
@@ -510,7 +538,9 @@ class _Loop:
                 self.stepper.time = self.t_now
             if index == len(intervals) - 1:
                 self._check(final=True)
-            self._keep(first + index, self.stepper.observe())
+            values = self.stepper.observe()
+            self._keep(first + index, values)
+            self._watch_energy(values)
 
     def _chart_guard(self) -> ChartGuard | None:
         """The coordinate-singularity guard of a constrained system's stepper, if its ``det W`` can vanish."""
@@ -592,7 +622,10 @@ class _Loop:
                 self.stepper.advance_to(float(t))
                 self.t_now = float(t)
                 self._check(final=index == len(self.times) - 1)
-            self._keep(index, self.stepper.observe())
+            values = self.stepper.observe()
+            self._keep(index, values)
+            if t > 0.0:
+                self._watch_energy(values)
             bar.update(1)
 
     def _run_exact(self, bar) -> None:
