@@ -149,3 +149,18 @@ def test_an_adaptive_method_at_a_loose_tolerance_is_told_to_tighten_it():
         warnings.simplefilter("error", DiracWarning)
         solution = integrate(_close_pass(), "scipy-RK45", t_end=3.0, tolerance=1e-8, samples=31)
     assert np.max(np.abs(solution.outputs["energy"] + 0.99)) < 1e-5
+
+
+def test_a_step_across_the_pole_of_a_repelling_core_is_hedged():
+    """``rattle-4`` at ``dt = 1e-3``: a stage lands across ``x = 0`` (from ``x = 0.01``, inside the turning point
+    ``x_min = 1/99``); ``V -> +inf`` there, above the energy ``-0.99`` of the start, so the motion of that energy
+    cannot reach the pole: the PoleError says that a smaller ``dt`` resolves the turn, with the potential met on
+    the step's way. ``V = log(x)`` (``V -> -inf``) keeps its plain verdict (``tests/flows/test_pole_guard.py``)."""
+    from dirac.errors import PoleError
+
+    with pytest.raises(PoleError, match=r"stepped across the pole x = 0") as caught:
+        integrate(_close_pass(), "rattle-4", t_end=3.0, dt=1e-3, samples=31)
+    text = str(caught.value)
+    assert "a smaller dt resolves the turn" in text
+    rose = float(text.split("rose to V = ")[1].split(",")[0])
+    assert rose > -0.99 and "above the energy of the start E = -0.99" in text
