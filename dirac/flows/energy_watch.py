@@ -36,7 +36,9 @@ ENERGY_CHANGE = 2e-2
 
 
 @dataclass
-class _Worst:
+class _Change:
+    """The first change found: the member, ``|H - H(0)|``, the kinetic scale, the sample interval and ``H`` at its ends."""
+
     member: int
     change: float
     scale: float
@@ -62,7 +64,7 @@ class EnergyWatch:
         self.scale: np.ndarray | None = None
         self.last: np.ndarray | None = None
         self.t_last = 0.0
-        self.found: _Worst | None = None
+        self.found: _Change | None = None
 
     def read(self, stepper: Any, t: float, energy: np.ndarray | None = None) -> None:
         """Read the state of ``stepper`` at the sample time ``t`` (``energy``: ``H`` if the run computed it)."""
@@ -79,7 +81,7 @@ class EnergyWatch:
         over = np.flatnonzero(~(change <= ENERGY_CHANGE * scale))  # NaN counts: the drift check names it first
         if over.size:
             b = int(over[np.argmax(change[over] / np.maximum(scale[over], 1e-300))])
-            self.found = _Worst(b, float(change[b]), float(scale[b]), self.t_last, t, float(self.last[b]),
+            self.found = _Change(b, float(change[b]), float(scale[b]), self.t_last, t, float(self.last[b]),
                                 float(values[b]))
         self.last, self.t_last = values.copy(), t
 
