@@ -76,7 +76,11 @@ __all__ = ["set_policy", "current_policy", "COMPILE_SECONDS", "TAPE_SPEEDUP", "T
 
 #: how many times faster the tape machine runs a step loop than the interpreter, assumed before
 #: the tape's own rate is measured: 5.9-7.1 measured on the RATTLE loops of the double and triple
-#: pendulums and the tops in Euler angles (2-7 us a step against 12-41 us), taken low
+#: pendulums and the tops in Euler angles (2-7 us a step against 12-41 us), taken low. With the
+#: directly threaded C loop (dirac/codegen/_tape.c) rattle-2 steps ran 7.4-10.5 times faster than
+#: interpreted on those loops and 4.6 on the unrolled constant-mass loop of the Cartesian double
+#: pendulum (calls of 200 steps, median of 7 alternated pairs; 2.1 with the former switch): kept
+#: at 5, the rate the first tape part measures corrects it
 TAPE_SPEEDUP = 5.0
 #: CPU seconds to compile the tape machine on a cold cache, numba's import apart (about 0.9 s
 #: measured: numba's first compilation in a process and the machine's loop), and to load it

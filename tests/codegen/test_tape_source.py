@@ -334,3 +334,30 @@ def test_two_dimensional_arrays_and_every_jump_run_as_in_python() -> None:
         assert out_python.tobytes() == out_tape.tobytes()
     with pytest.raises(TapeError, match="index"):
         TapeFunction(tape)(np.zeros(3), np.zeros(3), 4)
+
+
+def test_an_operation_outside_the_table_stops_the_machine_and_a_jump_to_the_end_ends_it() -> None:
+    """Hand-made tapes run by the machine and by its Python reading (:func:`_execute`): an
+    operation number outside :data:`OPS` (past the last, far past it, negative) stops the
+    run with code 4 (unknown operation) after the instructions before it ran; a jump to the
+    end of the tape (or beyond it) ends the run with 0, and the instructions it jumps over never
+    run. The C loop translates each operation number to the address of its code through a
+    table, which must not be read past its end, and clamps each jump to the stop it appends."""
+    run = tape_machine.machine()
+    base, rows, cols = np.zeros(1, dtype=np.int64), np.ones(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
+    add, mov, jmp = OPS["ADD"], OPS["MOV"], OPS["JMP"]
+    for unknown in (len(OPS), 99, 2 ** 40, -1):
+        code = np.array([add, 0, 1, 2, 0, unknown, 0, 1, 2, 0, mov, 0, 1, 0, 0], dtype=np.int64)
+        outcomes = []
+        for machine in (run, _execute):
+            reg, mem = np.array([0.0, 1.5, 2.25]), np.zeros(1)
+            outcomes.append((machine(code, reg, mem, base, rows, cols), reg.tolist()))
+        assert outcomes[0] == outcomes[1] == (4, [3.75, 1.5, 2.25]), (unknown, outcomes)
+    # instruction 1 jumps to instruction 3, the end of a 3-instruction tape, or beyond it (the C
+    # loop clamps the target to its stop): instruction 2 never runs
+    for target in (3, 4, 1000):
+        code = np.array([add, 0, 1, 2, 0, jmp, target, 0, 0, 0, mov, 0, 1, 0, 0], dtype=np.int64)
+        for machine in (run, _execute):
+            reg, mem = np.array([0.0, 1.5, 2.25]), np.zeros(1)
+            assert machine(code, reg, mem, base, rows, cols) == 0
+            assert reg.tolist() == [3.75, 1.5, 2.25]
