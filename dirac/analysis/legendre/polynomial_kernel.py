@@ -107,9 +107,10 @@ def _ansatz(
 
     ``A X = 0`` (``scaled_identity=False``) or ``A X = d 1`` for some ``d`` (``True``).
     ``None`` when the ansatz has more than :data:`MAX_UNKNOWNS` unknowns. A list given as
-    ``first_columns`` receives, per matrix, the first column's entries as elements of the
-    ring ``domain[q]`` (built from the same coefficients and monomials as the sympy
-    entries, so equal to them converted: :func:`_first_diagonal` needs no conversion).
+    ``first_columns`` receives, per matrix, the first column's entries as dictionaries
+    monomial exponents -> coefficient in ``domain`` (the same coefficients and monomials
+    as the sympy entries: ``ring.from_dict`` of one equals the entry converted, and
+    :func:`_first_diagonal` builds only the few it multiplies).
     """
     k, n = len(entries), len(entries[0])
     monos = _monomials(len(q), degree)
@@ -163,8 +164,7 @@ def _ansatz(
             X[j, c] = sympy.Add(*parts)
         out.append(X)
         if first_columns is not None:
-            ring = entries[0][0].ring  # the ring of A's entries (over ``domain``, generators ``q``)
-            first_columns.append([ring.from_dict(f) for f in first])
+            first_columns.append(first)
     return out
 
 
@@ -256,15 +256,16 @@ def _first_diagonal(A: sympy.Matrix, B: sympy.Matrix, entries, ring: PolyRing, c
     turned back into the expanded sum, the same expression as ``sympy.expand`` of the
     symbolic product (an expanded polynomial is canonical) at a fraction of the cost, for
     the hundreds of candidates of (228); with parameters, by ``sympy.expand``. ``column``
-    is ``B``'s first column in the ring (from :func:`_ansatz`): converting the sympy
-    entries again took a third of this function's time on (228) (413 conversions).
+    is ``B``'s first column as the terms :func:`_ansatz` built it from: an entry is made
+    a ring element from them (``from_dict``) instead of converting its sympy expression,
+    a third of this function's time on (228) (413 conversions).
     """
     if ring.domain != sympy.QQ:
         return sympy.expand((A[0, :] * B[:, 0])[0, 0])
     total = ring.zero
     for a, b in zip(entries[0], column):
         if a and b:
-            total += a * b
+            total += a * ring.from_dict(b)
     return total.as_expr()
 
 

@@ -92,5 +92,5 @@ def test_the_first_columns_in_the_ring_are_the_sympy_entries_converted():
         matrices = _ansatz(entries, q, domain, degree, A.shape[0], scaled_identity=True, first_columns=columns)
         assert matrices and len(columns) == len(matrices)
         for B, column in zip(matrices, columns):
-            assert [ring(B[j, 0]) for j in range(B.shape[0])] == column
+            assert [ring(B[j, 0]) for j in range(B.shape[0])] == [ring.from_dict(terms) for terms in column]
         assert sum(1 for column in columns if any(column)) > 1  # not a comparison of zeros only
