@@ -47,6 +47,25 @@ def test_help_does_not_import_sympy_or_numba():
     assert result.stdout.strip() == "[]"
 
 
+def test_version_prints_the_installed_version_on_stdout(run_cli):
+    from importlib.metadata import version
+
+    status, out, err = run_cli("--version")
+    assert (status, out, err) == (0, f"dirac {version('dirac-mechanics')}\n", "")
+
+
+def test_the_version_is_looked_up_only_when_asked(monkeypatch, run_cli):
+    import dirac.cli
+
+    def fail() -> str:
+        raise AssertionError("the installed version was looked up")
+
+    monkeypatch.setattr(dirac.cli, "_version", fail)
+    dirac.cli.build_parser()
+    status, out, _ = run_cli("systems")
+    assert status == 0 and "pendulum" in out
+
+
 def test_bare_dirac_prints_help_and_one_error_line(run_cli):
     # regression: bare `dirac` exited with status 2 but printed no error: line
     status, out, err = run_cli()

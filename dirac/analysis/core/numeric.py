@@ -261,6 +261,7 @@ class Numerics:
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
         self._plans: dict[tuple, Callable[[np.ndarray], np.ndarray]] = {}
         self._terms: dict[tuple, tuple[list[sympy.Expr], np.ndarray]] = {}
+        self._scale_plans: dict[tuple, tuple[list[int], list[tuple[int, np.ndarray, np.ndarray]]]] = {}
         self._jacobians: dict[tuple, _DenseJacobian] = {}
         #: (batch, arguments) -> values of a scaled batch computed together with its term sizes
         #: (:meth:`_call`): the values asked next at the same point are not computed again
@@ -410,6 +411,33 @@ class Numerics:
         compiled on their own.
         """
         exprs = [e if isinstance(e, sympy.Basic) else sympy.sympify(e) for e in exprs]
+        plan = self._scale_plans.get(tuple(exprs))
+        if plan is None:
+            plan = self._scale_plan(exprs)
+            if len(self._scale_plans) < PLAN_CACHE:
+                self._scale_plans[tuple(exprs)] = plan
+        rest, gathers = plan
+        if not gathers:
+            return self._term_scale(exprs, points)
+        scale = np.ones((len(points), len(exprs)))
+        if rest:
+            scale[:, rest] = self._term_scale([exprs[k] for k in rest], points)
+        for row, z in enumerate(points):
+            for b, where, picks in gathers:
+                scale[row, where] = self._call(b, z, sizes=True)[picks]
+        return scale
+
+    def _scale_plan(self, exprs: list[sympy.Expr]) -> tuple[list[int], list[tuple[int, np.ndarray, np.ndarray]]]:
+        """How :meth:`term_scale` gathers the sizes of ``exprs``: ``(rest, gathers)``, built once per list of expressions.
+
+        ``gathers`` holds ``(batch, positions, indices in the batch)`` of the expressions
+        compiled by :func:`~dirac.analysis.core.scaled_function.scaled_function` (empty when
+        none is), ``rest`` the positions of the others. Both depend only on where each
+        expression was compiled, which never changes once it is; the Newton steps of
+        :meth:`surface_points` ask for the sizes of the same constraints at every converged
+        point (779 times in the 400-point walk of (228)'s Legendre transform), and the plan
+        is no longer rebuilt each time.
+        """
         zero = sympy.S.Zero
         self._compile([e for e in exprs if e is not zero])
         index, scaled = self._index, self._scaled
@@ -418,21 +446,13 @@ class Numerics:
             at = index.get(e)
             if at is not None and at[0] in scaled:
                 fused[k] = at
-        if not fused:
-            return self._term_scale(exprs, points)
-        scale = np.ones((len(points), len(exprs)))
         rest = [k for k in range(len(exprs)) if k not in fused]
-        if rest:
-            scale[:, rest] = self._term_scale([exprs[k] for k in rest], points)
         gathers = [
             (b, np.array([k for k, (c, _) in fused.items() if c == b], dtype=np.intp),
              np.array([i for c, i in fused.values() if c == b], dtype=np.intp))
             for b in sorted({c for c, _ in fused.values()})
         ]
-        for row, z in enumerate(points):
-            for b, where, picks in gathers:
-                scale[row, where] = self._call(b, z, sizes=True)[picks]
-        return scale
+        return rest, gathers
 
     def _term_scale(self, exprs: list[sympy.Expr], points: Sequence[np.ndarray]) -> np.ndarray:
         """:meth:`term_scale` from the terms compiled as expressions of their own."""

@@ -100,11 +100,17 @@ def _monomials(nvars: int, degree: int) -> list[tuple[int, ...]]:
     return out
 
 
-def _ansatz(entries, q, domain, degree: int, columns: int, scaled_identity: bool) -> list[sympy.Matrix] | None:
+def _ansatz(
+    entries, q, domain, degree: int, columns: int, scaled_identity: bool, first_columns: list | None = None
+) -> list[sympy.Matrix] | None:
     """A basis of the polynomial ``n x columns`` matrices ``X`` of degree ``<= degree`` with
 
     ``A X = 0`` (``scaled_identity=False``) or ``A X = d 1`` for some ``d`` (``True``).
-    ``None`` when the ansatz has more than :data:`MAX_UNKNOWNS` unknowns.
+    ``None`` when the ansatz has more than :data:`MAX_UNKNOWNS` unknowns. A list given as
+    ``first_columns`` receives, per matrix, the first column's entries as dictionaries
+    monomial exponents -> coefficient in ``domain`` (the same coefficients and monomials
+    as the sympy entries: ``ring.from_dict`` of one equals the entry converted, and
+    :func:`_first_diagonal` builds only the few it multiplies).
     """
     k, n = len(entries), len(entries[0])
     monos = _monomials(len(q), degree)
@@ -143,16 +149,22 @@ def _ansatz(entries, q, domain, degree: int, columns: int, scaled_identity: bool
         # the terms of each entry gathered, then summed once: the same canonical sums as
         # adding them one by one (their monomials differ), without re-flattening a growing sum
         terms: dict[tuple[int, int], list[sympy.Expr]] = {}
+        first: list[dict] = [{} for _ in range(n)]  # column 0: monomial -> coefficient, per row
         for u, value in null.get(s, {}).items():
             jc, mi = divmod(u, len(monos))
             power = powers.get(mi)
             if power is None:
                 power = powers[mi] = sympy.Mul(*[v**e for v, e in zip(q, monos[mi])])
-            terms.setdefault(divmod(jc, columns), []).append(domain.to_sympy(value) * power)
+            j, c = divmod(jc, columns)
+            terms.setdefault((j, c), []).append(domain.to_sympy(value) * power)
+            if c == 0:
+                first[j][monos[mi]] = value
         X = sympy.zeros(n, columns)
         for (j, c), parts in terms.items():
             X[j, c] = sympy.Add(*parts)
         out.append(X)
+        if first_columns is not None:
+            first_columns.append(first)
     return out
 
 
@@ -213,10 +225,11 @@ def polynomial_kernel(
     lowest = None
     samples = None
     for degree in range(max_degree + 1):
-        matrices = _ansatz(entries, q, domain, degree, k, scaled_identity=True)
+        columns: list = []
+        matrices = _ansatz(entries, q, domain, degree, k, scaled_identity=True, first_columns=columns)
         if matrices is None:
             return None
-        solutions = [(B, _first_diagonal(A, B, entries, ring)) for B in matrices]
+        solutions = [(B, _first_diagonal(A, B, entries, ring, column)) for B, column in zip(matrices, columns)]
         if lowest is None and any(d != 0 for _, d in solutions):
             lowest = (degree, [(B, d) for B, d in solutions if d != 0])
         if lowest is not None and holonomic:
@@ -236,20 +249,23 @@ def polynomial_kernel(
     return PolynomialKernel(null_basis, lowest[1], (null_degree, lowest[0]))
 
 
-def _first_diagonal(A: sympy.Matrix, B: sympy.Matrix, entries, ring: PolyRing) -> sympy.Expr:
+def _first_diagonal(A: sympy.Matrix, B: sympy.Matrix, entries, ring: PolyRing, column: list) -> sympy.Expr:
     """``d = (A B)_00``, expanded: the scale of ``A B = d 1``.
 
     Over ``QQ`` (no parameters in ``A``) the product is taken in the polynomial ring and
     turned back into the expanded sum, the same expression as ``sympy.expand`` of the
     symbolic product (an expanded polynomial is canonical) at a fraction of the cost, for
-    the hundreds of candidates of (228); with parameters, by ``sympy.expand``.
+    the hundreds of candidates of (228); with parameters, by ``sympy.expand``. ``column``
+    is ``B``'s first column as the terms :func:`_ansatz` built it from: an entry is made
+    a ring element from them (``from_dict``) instead of converting its sympy expression,
+    a third of this function's time on (228) (413 conversions).
     """
     if ring.domain != sympy.QQ:
         return sympy.expand((A[0, :] * B[:, 0])[0, 0])
     total = ring.zero
-    for j, a in enumerate(entries[0]):
-        if a and B[j, 0] != 0:
-            total += a * ring(B[j, 0])
+    for a, b in zip(entries[0], column):
+        if a and b:
+            total += a * ring.from_dict(b)
     return total.as_expr()
 
 

@@ -74,3 +74,23 @@ def test_parameters_stay_in_the_coefficient_field():
     assert kernel is not None
     (n,) = kernel.null_basis
     assert sympy.expand(A[0, 0] * n[0] + A[0, 1] * n[1]) == 0
+
+
+def test_the_first_columns_in_the_ring_are_the_sympy_entries_converted():
+    """The ring elements ``_first_diagonal`` multiplies are ``B``'s first column, exactly (QQ and a parameter field)."""
+    from sympy.polys.rings import PolyRing
+
+    from dirac.analysis.legendre.polynomial_kernel import _ansatz
+
+    q = list(R)
+    a = sympy.Symbol("a", positive=True)
+    # degree 2 gives (228)'s first candidates with d != 0; over the parameter field degree 1 (its exact nullspace is slow)
+    for A, domain, degree in ((body_velocity_map(), sympy.QQ, 2), (a * body_velocity_map(), sympy.QQ.frac_field(a), 1)):
+        ring = PolyRing(q, domain)
+        entries = [[ring(A[i, j]) for j in range(A.shape[1])] for i in range(A.shape[0])]
+        columns: list = []
+        matrices = _ansatz(entries, q, domain, degree, A.shape[0], scaled_identity=True, first_columns=columns)
+        assert matrices and len(columns) == len(matrices)
+        for B, column in zip(matrices, columns):
+            assert [ring(B[j, 0]) for j in range(B.shape[0])] == [ring.from_dict(terms) for terms in column]
+        assert sum(1 for column in columns if any(column)) > 1  # not a comparison of zeros only
