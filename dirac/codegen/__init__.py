@@ -22,7 +22,7 @@ Sympy never runs inside the generated functions.
 from dirac.codegen.kernel_source import analysed_kernel_source, load_kernels, mechanical_kernel_source
 from dirac.codegen.numba_backend import GeneratedFunction, cache_directory, generate_module
 from dirac.codegen.numpy_backend import array_function, numpy_function
-from dirac.codegen.printer import StraightLineCode, UnsupportedExpression, straight_line
+from dirac.codegen.printer import StraightLineCode, UnsupportedExpression, chained, straight_line
 from dirac.codegen.scalar_backend import scalar_function
 
 __all__ = [
@@ -38,4 +38,5 @@ __all__ = [
     "numpy_function",
     "scalar_function",
     "straight_line",
+    "chained",
 ]

@@ -264,6 +264,28 @@ def straight_line(
     return StraightLineCode(assignments, tuple(printer.doprint(value) for value in flat_expressions(reduced)))
 
 
+#: Most operands of one line of a sum or product: a line of ``a + b + ...`` is a left-deep tree
+#: whose depth CPython's compiler recurses into, and about 3,000 operands exceed its limit
+#: (``RecursionError: maximum recursion depth exceeded during compilation``).
+CHAIN_OPERANDS = 200
+
+
+def chained(operands: Sequence[str], operator: str, lines: list[tuple[str, str]], prefix: str = "t") -> str:
+    """The code of ``operands`` joined by ``operator`` (``" + "``, ``" * "``) for the last line of ``lines``.
+
+    Longer than :data:`CHAIN_OPERANDS`, the leading operands go to lines of their own
+    (``<prefix><k>``, ``k`` the line's index in ``lines``, appended to it), each continuing the one before: ``t_1 = a_1 + ... + a_200``,
+    ``t_2 = t_1 + a_201 + ...``. Python adds left to right, so these are the same operations in
+    the same order as one long line: the same bits.
+    """
+    head = list(operands)
+    while len(head) > CHAIN_OPERANDS:
+        name = f"{prefix}{len(lines)}"
+        lines.append((name, operator.join(head[:CHAIN_OPERANDS])))
+        head = [name, *head[CHAIN_OPERANDS:]]
+    return operator.join(head)
+
+
 def _dag_code(
     printer: _MathPrinter, inputs: Mapping[sympy.Symbol, str], outputs: Sequence[sympy.Expr]
 ) -> StraightLineCode:
@@ -305,10 +327,8 @@ def _dag_code(
             operands = [part for part in parts if part is not None]
             if len(operands) < len(parts):  # only a symbol that is not an input is left
                 raise UnsupportedExpression(f"cannot compile {node}: it is not an input")
-            if node.is_Add:
-                code = " + ".join(operands)
-            elif node.is_Mul:
-                code = " * ".join(operands)
+            if node.is_Add or node.is_Mul:
+                code = chained(operands, " + " if node.is_Add else " * ", lines)
             elif node.is_Pow:
                 code = printer.power(operands[0], node.exp, operands[1])
             elif isinstance(node, sympy.Function):

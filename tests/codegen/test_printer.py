@@ -86,3 +86,34 @@ def test_a_large_expression_skips_the_basic_preprocessing_and_keeps_its_value(mo
     for code in (whole, plain):
         value = eval(code.outputs[0], {"math": math, "a0": 0.7, "a1": -1.3})  # noqa: S307 (generated from sympy)
         assert value == pytest.approx(0.7 * -1.3 - 0.7 * 1.69, rel=1e-15)
+
+
+def test_a_long_sum_is_split_into_lines_that_add_in_the_same_order():
+    """A line of 3,000 or more operands is deeper than CPython's compiler recurses (RecursionError at
+    compile time); the dag printer splits sums and products longer than ``CHAIN_OPERANDS`` into lines
+    that continue one another. 450 operands (under the limit, so that one line compiles too) give the
+    same bits both ways, the same additions in the same order; 5,000 compile and equal ``math.fsum`` to
+    rounding."""
+    import math
+    import random
+
+    from dirac.codegen.printer import CHAIN_OPERANDS
+
+    rng = random.Random(7)
+    for count in (450, 5000):
+        xs = sympy.symbols(f"x0:{count}", real=True)
+        code = straight_line({x: f"a[{k}]" for k, x in enumerate(xs)}, [sympy.Add(*xs), sympy.Mul(*xs[:450])],
+                             "math", "dag")
+        assert max(text.count(" + ") for _, text in code.assignments) <= CHAIN_OPERANDS - 1
+        source = "def f(a):\n" + "\n".join(code.body()) + f"\n    return {code.outputs[0]}, {code.outputs[1]}\n"
+        namespace: dict = {"math": math}
+        exec(compile(source, "<test>", "exec"), namespace)
+        values = [rng.uniform(-1.0, 1.0) for _ in range(count)]
+        total, product = namespace["f"](values)
+        order = [int(str(x)[1:]) for x in sympy.Add(*xs).args]  # the printed order of the terms
+        assert total == pytest.approx(math.fsum(values), abs=1e-12 * count)
+        if count == 450:
+            one_line = eval(" + ".join(f"values[{k}]" for k in order))  # noqa: S307 (a test's own text)
+            assert total == one_line
+            factors = [int(str(x)[1:]) for x in sympy.Mul(*xs[:450]).args]
+            assert product == eval(" * ".join(f"values[{k}]" for k in factors))  # noqa: S307

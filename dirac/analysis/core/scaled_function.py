@@ -21,7 +21,7 @@ from typing import Any
 
 import sympy
 
-from dirac.codegen import straight_line
+from dirac.codegen import chained, straight_line
 
 __all__ = ["BOTH", "ScaledFunction", "scaled_function", "terms_of"]
 
@@ -109,15 +109,19 @@ def scaled_function(arguments: Sequence[sympy.Symbol], expressions: Sequence[sym
     code = straight_line(inputs, [*expressions, *symbolic], "math", "dag")
     term_name = dict(zip(symbolic, code.outputs[len(expressions):]))
 
+    size_lines: list[tuple[str, str]] = []  # the partial sums of long sizes (s<k>, apart from the body's t<k>)
+
     def size(terms: tuple[sympy.Expr, ...]) -> str:
         parts = [_literal(abs(float(t))) if t.is_number else f"abs(({term_name[t]}).real)" for t in terms]
-        return " + ".join(["1.0", *parts])
+        return chained(["1.0", *parts], " + ", size_lines, prefix="s")
 
     signature = ", ".join(["flag", *(f"a{k}" for k in range(len(arguments)))])
     values = f"[{', '.join(code.outputs[: len(expressions)])}]"
+    sizes = ", ".join(size(terms) for terms in owned)
+    sizes_body = "".join(f"\n        {name} = {text}" for name, text in size_lines)
     source = (
         f"def _f({signature}):\n" + "\n".join(code.body())
-        + f"\n    if flag:\n        sizes = [{', '.join(size(terms) for terms in owned)}]"
+        + f"\n    if flag:{sizes_body}\n        sizes = [{sizes}]"
         + f"\n        return ({values}, sizes) if flag == {BOTH} else sizes"
         + f"\n    return {values}\n"
     )

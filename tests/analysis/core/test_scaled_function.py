@@ -9,11 +9,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import sympy
 
 from dirac.analysis.core.numeric import Numerics
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.core.scaled_function import scaled_function, terms_of
+from dirac.analysis.core.scaled_function import BOTH, scaled_function, terms_of
 
 x, y, a = sympy.symbols("x y a")
 
@@ -83,8 +84,6 @@ def test_term_scale_before_and_after_compilation_agree() -> None:
 
 def test_both_from_one_pass_by_hand() -> None:
     """flag BOTH: (values, sizes) of x*y - 3, x**2 at (2, 0.5): (-2, 4) and (1 + 1 + 3, 1 + 4) by hand; NaN pairs off the domain."""
-    from dirac.analysis.core.scaled_function import BOTH
-
     fn = scaled_function([x, y], [x * y - 3, x**2])
     assert fn(BOTH, 2.0, 0.5) == ([-2.0, 4.0], [5.0, 5.0])
     values, sizes = scaled_function([x], [sympy.log(x) + 1])(BOTH, -1.0)
@@ -107,3 +106,27 @@ def test_values_after_sizes_at_the_same_point_and_at_another() -> None:
     assert numerics.evaluate([f], [np.array([1.0, -0.0])]).tolist() == [[2.0]]
     numerics.parameter_vector = np.array([5.0])
     assert numerics.evaluate([f], [z]).tolist() == [[2.0]]
+
+
+def test_a_sum_of_thousands_of_terms_compiles_with_its_sizes():
+    """``dirac analyze`` used to stop with a traceback on a sum of about 3,000 terms (a RecursionError of
+    Python's compiler on one line of ``a + b + ...``): 3,500 distinct monomials of 20 variables compile; the
+    value is the sum of the terms (to rounding) and the size ``1 + sum |t_i|`` (by hand, term by term)."""
+    import itertools
+    import math
+    import random
+
+    xs = sympy.symbols("x0:20", real=True)
+    monomials = list(itertools.combinations(range(20), 3))  # 1,140 distinct
+    terms = [sympy.Rational(k % 13 + 1, 7) * sympy.Mul(*[xs[i] ** (1 + k // len(monomials) if j == 0 else 1)
+                                                       for j, i in enumerate(m)])
+             for k, m in enumerate(itertools.islice(itertools.cycle(monomials), 3500))]
+    expression = sympy.Add(*terms)
+    assert len(expression.args) == 3500
+    f = scaled_function(list(xs), [expression])
+    rng = random.Random(3)
+    point = [rng.uniform(-1.5, 1.5) for _ in xs]
+    values, sizes = f(BOTH, *point)
+    by_term = [float(t.subs(dict(zip(xs, point)))) for t in expression.args]
+    assert values[0] == pytest.approx(math.fsum(by_term), rel=1e-12, abs=1e-12 * math.fsum(map(abs, by_term)))
+    assert sizes[0] == pytest.approx(1.0 + math.fsum(map(abs, by_term)), rel=1e-13)
