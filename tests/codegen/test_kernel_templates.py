@@ -18,6 +18,7 @@ same equations are solved by plain fixed-point iteration in numpy from ``M``, ``
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -113,8 +114,12 @@ def _steps_solve_stoermer_verlet(system, mass, dmass, grad_v, q0, p0) -> None:
     """20 steps of h = 0.05 of the kernel, each against the hand-derived scheme redone from
     the kernel's state before it (the bound of the test above)."""
     h = 0.05
-    solution = dirac.integrate(dirac.ConstrainedProblem(system, q0=q0, p0=p0), "rattle-2", t_end=20 * h, dt=h,
-                               samples=21, outputs=["q", "p"], newton_tolerance=1e-12)
+    with warnings.catch_warnings():
+        # steps this long on purpose (several Newton iterations per block): the energy changes by 3-3.8 % of the
+        # kinetic energy, and the run says so (dirac.flows.energy_watch); the steps are what this test checks
+        warnings.filterwarnings("ignore", "the energy of", dirac.DiracWarning)
+        solution = dirac.integrate(dirac.ConstrainedProblem(system, q0=q0, p0=p0), "rattle-2", t_end=20 * h, dt=h,
+                                   samples=21, outputs=["q", "p"], newton_tolerance=1e-12)
     qs, ps = solution.outputs["q"], solution.outputs["p"]
     for k in range(20):
         q1, p1 = _stoermer_verlet(qs[k], ps[k], h, mass, dmass, grad_v)
