@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ENERGY_CHANGE", "EnergyWatch", "energy_watch", "barrier_before"]
+__all__ = ["ENERGY_CHANGE", "EnergyWatch", "energy_watch"]
 
 #: A change of ``H`` beyond this fraction of the largest kinetic energy sampled is reported.
 #: Stormer-Verlet (``rattle-2``) changes the energy of a small oscillation by ``(omega dt)^2 / 4`` of
@@ -185,31 +185,3 @@ def _reads_state(stepper: Any, scipy_mark: str) -> bool:
     for these problems, a ``field`` (constrained) or the ``analysed`` system."""
     return (hasattr(stepper, "q") and hasattr(stepper, "p")) or hasattr(stepper, "z") or (
         hasattr(stepper, "y") and hasattr(stepper, scipy_mark))
-
-
-def barrier_before(mechanics: Any, poles: Any, before: np.ndarray, after: np.ndarray, t: float,
-                   energies: np.ndarray) -> tuple[float, float] | None:
-    """``(V, E)`` where the potential exceeds the start energy ``E`` of its member on the chord from ``before``
-    to the first zero of a pole factor that changed sign towards ``after`` (batches ``(B, n)``); None if nowhere.
-
-    The chord is cut at the zero by bisection of that factor (60 halvings) and ``V`` read at ``10^-k`` of the
-    cut chord before it, ``k = 1 .. 6`` (a pole of ``V`` grows by orders there).
-    """
-    potential = mechanics.module.function("potential")
-    start, end = poles.read(before, t), poles.read(after, t)
-    for b, k in zip(*np.nonzero(np.sign(start) * np.sign(end) < 0.0)):
-        lo, hi = 0.0, 1.0
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            value = poles.read(before[b] + mid * (after[b] - before[b]), t)[0, k]
-            if np.sign(value) == np.sign(start[b, k]):
-                lo = mid
-            else:
-                hi = mid
-        for power in range(1, 7):
-            s = lo * (1.0 - 10.0 ** -power)
-            with np.errstate(all="ignore"):
-                v = float(potential(np.ascontiguousarray(before[b] + s * (after[b] - before[b])), t, mechanics.params))
-            if v > energies[b]:
-                return v, float(energies[b])
-    return None

@@ -354,7 +354,6 @@ class _Loop:
         self.cpu = 0.0
         self._checked_at = 0
         self.energy: EnergyWatch | None = None
-        self._pole_state: np.ndarray | None = None  # the state at the pole guard's last reading
 
     # ------------------------------------------------------------------ storage
     def _keep(self, index: int, values: dict[str, np.ndarray]) -> None:
@@ -574,14 +573,12 @@ class _Loop:
         try:
             if start:
                 poles.start(q, t, self.stepper.steps)
-                self._pole_state = np.array(q, dtype=float)
                 return GUARD_STEPS
             following = poles.check(q, t, self.stepper.steps, steps, at=self.t_now)
         except PoleCrossing as crossing:
             if not crossing.turn and poles.state == "q":
                 crossing = self._barrier(poles, crossing, np.array(q, dtype=float), t)
             raise _Pole(pole_message(str(self.problem.system), crossing, self.method.name)) from None
-        self._pole_state = np.array(q, dtype=float)
         return following
 
     def _barrier(self, poles: PoleGuard, crossing: Any, q: np.ndarray, t: float) -> Any:
@@ -594,12 +591,11 @@ class _Loop:
         The step's chord from the last reading, cut at the factor's zero by bisection, is sampled at ``10^-k``
         of its length before that zero, ``k = 1 .. 6``. Hedged only (the exact path is not the chord).
         """
-        from dirac.flows.energy_watch import barrier_before
+        from dirac.flows.pole_guard import barrier_before
 
-        before = getattr(self, "_pole_state", None)
-        if self.energy is None or self.energy.first is None or before is None or before.shape != q.shape:
+        if self.energy is None or self.energy.first is None:
             return crossing
-        found = barrier_before(getattr(self.problem, "mechanics"), poles, before, q, t, self.energy.first)  # noqa: B009
+        found = barrier_before(poles, getattr(self.problem, "mechanics"), q, t, self.energy.first)  # noqa: B009
         if found is None:
             return crossing
         return type(crossing)(f"{crossing}; the potential on the step's way there rose to V = {found[0]:.3g}, above "

@@ -58,8 +58,8 @@ import numpy as np
 
 from dirac.flows.chart_guard import GUARD_STEPS, MAX_GUARD_STEPS, built_once
 
-__all__ = ["PoleGuard", "pole_guard", "analysed_pole_guard", "PoleCrossing", "message", "READINGS_PER_APPROACH",
-           "COLLAPSE_EXPONENT", "REMEDY"]
+__all__ = ["PoleGuard", "pole_guard", "analysed_pole_guard", "PoleCrossing", "message", "barrier_before",
+           "READINGS_PER_APPROACH", "COLLAPSE_EXPONENT", "REMEDY"]
 
 #: readings per predicted approach: the guard is read again after half the steps the fastest-falling factor
 #: needs to reach zero at its last rate (the rate grows near an attracting pole: ``x ~ (t* - t)^(2/3)`` for
@@ -123,6 +123,8 @@ class PoleGuard:
         self._last: list[float] | None = None  # the last reading
         self._last_time = 0.0
         self._last_step = 0
+        #: the state at the last reading (a copy), the start of the chord :func:`barrier_before` samples
+        self.last_state: np.ndarray | None = None
         self._rate: list[float] = []  # approach per step of each factor over the last interval
         self._eta: list[float] = []  # steps to zero of each factor at that rate (inf: not approaching)
         self._accelerating: list[bool] = []  # whether that approach was as fast as the one before
@@ -160,7 +162,7 @@ class PoleGuard:
         PoleCrossing
             The initial state is on a pole (a factor is zero there).
         """
-        self._last = None
+        self._last = self.last_state = None
         self.steps_to_pole = self.steps_to_collapse = math.inf
         self.check(q, t, step, GUARD_STEPS)
 
@@ -188,6 +190,7 @@ class PoleGuard:
                     raise PoleCrossing(self._describe(i, now, None, t, step))
             # the first reading: every factor nonzero; NaN (no real value) is left to the loop's own checks
             self._last, self._last_time, self._last_step = now, t, step
+            self.last_state = np.array(q, dtype=float)
             self._rate = [math.nan] * len(now)
             self._eta = [math.inf] * len(now)
             self._accelerating = [True] * len(now)
@@ -221,6 +224,7 @@ class PoleGuard:
         if collapsing >= 0:
             self._collapsing = (collapsing // len(self.factors), collapsing % len(self.factors), now[collapsing])
         self._last, self._last_time, self._last_step = now, t, step
+        self.last_state = np.array(q, dtype=float)
         return self.next_reading(now, span)
 
     def next_reading(self, now: list[float], steps: int) -> int:
@@ -552,6 +556,42 @@ def _domain_bounds(exprs: list[Any], variables: list[Any]) -> set[Any]:
                 continue
             bounds.update(denominator_factors(1 / inner, variables))
     return bounds
+
+
+def barrier_before(guard: PoleGuard, mechanics: Any, after: np.ndarray, t: float,
+                   energies: np.ndarray) -> tuple[float, float] | None:
+    """``(V, E)`` where the potential exceeds the start energy ``E`` of its member on the chord from the guard's
+    last reading (:attr:`PoleGuard.last_state`) to the first zero of a pole factor that changed sign towards
+    ``after`` (batches ``(B, n)``); None if nowhere, or if the guard has no reading of that shape.
+
+    The exact motion of a conservative system keeps ``V(q) <= E`` (Arnold, "Mathematical Methods of
+    Classical Mechanics", Sect. 4): where ``V`` exceeds ``E`` between the last reading and the pole, that
+    motion cannot have come there along the step. The chord is cut at the zero by bisection of that factor
+    (60 halvings) and ``V`` read at ``10^-k`` of the cut chord before it, ``k = 1 .. 6`` (a pole of ``V``
+    grows by orders there).
+    """
+    before = guard.last_state
+    if before is None or before.shape != np.shape(after):
+        return None
+    potential = mechanics.module.function("potential")
+    start, end = guard.read(before, t), guard.read(after, t)
+    before, after = np.atleast_2d(before), np.atleast_2d(after)
+    for b, k in zip(*np.nonzero(np.sign(start) * np.sign(end) < 0.0)):
+        lo, hi = 0.0, 1.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            value = guard.read(before[b] + mid * (after[b] - before[b]), t)[0, k]
+            if np.sign(value) == np.sign(start[b, k]):
+                lo = mid
+            else:
+                hi = mid
+        for power in range(1, 7):
+            s = lo * (1.0 - 10.0 ** -power)
+            with np.errstate(all="ignore"):
+                v = float(potential(np.ascontiguousarray(before[b] + s * (after[b] - before[b])), t, mechanics.params))
+            if v > energies[b]:
+                return v, float(energies[b])
+    return None
 
 
 def pole_guard(mechanics: Any) -> PoleGuard | None:
