@@ -43,7 +43,7 @@ import sympy
 
 from dirac.codegen.printer import straight_line
 
-__all__ = ["sparse_rattle_source", "group_families", "Family", "RATTLE_ONLY"]
+__all__ = ["sparse_rattle_source", "group_families", "termwise_gradient", "Family", "RATTLE_ONLY"]
 
 #: marker in the module source of a system whose module holds RATTLE only
 RATTLE_ONLY = "RATTLE_ONLY = True"
@@ -130,6 +130,22 @@ def _family_loop(family: Family, table: str, rows: str, outputs: Sequence[sympy.
     return "\n".join(lines) + "\n"
 
 
+def termwise_gradient(expression: sympy.Expr, symbols: Sequence[sympy.Symbol]) -> list[sympy.Expr]:
+    """``[d expression / d s for s in symbols]``, each term of the sum differentiated only by the symbols it has.
+
+    The same expressions as ``sympy.diff`` (the derivative of a sum is the sum of its terms' derivatives,
+    :meth:`sympy.Add._eval_derivative`), in ``O(terms)`` derivatives of single terms instead of ``n``
+    derivatives of the whole sum: a lattice of ``n`` sites has ``O(n)`` terms, and ``n`` whole derivatives
+    took 58 s of a 200-site lattice's 158 s (CPU under cProfile).
+    """
+    position = {s: k for k, s in enumerate(symbols)}
+    parts: list[list[sympy.Expr]] = [[] for _ in symbols]
+    for term in sympy.Add.make_args(expression):
+        for s in term.free_symbols & position.keys():
+            parts[position[s]].append(sympy.diff(term, s))
+    return [sympy.Add(*p) for p in parts]
+
+
 def sparse_rattle_source(
     coordinates: Sequence[sympy.Symbol],
     parameters: Sequence[sympy.Symbol],
@@ -180,7 +196,7 @@ def constraint_parts(q, t, c, chi, Gv, ct):
 {''.join(calls) or '    return'}
 """)
     # ------------------------------------------------------------ families of grad V
-    gradient = [sympy.diff(potential, s) for s in q]
+    gradient = termwise_gradient(potential, q)
     gfamilies = group_families(gradient, q)
     gcalls = []
     for j, f in enumerate(gfamilies):

@@ -366,7 +366,11 @@ def _build(mechanics: Any) -> PoleGuard | None:
     variables = [*q, *([time] if time is not None else [])]
     velocities = set(symbolic.get("velocities") or ())
     V = sympy.sympify(symbolic.get("potential") or 0)
-    M = [sympy.sympify(e) for e in (symbolic.get("mass") or [])]
+    mass = symbolic.get("mass")
+    # the entries a matrix stores (a zero has no denominator): a lattice of n sites has n of its n^2 entries,
+    # and reading all of them took 4 s of a 400-site lattice's run
+    M = [sympy.sympify(e) for _, e in sorted(mass.todok().items())] if isinstance(mass, sympy.MatrixBase) else \
+        [sympy.sympify(e) for e in (mass or [])]
     chis = [sympy.sympify(e) for e in (symbolic.get("constraints") or [])]
     forces = [sympy.sympify(e) for e in (symbolic.get("forces") or [])]
     if not _may_have_poles([V, *M, *chis, *forces]):
