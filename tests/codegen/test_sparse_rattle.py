@@ -160,3 +160,44 @@ def test_a_long_chain_far_from_the_origin_keeps_its_rods_to_round_off() -> None:
     rods = np.linalg.norm(np.diff(np.vstack([[0.0, 0.0], q.reshape(N, 2)]), axis=0), axis=1)
     assert np.abs(rods - 1.0).max() < 1e-12
     assert np.abs(p).max() > 0.1  # it moved
+
+
+def test_the_termwise_gradient_is_sympys_gradient() -> None:
+    from dirac.codegen.sparse_rattle import termwise_gradient
+
+    x = sympy.symbols("x0:5", real=True)
+    a = sympy.Symbol("a", positive=True)
+    V = sympy.expand(a * (x[1] - x[0]) ** 2 + sympy.sin(x[2]) * x[3] + x[4] ** 3 / 3 - sympy.cos(x[0] - x[4]) + 7)
+    gradient = termwise_gradient(V, x)
+    # by hand: dV/dx0 = -2a(x1 - x0) + sin(x0 - x4), dV/dx4 = x4^2 - sin(x0 - x4), ...
+    by_hand = [-2 * a * (x[1] - x[0]) + sympy.sin(x[0] - x[4]), 2 * a * (x[1] - x[0]), sympy.cos(x[2]) * x[3],
+               sympy.sin(x[2]), x[4] ** 2 - sympy.sin(x[0] - x[4])]
+    assert all(sympy.expand(g - h) == 0 for g, h in zip(gradient, by_hand))
+    assert gradient == [sympy.diff(V, s) for s in x]  # the same expressions, so the same printed kernels
+    assert termwise_gradient(sympy.Integer(3), x) == [0] * 5
+
+
+def test_a_klein_gordon_lattice_runs_looped_and_keeps_its_normal_mode() -> None:
+    """``L = a sum_j (phi_j'^2 - ((phi_{j+1} - phi_j)/a)^2 - m^2 phi_j^2)/2`` on a ring of n sites: the mode
+    ``phi_j = cos(theta j)``, ``theta = 2 pi / n``, oscillates as ``cos(omega t)`` with
+    ``omega^2 = (4/a^2) sin^2(theta/2) + m^2`` (from ``phi_j'' = (phi_{j+1} - 2 phi_j + phi_{j-1})/a^2 - m^2 phi_j``).
+    Stoermer-Verlet (``rattle-2``) is second order: halving dt quarters the error."""
+    import dirac
+    from dirac.codegen.kernel_source import SPARSE_MIN_COORDINATES
+    from dirac.errors import InputError
+
+    n, a = SPARSE_MIN_COORDINATES, 0.1
+    kg = dirac.FieldTheory.from_strings("kg", ["x"], ["phi"], "phi_t**2/2 - phi_x**2/2 - phi**2/2")
+    theta = 2 * np.pi / n
+    mode = np.cos(theta * np.arange(n))
+    problem = dirac.ConstrainedProblem(dirac.lattice(kg, sites=n, spacing=a), q0=mode, qdot0=np.zeros(n))
+    assert RATTLE_ONLY in problem.mechanics.module.source  # the looped module: n^2 entries of M not written
+    omega = np.sqrt(4 / a**2 * np.sin(theta / 2) ** 2 + 1.0)
+    errors = []
+    for dt in (2e-3, 1e-3):
+        solution = dirac.integrate(problem, "rattle-2", t_end=1.0, dt=dt, samples=3)
+        errors.append(np.abs(solution["q"][-1] - mode * np.cos(omega * 1.0)).max())
+    assert errors[1] < 1e-6
+    assert 3.6 < errors[0] / errors[1] < 4.4
+    with pytest.raises(InputError, match=f"{n} coordinates and 0 constraints.*rattle-2"):
+        dirac.integrate(problem, "midpoint", t_end=0.01, dt=1e-3)
