@@ -153,3 +153,61 @@ def test_a_det_w_too_long_to_factor_still_guards_its_zero_set(monkeypatch):
     for theta in (0.4, 1e-3, -0.2):
         q = np.array([[0.3, theta, 1.1]])
         assert guard.distance(q) == pytest.approx(abs(np.tan(theta)) / 2, rel=1e-12)
+
+
+def _double_pendulum(m1: float) -> ConstrainedProblem:
+    """The double pendulum in its angles (Landau & Lifshitz Sect. 5), unit rods:
+    ``W = [[m1 + m2, m2 cos(a - b)], [m2 cos(a - b), m2]]``, ``det W = m2 (m1 + m2 sin(a - b)^2)``."""
+    L = dirac.Lagrangian.from_strings(
+        "double_pendulum", ["a", "b"],
+        "(m1+m2)/2*a_dot**2 + m2/2*b_dot**2 + m2*a_dot*b_dot*cos(a-b) + (m1+m2)*g*cos(a) + m2*g*cos(b)", [],
+        parameters={"m1": m1, "m2": 1.0, "g": 9.81})
+    return ConstrainedProblem(L, q0=[1.0, 0.5], qdot0=[0.0, 0.0])
+
+
+def test_never_zero_encloses_the_factor_over_the_sines_and_cosines():
+    """Interval enclosures by hand over ``|s|, |c| <= 1`` (each monomial in ``[0, 1]`` with even
+    exponents, else ``[-1, 1]``): ``m1 + m2 - m2 c^2`` is in ``[m1, m1 + m2]``, never zero for
+    ``m1 > 0`` (``m1 = 0.1``: a double that is not a short binary fraction, taken exactly), and
+    reaches 0 at ``c = 1`` for ``m1 = 0``; ``-(1 + c^2)`` is in ``[-2, -1]``. Not proved (and
+    each does vanish, or may): ``s`` (``sin(theta) = 0``), ``c_1 + c_2 + 2`` in ``[0, 4]`` (zero
+    at ``b = c = pi``), the triple pendulum's ``6 - 4x^2 - 2y^2 - 3z^2 + 4xyz`` in ``[-7, 10]``,
+    and a factor in a coordinate outside the sines and cosines."""
+    import sympy
+
+    from dirac.flows.chart_guard import never_zero
+
+    s, c, c1, c2, x, y, z, r = sympy.symbols("s c c1 c2 x y z r", real=True)
+    m1, m2 = sympy.symbols("m1 m2", positive=True)
+    pendulum = m1 + m2 - m2 * c**2
+    assert never_zero(pendulum, [s, c], {m1: 1.0, m2: 1.0})
+    assert never_zero(pendulum, [s, c], {m1: 0.1, m2: 3.0})
+    assert not never_zero(pendulum, [s, c], {m1: 0.0, m2: 1.0})
+    assert never_zero(-(1 + c**2), [s, c], {})
+    assert not never_zero(s, [s, c], {})
+    assert not never_zero(c1 + c2 + 2, [c1, c2], {})
+    assert not never_zero(6 - 4 * x**2 - 2 * y**2 - 3 * z**2 + 4 * x * y * z, [x, y, z], {})
+    assert not never_zero(r**2 + 1 + c, [c], {})
+
+
+def test_a_double_pendulum_whose_det_w_never_vanishes_has_no_guard_and_the_same_numbers(monkeypatch):
+    """``det W = m2 (m1 + m2 sin(a - b)^2) >= m1 m2 > 0`` for ``m1 = m2 = 1``: no configuration
+    is singular, and the guard is left out (it was read between calls of the step loop, two
+    calls per output sample of the default run to t = 100 where one does, and its distance
+    ``|f| / |grad f| = (1 + sin^2 u) / (sqrt(2) |sin 2u|)``, ``u = a - b``, never fell below
+    ``1 / sqrt(2)``). The system has no explicit
+    time, so its steps do not depend on those cuts: ``q`` and ``p`` are the same, bit for bit,
+    as with the guard kept. With ``m1 = 0`` (a massless upper bob) ``det W = sin(a - b)^2``
+    vanishes at ``a = b``, and the guard is there."""
+    from dirac.flows import chart_guard as module
+
+    assert chart_guard(_double_pendulum(1.0).mechanics) is None
+    massless = chart_guard(_double_pendulum(0.0).mechanics)
+    assert massless is not None and "cos(a - b)" in massless.locus
+    plain = integrate(_double_pendulum(1.0), "rattle-4", t_end=3.0, dt=0.01, samples=31)
+    kept = _double_pendulum(1.0)
+    monkeypatch.setattr(module, "never_zero", lambda *args: False)
+    assert chart_guard(kept.mechanics) is not None
+    guarded = integrate(kept, "rattle-4", t_end=3.0, dt=0.01, samples=31)
+    assert plain.outputs["q"].tobytes() == guarded.outputs["q"].tobytes()
+    assert plain.outputs["p"].tobytes() == guarded.outputs["p"].tobytes()
