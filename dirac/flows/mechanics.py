@@ -208,6 +208,9 @@ class MechanicalSystem:
     rotation: tuple[int, int, float, str] | None = field(repr=False, default=None)
     forced: bool = False
     conformal_rate: float | None = None
+    # the constant mass last found positive definite (a copy): checked when it changes, not at every sample (a
+    # 400-site lattice's eigvalsh took 60 ms of CPU a sample, and seconds of wall with BLAS threads under load)
+    _positive_mass: np.ndarray | None = field(init=False, repr=False, compare=False, default=None)
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -405,6 +408,8 @@ class MechanicalSystem:
         """``M(q, t)``, checked to be symmetric positive definite."""
         if self.constant_mass is not None:
             matrix = self.constant_mass.copy()
+            if self._positive_mass is not None and np.array_equal(matrix, self._positive_mass):
+                return matrix
         else:
             matrix = self._evaluate("mass", q, time, (self.dimension, self.dimension))
         eigenvalues = np.linalg.eigvalsh(matrix)
@@ -413,6 +418,8 @@ class MechanicalSystem:
                 f"the mass matrix of {self.name!r} is singular or not positive at q = {np.asarray(q).tolist()}: "
                 "RATTLE needs a regular Lagrangian (positive kinetic energy in every velocity)"
             )
+        if self.constant_mass is not None:
+            self._positive_mass = matrix.copy()
         return matrix
 
     def energy(self, q: np.ndarray, p: np.ndarray, time: float = 0.0) -> float:

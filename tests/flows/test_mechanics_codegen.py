@@ -63,3 +63,22 @@ def test_position_dependent_mass_takes_the_general_rattle_path():
     midpoint = integrate(problem, "midpoint", t_end=2.0, dt=0.005, samples=2, outputs=["q"])
     r, th = midpoint["q"][-1]
     assert np.abs([r * np.sin(th), -r * np.cos(th)] - q_ref).max() < 1e-3
+
+
+def test_a_constant_mass_is_checked_once_and_again_when_it_changes(monkeypatch):
+    """The positivity of a constant mass matrix is checked at its first use and whenever its values change
+    (a matrix set singular afterwards is refused), not at every sample."""
+    from dirac.model.systems import load_system
+
+    system = MechanicalSystem.from_lagrangian(load_system("pendulum"))  # its own: the mass is changed below
+    calls = []
+    eigvalsh = np.linalg.eigvalsh
+    monkeypatch.setattr(np.linalg, "eigvalsh", lambda a: calls.append(1) or eigvalsh(a))
+    assert system.constant_mass is not None
+    q = np.zeros(system.dimension)
+    for _ in range(5):
+        np.testing.assert_array_equal(system.mass_matrix(q), system.constant_mass)
+    assert len(calls) <= 1
+    system.constant_mass[0, 0] = 0.0
+    with pytest.raises(InputError, match="singular or not positive"):
+        system.mass_matrix(q)
