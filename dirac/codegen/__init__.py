@@ -32,11 +32,11 @@ __all__ = [
     "analysed_kernel_source",
     "array_function",
     "cache_directory",
+    "chained",
     "generate_module",
     "load_kernels",
     "mechanical_kernel_source",
     "numpy_function",
     "scalar_function",
     "straight_line",
-    "chained",
 ]

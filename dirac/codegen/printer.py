@@ -21,6 +21,10 @@ Three ways to share sub-expressions:
   generate even for brackets whose trees print exponentially long: used for evaluations
   at a few points.
 * ``sharing="tree"``: every output printed whole, nothing shared (small expressions).
+
+On every road a sum or product of more than :data:`CHAIN_OPERANDS` operands is printed over
+several lines (:func:`chained`), in the order of operations of one line: CPython does not
+compile a line of about 3,000 of them.
 """
 
 from __future__ import annotations
@@ -29,12 +33,14 @@ import builtins
 import keyword
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from itertools import islice
+from itertools import count, islice
 from typing import Any, Literal
 
 import sympy
+from sympy.core.mul import _keep_coeff
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
 from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.precedence import PRECEDENCE, precedence
 from sympy.printing.pycode import PythonCodePrinter
 
 __all__ = ["StraightLineCode", "UnsupportedExpression", "distinct_nodes", "flat_expressions", "input_name",
@@ -69,7 +75,123 @@ class StraightLineCode:
         return [f"{indent}{name} = {code}" for name, code in self.assignments]
 
 
-class _MathPrinter(PythonCodePrinter):
+#: Most operands of one line of a sum or product: a line of ``a + b + ...`` is a left-deep tree
+#: whose depth CPython's compiler recurses into, and about 3,000 operands exceed its limit
+#: (``RecursionError: maximum recursion depth exceeded during compilation``; CPython 3.11: 2,987
+#: names added in a ``return`` compiled from a script's top level, 3 fewer per frame of the caller's
+#: stack, 1,187 at 600 frames deep; :func:`ast.parse` fails at 2,989, "during ast construction").
+CHAIN_OPERANDS = 200
+
+
+def chained(operands: Sequence[str], operator: str, lines: list[tuple[str, str]], prefix: str = "t",
+            names: Iterator[str] | None = None) -> str:
+    """The code of ``operands`` joined by ``operator`` (``" + "``, ``" * "``) for the last line of ``lines``.
+
+    Longer than :data:`CHAIN_OPERANDS`, the leading operands go to lines of their own
+    (``<prefix><k>``, ``k`` the line's index in ``lines``, or the next of ``names`` when given,
+    appended to it), each continuing the one before: ``t_1 = a_1 + ... + a_200``,
+    ``t_2 = t_1 + a_201 + ...``. Python adds left to right, so these are the same operations in
+    the same order as one long line: the same bits. ``operator`` may be ``" "`` when each
+    operand but the first carries its own (``"- b"``, ``"+ c"``, as sympy prints a sum).
+    """
+    head = list(operands)
+    while len(head) > CHAIN_OPERANDS:
+        name = next(names) if names is not None else f"{prefix}{len(lines)}"
+        lines.append((name, operator.join(head[:CHAIN_OPERANDS])))
+        head = [name, *head[CHAIN_OPERANDS:]]
+    return operator.join(head)
+
+
+class _ChainedPrinting(PythonCodePrinter):
+    """A code printer whose sums and products of more than :data:`CHAIN_OPERANDS` operands are printed as
+    :func:`chained` lines.
+
+    sympy prints a sum ``a + b - c + ...`` (and a product) on one line, a left-deep tree of binary
+    operations that CPython's compiler recurses into: a sum of 3,000 names printed by
+    :func:`straight_line` (``"cse"`` and ``"tree"``, targets ``"math"`` and ``"numpy"``) fails to compile
+    (``RecursionError``, measured with Python 3.11 from a script's top level at 2,993 names; fewer from
+    deeper in a stack, see :data:`CHAIN_OPERANDS`). Sums and products of more than
+    :data:`CHAIN_OPERANDS` operands, nested ones too (a long sum under a function, a power or in a
+    product), leave their leading operands in :attr:`lines`, each line continuing the one before;
+    the code returned continues the last: the text with each line's name replaced by its code is sympy's
+    one-line text, so the operations and their order are those of the one line, to the last bit.
+    Up to :data:`CHAIN_OPERANDS` operands everything prints as sympy prints it.
+
+    Attributes
+    ----------
+    lines : list of (str, str)
+        The lines ``(name, code)`` left by the printing since the caller last emptied it; they go,
+        in order, before the line of the code printed.
+    names : iterator of str or None
+        Fresh names for these lines; None: long sums print on one line (nothing else may be defined).
+    """
+
+    def __init__(self, settings: dict[str, Any]) -> None:
+        super().__init__(settings)
+        self.lines: list[tuple[str, str]] = []
+        self.names: Iterator[str] | None = None
+
+    def _print_Add(self, expr: sympy.Add, order: str | None = None) -> str:
+        if len(expr.args) <= CHAIN_OPERANDS or self.names is None:
+            code: str = super()._print_Add(expr, order)
+            return code
+        # sympy's StrPrinter._print_Add, each term with its sign, then chained
+        prec = precedence(expr)
+        operands = []
+        for term in self._as_ordered_terms(expr, order=order):
+            text = self._print(term)
+            sign = "+"
+            if text.startswith("-") and not term.is_Add:
+                sign, text = "-", text[1:]
+            if precedence(term) < prec or term.is_Add:
+                text = f"({text})"
+            operands.append(f"{sign} {text}")
+        operands[0] = operands[0][2:] if operands[0][0] == "+" else "-" + operands[0][2:]
+        return chained(operands, " ", self.lines, names=self.names)
+
+    def _print_Mul(self, expr: sympy.Mul) -> str:
+        if len(expr.args) <= CHAIN_OPERANDS or self.names is None:
+            code: str = super()._print_Mul(expr)
+            return code
+        # sympy's CodePrinter._print_Mul (numerator and denominator), each product chained
+        prec = precedence(expr)
+        c, e = expr.as_coeff_Mul()
+        sign = ""
+        if c < 0:
+            expr = _keep_coeff(-c, e)
+            sign = "-"
+        args = expr.as_ordered_factors() if self.order not in ("old", "none") else sympy.Mul.make_args(expr)
+        a: list[sympy.Expr] = []
+        b: list[sympy.Expr] = []
+        pow_paren = []
+        for item in args:
+            if item.is_commutative and item.is_Pow and item.exp.is_Rational and item.exp.is_negative:
+                if item.exp != -1:
+                    b.append(sympy.Pow(item.base, -item.exp, evaluate=False))
+                else:
+                    if len(item.args[0].args) != 1 and isinstance(item.base, sympy.Mul):
+                        pow_paren.append(item)
+                    b.append(sympy.Pow(item.base, -item.exp))
+            else:
+                a.append(item)
+        a = a or [sympy.S.One]
+        if len(a) == 1 and sign == "-":
+            a_str = [self.parenthesize(a[0], 0.5 * (PRECEDENCE["Pow"] + PRECEDENCE["Mul"]))]
+        else:
+            a_str = [self.parenthesize(x, prec) for x in a]
+        b_str = [self.parenthesize(x, prec) for x in b]
+        for item in pow_paren:
+            if item.base in b:
+                b_str[b.index(item.base)] = f"({b_str[b.index(item.base)]})"
+        numerator = chained([sign + a_str[0], *a_str[1:]], "*", self.lines, names=self.names)
+        if not b:
+            return numerator
+        if len(b) == 1:
+            return f"{numerator}/{b_str[0]}"
+        return f"{numerator}/({chained(b_str, '*', self.lines, names=self.names)})"
+
+
+class _MathPrinter(_ChainedPrinting):
     """Scalar Python with ``math`` functions and numbers as floats.
 
     Parameters
@@ -125,13 +247,17 @@ class _MathPrinter(PythonCodePrinter):
         return f"{base}**{code}" if not self.unroll_powers else f"(({base})**({code}))"
 
 
-def _printer(target: Target, sharing: Sharing) -> PythonCodePrinter:
+class _NumPyPrinter(_ChainedPrinting, NumPyPrinter):
+    """sympy's numpy printer (as :func:`sympy.lambdify` prints) with long sums and products chained."""
+
+
+def _printer(target: Target, sharing: Sharing) -> _ChainedPrinting:
     if target == "math":
         # kernels ("cse"): products for small powers; fast-to-build scalar code ("dag"): every
         # bit of a float constant
         return _MathPrinter(unroll_powers=sharing != "dag", exact_floats=sharing == "dag")
     if target == "numpy":
-        return NumPyPrinter({"fully_qualified_modules": True, "inline": True})
+        return _NumPyPrinter({"fully_qualified_modules": True, "inline": True})
     raise ValueError(f"target = {target!r}: use 'math' or 'numpy'")
 
 
@@ -215,7 +341,9 @@ def straight_line(
     inputs
         Every symbol the expressions may use -> its local name in the generated code
         (valid Python names; ``sharing="dag"`` names shared sub-expressions ``t<digits>``,
-        so no input may be named so there; :func:`sympy.cse` picks names no input uses).
+        so no input may be named so there; :func:`sympy.cse` picks names no input uses, and so
+        do the lines of sums longer than :data:`CHAIN_OPERANDS`: ``t<digits>`` (``x<digits>``
+        for ``"numpy"``) numbered on after cse's, placed just before the line that uses them).
     expressions
         The outputs: a sympy matrix (row by row) or a sequence of expressions.
     target
@@ -252,38 +380,29 @@ def straight_line(
     if leftover:
         names = ", ".join(sorted(s.name for s in leftover))
         raise ValueError(f"{label}: expressions use symbols that are neither arguments nor parameters: {names}")
+    replacements: list[tuple[sympy.Symbol, sympy.Expr]] = []
     if sharing == "tree":
-        return StraightLineCode((), tuple(printer.doprint(e) for e in flat_expressions(localised)))
-    if target == "math":
+        reduced = localised
+    elif target == "math":
         outputs = flat_expressions(localised)
         replacements, reduced = sympy.cse(outputs, symbols=sympy.numbered_symbols("t", real=True),
                                           optimizations=_BOUNDED_BASIC)
     else:  # lambdify's cse=True
         replacements, reduced = sympy.cse(localised, list=False)
-    assignments = tuple((symbol.name, printer.doprint(value)) for symbol, value in replacements)
-    return StraightLineCode(assignments, tuple(printer.doprint(value) for value in flat_expressions(reduced)))
-
-
-#: Most operands of one line of a sum or product: a line of ``a + b + ...`` is a left-deep tree
-#: whose depth CPython's compiler recurses into, and about 3,000 operands exceed its limit
-#: (``RecursionError: maximum recursion depth exceeded during compilation``).
-CHAIN_OPERANDS = 200
-
-
-def chained(operands: Sequence[str], operator: str, lines: list[tuple[str, str]], prefix: str = "t") -> str:
-    """The code of ``operands`` joined by ``operator`` (``" + "``, ``" * "``) for the last line of ``lines``.
-
-    Longer than :data:`CHAIN_OPERANDS`, the leading operands go to lines of their own
-    (``<prefix><k>``, ``k`` the line's index in ``lines``, appended to it), each continuing the one before: ``t_1 = a_1 + ... + a_200``,
-    ``t_2 = t_1 + a_201 + ...``. Python adds left to right, so these are the same operations in
-    the same order as one long line: the same bits.
-    """
-    head = list(operands)
-    while len(head) > CHAIN_OPERANDS:
-        name = f"{prefix}{len(lines)}"
-        lines.append((name, operator.join(head[:CHAIN_OPERANDS])))
-        head = [name, *head[CHAIN_OPERANDS:]]
-    return operator.join(head)
+    # the lines of long sums (printer.lines) are named on after cse's names (t0, t1, ... for "math", x0, ... for
+    # "numpy"), skipping the inputs' and cse's: names of the kind the callers already leave to the printed code
+    taken = set(inputs.values()) | {symbol.name for symbol, _ in replacements}
+    stem = "t" if target == "math" else "x"
+    printer.names = (name for name in (f"{stem}{k}" for k in count(len(replacements))) if name not in taken)
+    assignments: list[tuple[str, str]] = []
+    for symbol, value in replacements:
+        code = printer.doprint(value)
+        assignments += printer.lines
+        printer.lines.clear()
+        assignments.append((symbol.name, code))
+    results = tuple(printer.doprint(value) for value in flat_expressions(reduced))
+    assignments += printer.lines
+    return StraightLineCode(tuple(assignments), results)
 
 
 def _dag_code(

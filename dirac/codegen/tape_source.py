@@ -672,6 +672,10 @@ def translate(source: str, name: str, reasons: list[str] | None = None, optimise
         if reasons is not None:
             reasons.append("not Python source")
         return None
+    except RecursionError:  # an expression nested deeper than the parser builds (a line of ~3,000 sums)
+        if reasons is not None:
+            reasons.append("an expression nested too deep to parse")
+        return None
     functions = [n for n in module.body if isinstance(n, ast.FunctionDef) and n.name == name]
     if len(functions) != 1:
         if reasons is not None:

@@ -159,3 +159,39 @@ def test_the_same_source_is_one_module(hoop):
         [x, y, z], [m, g, R, w], m * sympy.eye(3), m * g * z,
         [-x * sympy.sin(w * t) + y * sympy.cos(w * t), x**2 + y**2 + z**2 - R**2], t, title="rotating hoop"))
     assert again is hoop[0]
+
+
+@pytest.mark.parametrize("terms", [450, 3000])
+def test_a_kernel_of_a_long_sum_runs_on_every_tier_with_the_same_bits(terms):
+    """The coupling energy ``k sum_i q_i q_(i+1)`` of a chain of ``terms + 1`` coordinates and its
+    derivative by ``q_5``, ``k (q_4 + q_6)``, as one kernel function. Printed on one line, a sum of
+    3,000 terms does not compile (RecursionError in CPython's compiler, and in the parser of the tape's
+    translation); split over lines it compiles, the tape translates it, and the interpreted code, the
+    tape and numba give the same bits, equal to ``k math.fsum(...)`` to rounding. numba is run on the
+    450 terms only: the 3,000 take it minutes (416 s measured), the two other tiers seconds."""
+    from dirac.codegen.kernel_source import INLINED, emit_function
+    from dirac.codegen.tape_machine import TapeFunction
+    from dirac.codegen.tape_source import translate
+
+    q = sympy.symbols(f"q0:{terms + 1}", real=True)
+    k = sympy.Symbol("k", positive=True)
+    energy = k * sum(q[i] * q[i + 1] for i in range(terms))
+    source = emit_function("coupling", "the coupling energy", [("q", q)], [], [energy, sympy.diff(energy, q[5])],
+                           (2,), [k])
+    x, c = np.random.default_rng(terms).uniform(-1.0, 1.0, terms + 1), np.array([0.75])
+    namespace: dict = {"math": math, "np": np}
+    exec(compile(source.replace(INLINED + "\n", ""), "<kernel>", "exec"), namespace)  # noqa: S102 (generated)
+    interpreted = np.empty(2)
+    namespace["coupling"](x, c, interpreted)
+    assert interpreted[0] == pytest.approx(0.75 * math.fsum(x[:-1] * x[1:]), rel=0, abs=1e-15 * terms)
+    assert interpreted[1] == 0.75 * (x[4] + x[6])
+    reasons: list[str] = []
+    tape = translate(source, "coupling", reasons)
+    assert tape is not None, reasons
+    on_tape = np.empty(2)
+    TapeFunction(tape)(x, c, on_tape)
+    assert on_tape.tolist() == interpreted.tolist()
+    if terms <= 450:
+        compiled = np.empty(2)
+        import_source(_HEADER + source).coupling(x, c, compiled)
+        assert compiled.tolist() == interpreted.tolist()

@@ -117,3 +117,94 @@ def test_a_long_sum_is_split_into_lines_that_add_in_the_same_order():
             assert total == one_line
             factors = [int(str(x)[1:]) for x in sympy.Mul(*xs[:450]).args]
             assert product == eval(" * ".join(f"values[{k}]" for k in factors))  # noqa: S307
+
+
+def _inlined(code: StraightLineCode, text: str) -> str:
+    """``text`` with the name of each line of ``code`` replaced by that line's code, last line first (a line
+    uses only earlier ones): one line of code again."""
+    import re
+
+    for name, line in reversed(code.assignments):
+        text = re.sub(rf"\b{name}\b", lambda _: line, text)  # noqa: B023 (used at once)
+    return text
+
+
+def _function(code: StraightLineCode, count: int, modules: dict) -> object:
+    source = ("def f(a):\n" + "".join(f"    a{k}_ = a[{k}]\n" for k in range(count)) + "\n".join(code.body())
+              + f"\n    return ({''.join(o + ', ' for o in code.outputs)})\n")
+    namespace = dict(modules)
+    exec(compile(source, "<test>", "exec"), namespace)  # noqa: S102 (generated from sympy)
+    return namespace["f"]
+
+
+ROADS = [("math", "cse"), ("math", "tree"), ("numpy", "cse"), ("numpy", "tree")]
+
+
+def _long_expressions(count: int) -> tuple[dict, list[sympy.Expr]]:
+    """Inputs ``a<k>_`` and expressions with sums and products of ``count`` operands, alone and nested:
+    in a function and a power, in a product, a quotient of two long products (no two sums share terms,
+    so that cse leaves them whole)."""
+    xs = sympy.symbols(f"x0:{count}", real=True)
+    total = sympy.Add(*[(-1) ** k * x for k, x in enumerate(xs)])
+    nested = [total, sympy.sin(total + 1) + 2 * total**2, sympy.Mul(*xs[:count // 2]) / sympy.Mul(*xs[count // 2:]),
+              xs[0] * (sympy.Add(*[2 * x for x in xs[1:]]) + 1)]
+    return {x: f"a{k}_" for k, x in enumerate(xs)}, nested
+
+
+@pytest.mark.parametrize(("target", "sharing"), ROADS)
+def test_long_sums_on_the_cse_and_tree_roads_are_split_into_lines_that_keep_the_operations(target, sharing,
+                                                                                          monkeypatch):
+    """Sums and products of more than ``CHAIN_OPERANDS`` operands, also inside a function, a power, a
+    product or a quotient, are printed over lines continuing one another: with each line's name replaced
+    by its code, the text is the one line sympy prints (the printer with the limit out of reach), so the
+    same operations in the same order: 450 operands (the one line compiles too) give the same bits both
+    ways, on random inputs."""
+    import math
+    import random
+
+    import numpy as np
+
+    import dirac.codegen.printer as printer
+
+    count = 450
+    inputs, expressions = _long_expressions(count)
+    code = straight_line(inputs, expressions, target, sharing)
+    assert max(len(text.split()) for _, text in code.assignments) <= 2 * printer.CHAIN_OPERANDS - 1
+    names = [name for name, _ in code.assignments]
+    assert len(set(names)) == len(names) and not set(names) & set(inputs.values())
+    with monkeypatch.context() as patch:
+        patch.setattr(printer, "CHAIN_OPERANDS", 10**9)
+        whole = straight_line(inputs, expressions, target, sharing)
+    assert len(whole.assignments) < len(code.assignments)
+    assert [_inlined(code, text) for text in code.outputs] == [_inlined(whole, text) for text in whole.outputs]
+    modules = {"math": math, "numpy": np}
+    rng = random.Random(11)
+    for _ in range(3):
+        values = [rng.uniform(0.5, 2.0) for _ in range(count)]
+        assert _function(code, count, modules)(values) == _function(whole, count, modules)(values)  # == on floats
+
+
+@pytest.mark.parametrize(("target", "sharing"), [("math", "cse"), ("numpy", "tree")])
+def test_a_sum_of_3000_terms_compiles_once_split(target, sharing, monkeypatch):
+    """A sum of 2,987 or more names on one line does not compile at the top level of a script (CPython
+    3.11's compiler recurses into the left-deep tree: RecursionError; 3 operands fewer per frame of the
+    caller's stack), on every road and target (the kernels' road, "cse" and "math", in
+    test_kernel_source.py). Split, 3,000 compile and equal ``math.fsum`` to rounding."""
+    import math
+    import random
+
+    import numpy as np
+
+    import dirac.codegen.printer as printer
+
+    count = 3000
+    inputs, expressions = _long_expressions(count)
+    code = straight_line(inputs, expressions[:1], target, sharing)
+    rng = random.Random(3)
+    values = [rng.uniform(0.5, 2.0) for _ in range(count)]
+    (total,) = _function(code, count, {"math": math, "numpy": np})(values)
+    assert total == pytest.approx(math.fsum((-1) ** k * v for k, v in enumerate(values)), rel=0, abs=1e-15 * count)
+    if sharing == "tree":  # printed on one line, as before (cse's road: twice the time of sympy's cse)
+        monkeypatch.setattr(printer, "CHAIN_OPERANDS", 10**9)
+        with pytest.raises(RecursionError):
+            _function(straight_line(inputs, expressions[:1], target, sharing), count, {})

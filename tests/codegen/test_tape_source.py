@@ -140,6 +140,8 @@ def test_the_machine_run_by_python_agrees_with_the_compiled_machine() -> None:
     ("for i in range(x.shape[0]):\n        W = np.empty(3)\n        out[0] = W[0]", "an array allocated inside a loop"),
     ("out[0:2] = x[0:2]", "slice"),
     ("out[0] = 0.0 < x[0] < 1.0", "chained"),
+    # a sum of 3,000 names on one line is deeper than Python's parser builds its tree (RecursionError)
+    ("out[0] = " + " + ".join(["x[0]"] * 3000), "nested too deep"),
 ])
 def test_what_the_tape_does_not_translate_is_declined_with_its_reason(body: str, why: str) -> None:
     """A construct outside the machine's operations makes the translation decline (None),
