@@ -210,7 +210,7 @@ def mechanical_kernel_source(
     hidden = [sum((jacobian[a, j] * v[j] for j in range(n)), sympy.S.Zero) + chi_t[a] for a in range(m)]
     hidden_dq = [sympy.diff(h, s) for h in hidden for s in q]
     hidden_dt = [sympy.diff(h, time) if time is not None else sympy.S.Zero for h in hidden]
-    dmass_v = [_row_times(dmass[k], i, v) for k in range(n) for i in range(n)]
+    dmass_v = [entry for k in range(n) for entry in _times(dmass[k], v, n)]
     mass_dt_v = list(mass.diff(time) * sympy.Matrix(v)) if time is not None else [sympy.S.Zero] * n
     qa = [("q", q)]
     qva = [("q", q), ("v", v)]
@@ -313,10 +313,13 @@ def _mass_derivatives(mass: sympy.Matrix, q: Sequence[sympy.Symbol]) -> list[dic
     return derivatives
 
 
-def _row_times(derivative: dict[tuple[int, int], sympy.Expr], i: int, v: Sequence[sympy.Symbol]) -> sympy.Expr:
-    """``sum_j D_ij v_j`` of a sparse ``D`` (entry ``i`` of ``D v``): the expression sympy's product of the
-    dense matrices gives (one ``Add`` of the products ``D_ij v_j``)."""
-    return sympy.Add(*[d * v[j] for (row, j), d in sorted(derivative.items()) if row == i])
+def _times(derivative: dict[tuple[int, int], sympy.Expr], v: Sequence[sympy.Symbol], n: int) -> list[sympy.Expr]:
+    """``D v`` of a sparse ``n x n`` matrix ``D``: entry ``i`` is ``sum_j D_ij v_j``, the expression sympy's
+    product of the dense matrices gives (one ``Add`` of the products ``D_ij v_j``)."""
+    rows: list[list[sympy.Expr]] = [[] for _ in range(n)]
+    for (i, j), d in sorted(derivative.items()):
+        rows[i].append(d * v[j])
+    return [sympy.Add(*terms) for terms in rows]
 
 
 def _quadratic(v: Sequence[sympy.Symbol], derivative: dict[tuple[int, int], sympy.Expr]) -> sympy.Expr:
