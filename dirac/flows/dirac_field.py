@@ -28,7 +28,7 @@ class ConstrainedField:
     def __init__(self, mechanics) -> None:
         self.mechanics = mechanics
         if hasattr(mechanics, "require_field"):
-            mechanics.require_field("the Dirac vector field (scipy methods)")
+            mechanics.require_field("a scipy method")
         self.n = mechanics.dimension
         self.m = mechanics.n_constraints
         self._kernel = mechanics.module.field

@@ -201,3 +201,5 @@ def test_a_klein_gordon_lattice_runs_looped_and_keeps_its_normal_mode() -> None:
     assert 3.6 < errors[0] / errors[1] < 4.4
     with pytest.raises(InputError, match=f"{n} coordinates and 0 constraints.*rattle-2"):
         dirac.integrate(problem, "midpoint", t_end=0.01, dt=1e-3)
+    with pytest.raises(InputError, match="^a scipy method needs the Dirac vector field"):
+        dirac.integrate(problem, "scipy-RK45", t_end=0.01)
