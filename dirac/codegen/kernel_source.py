@@ -302,14 +302,11 @@ def _mass_derivatives(mass: sympy.Matrix, q: Sequence[sympy.Symbol]) -> list[dic
     """
     position = {s: k for k, s in enumerate(q)}
     derivatives: list[dict[tuple[int, int], sympy.Expr]] = [{} for _ in q]
-    rows, columns = mass.shape
-    for i in range(rows):
-        for j in range(columns):
-            entry = mass[i, j]
-            for symbol in entry.free_symbols & position.keys():
-                d = sympy.diff(entry, symbol)
-                if d != 0:
-                    derivatives[position[symbol]][i, j] = d
+    for (i, j), entry in mass.todok().items():  # the entries the matrix stores: the others are zero
+        for symbol in entry.free_symbols & position.keys():
+            d = sympy.diff(entry, symbol)
+            if d != 0:
+                derivatives[position[symbol]][i, j] = d
     return derivatives
 
 
