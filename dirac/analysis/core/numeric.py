@@ -16,6 +16,7 @@ they do not are found by :mod:`dirac.analysis.chain.special_values`).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 from typing import TYPE_CHECKING, Any, Protocol
@@ -567,6 +568,7 @@ class Numerics:
         start: np.ndarray | None = None,
         regular: int = 0,
         minors: Sequence[RankTest] = (),
+        deadline: float | None = None,
     ) -> list[np.ndarray]:
         """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
 
@@ -595,6 +597,9 @@ class Numerics:
             fall within ``1e-3`` of one. Only when ``attempts`` run out are the set-aside
             points used, those farthest from the locus first, and a note in :attr:`notes`
             says so.
+        deadline
+            ``time.process_time()`` past which no further random start is tried (the first
+            always is): a search with a CPU-time budget (:func:`~dirac.analysis.core.divisors.singular_loci`).
 
         Raises
         ------
@@ -623,6 +628,8 @@ class Numerics:
         tries = 0
         singular = 0
         while len(points) < count and tries < attempts:
+            if tries and deadline is not None and time.process_time() > deadline:
+                break
             tries += 1
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
             for i, v in fixed.items():
