@@ -25,7 +25,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.graphs import issparse
-from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.phase_space import PhaseSpace, free_symbols_of
 from dirac.analysis.core.scaled_function import BOTH, ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
@@ -257,6 +257,8 @@ class Numerics:
         self.rng = np.random.default_rng(seed)
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
+        #: batch -> positions in ``(z, parameters)`` of the arguments it takes, when not all of them
+        self._picks: dict[int, np.ndarray] = {}
         #: batches compiled by :func:`scaled_function`: they also give their expressions' term sizes
         self._scaled: dict[int, ScaledFunction] = {}
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
@@ -269,6 +271,7 @@ class Numerics:
         self._values_with_sizes: dict[tuple, Any] = {}
         self._kept = 0  # numbers held in it
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
+        self._arg_set = frozenset(self._args)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
         #: indices of variables that projections hold two of at their start values (:meth:`_held_variables`)
@@ -286,7 +289,7 @@ class Numerics:
         variables, no notes.
         """
         other = Numerics(self.phase_space, parameter_values, seed=seed, time=self.time)
-        other._index, other._batches, other._scaled = self._index, self._batches, self._scaled
+        other._index, other._batches, other._scaled, other._picks = self._index, self._batches, self._scaled, self._picks
         return other
 
     # ------------------------------------------------------------------ compiled functions
@@ -339,12 +342,21 @@ class Numerics:
             return
         raw: Callable
         batch = len(self._batches)
+        arguments = self._args
+        # a batch takes the arguments its expressions hold: one Gauss law of a 256-site lattice held all
+        # 1,024 phase-space variables as arguments, and each of its thousands of calls passed them all
+        # (work quadratic in the size); a symbol that is no argument keeps them all (the error as before)
+        used = free_symbols_of(missing, self.phase_space._free)  # the phase space's memo: nodes walked once
+        if used <= self._arg_set and len(used) < len(arguments):
+            positions = [k for k, a in enumerate(arguments) if a in used]
+            arguments = tuple(arguments[k] for k in positions)
+            self._picks[batch] = np.asarray(positions, dtype=np.intp)
         try:
-            scaled = scaled_function(self._args, missing)
+            scaled = scaled_function(arguments, missing)
             raw = partial(scaled, False)
             self._scaled[batch] = scaled
         except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
-            raw = array_function(self._args, missing)
+            raw = array_function(arguments, missing)
         self._batches.append(raw)
         for i, e in enumerate(missing):
             self._index[e] = (batch, i)
@@ -359,7 +371,11 @@ class Numerics:
         The values are the same numbers either way (the same code).
         """
         z = np.asarray(z, dtype=float)
-        args = [*z.tolist(), *self.parameter_vector.tolist()]
+        pick = self._picks.get(batch)
+        if pick is None:
+            args = [*z.tolist(), *self.parameter_vector.tolist()]
+        else:
+            args = np.concatenate((z, self.parameter_vector))[pick].tolist()
         if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
             key = (batch, z.tobytes(), self.parameter_vector.tobytes())  # bit-exact (0.0 and -0.0 differ)
             if sizes:
