@@ -360,7 +360,7 @@ class ConstraintAnalysis:
         numerics.avoid = list(self._numerics.avoid)
         undecided: list[Undecided] = []
         gram = GramProver.on_first_use(self.canonical_hamiltonian, self._space.coordinates, self._space.momenta,
-                                       surface, variables)  # Gram minors of the multiplier solution (Cauchy-Binet)
+                                       surface, variables, partials=self._space.partials)  # Gram minors (Cauchy-Binet)
         loci = singular_loci(found, surface, numerics, variables, undecided=undecided,
                              regular_at=self._solved_block_regular(numerics), gram=gram)
         self._unsearched = (*unsearched, *undecided)

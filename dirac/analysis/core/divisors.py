@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from math import factorial
 
@@ -142,7 +143,8 @@ def _never_zero(factor: sympy.Expr) -> bool:
 
 
 def denominator_factors(
-    expr: sympy.Expr, variables: Sequence[sympy.Symbol], settled: Callable[[sympy.Expr], bool] | None = None
+    expr: sympy.Expr, variables: Sequence[sympy.Symbol] | AbstractSet[sympy.Symbol],
+    settled: Callable[[sympy.Expr], bool] | None = None,
 ) -> list[sympy.Expr]:
     """The distinct irreducible factors of the denominator of ``expr`` that depend on the ``variables``.
 
@@ -153,7 +155,7 @@ def denominator_factors(
     ``settled`` is true (proven nonzero on the surface, :func:`nonvanishing_on`) is not factored:
     a factor of a function that never vanishes there never vanishes there either.
     """
-    names = set(variables)
+    names = _as_set(variables)
     if not prints_shorter(expr, DIVISOR_TEXT_LIMIT) or not (expr.free_symbols & names):  # size first: a shared tree is huge
         return []
     bases = list(dict.fromkeys(
@@ -165,7 +167,7 @@ def denominator_factors(
     return _irreducible_factors(bases, names)
 
 
-def _irreducible_factors(bases: Sequence[sympy.Expr], names: set) -> list[sympy.Expr]:
+def _irreducible_factors(bases: Sequence[sympy.Expr], names: AbstractSet[sympy.Symbol]) -> list[sympy.Expr]:
     """The distinct irreducible factors of the ``bases`` that depend on ``names``, without real-zero-free ones."""
     found: list[sympy.Expr] = []
     for base in bases:
@@ -204,9 +206,12 @@ def divisions(
     skipped = 0
     seen: set = set()  # nodes shared between the expressions are walked once
     memo: dict = {}  # ... and their free symbols found once
+    names = frozenset(variables)  # once for all the expressions
     for e in exprs:
         e = sympy.sympify(e)
-        if too_long_to_search(e, variables, memo):
+        if e.is_Number:  # no denominator in the variables (most entries of a large multiplier solution are 0)
+            continue
+        if too_long_to_search(e, names, memo):
             bases = structural_divisors(e, variables, settled, seen) if structural else None
             if bases is None:
                 skipped += 1
@@ -214,7 +219,7 @@ def divisions(
             for f in bases:
                 found.setdefault(f, Division(f, stage, what, structural=True))
             continue
-        for f in denominator_factors(e, variables, settled):
+        for f in denominator_factors(e, names, settled):
             found.setdefault(f, Division(f, stage, what))
     if skipped and unsearched is not None:
         unsearched.append(Unsearched(skipped, stage, what, STRUCTURAL_NODES if structural else None))
@@ -290,12 +295,19 @@ def structural_divisors(
     return out
 
 
-def too_long_to_search(expr: sympy.Expr, variables: Sequence[sympy.Symbol], memo: dict | None = None) -> bool:
+def too_long_to_search(expr: sympy.Expr, variables: Sequence[sympy.Symbol] | AbstractSet[sympy.Symbol],
+                       memo: dict | None = None) -> bool:
     """Whether ``expr`` depends on the ``variables`` and prints longer than ``DIVISOR_TEXT_LIMIT``
     characters: :func:`denominator_factors` gives ``[]`` for it without looking at its denominators.
     ``memo`` (:func:`~dirac.analysis.core.phase_space.free_symbols_of`) shares the walk of sub-trees
     between calls: the multipliers of one solve share most of theirs."""
-    return not prints_shorter(expr, DIVISOR_TEXT_LIMIT) and bool(free_symbols_of([expr], memo) & set(variables))
+    return not prints_shorter(expr, DIVISOR_TEXT_LIMIT) and bool(free_symbols_of([expr], memo) & _as_set(variables))
+
+
+def _as_set(variables: Sequence[sympy.Symbol] | AbstractSet[sympy.Symbol]) -> AbstractSet[sympy.Symbol]:
+    """``variables`` as a set (as given when already one: :func:`divisions` builds it once for all its expressions;
+    a set of the 512 variables of a 128-site ring built for each of its 16,512 multiplier entries took 1.5 s)."""
+    return variables if isinstance(variables, (set, frozenset)) else set(variables)
 
 
 @dataclass(frozen=True)
@@ -682,6 +694,13 @@ FACTOR_ORIGIN = "a factor of a denominator"
 #: ... when it is too long to search
 TOO_LONG_TO_SEARCH = (f"not searched: it prints to {SEARCH_TEXT_LIMIT} characters or more (the projections onto "
                       "its zeros would cost more than the analysis)")
+#: CPU seconds the searches for a point of the loci of the other divisors (factors of denominators) may take in
+#: all: each costs milliseconds on a system of a few coordinates, but eight failed projections onto a 24-link
+#: chain's Gram pivot took 1.5 s
+SEARCH_BUDGET = 2.0
+#: why such a divisor stays undecided when that budget ran out before or during its search
+SEARCH_OUT_OF_TIME = ("no point of the surface where it vanishes was found before the budget of these searches "
+                      f"({SEARCH_BUDGET:g} s of CPU time) ran out, which is no proof that there is none")
 #: ... and when the time budget ran out before it was searched
 OUT_OF_TIME = (f"not searched: the budget for divisors read off long expressions ({STRUCTURAL_SEARCHES} searches, "
                f"{STRUCTURAL_BUDGET:g} s of CPU time) ran out")
@@ -811,6 +830,10 @@ def _ring_constant(
     return _exact_value(row[len(used) + 1])
 
 
+class _SearchSpent(Exception):
+    """The budget of the searches for points of loci (:data:`SEARCH_BUDGET`) ran out before a search."""
+
+
 def singular_loci(
     found: Sequence[Division],
     surface: Sequence[sympy.Expr],
@@ -842,7 +865,9 @@ def singular_loci(
     when it recognised the divisor) proves a principal minor of ``J W J^T`` positive on the surface by
     the Cauchy–Binet formula; so do the divisors read off trees left
     when ``budget`` CPU seconds of these decisions, or ``STRUCTURAL_SEARCHES`` searches, have
-    run out.
+    run out, and the other divisors whose search was cut short or not started because the
+    searches for them together took ``SEARCH_BUDGET`` CPU seconds (a projection that fails runs
+    its full count of steps: on a large chain eight of them take seconds).
     """
     fixed = fixed_values(list(surface), variables)
     seen: dict[sympy.Expr, Division] = {}
@@ -852,6 +877,7 @@ def singular_loci(
     memo: dict = {}  # free symbols of the constraints, walked once for all the divisors
     cache: dict = {}  # values on the surface of the nodes of the divisors read off trees (value_on_surface)
     deadline: float | None = None
+    search_deadline: float | None = None  # of the searches for the other divisors' loci (SEARCH_BUDGET)
     searched = 0  # divisors read off trees searched for a point so far (at most STRUCTURAL_SEARCHES)
     plain = {d.divisor: not d.structural or (not _nested(d.divisor) and prints_shorter(d.divisor, DIVISOR_TEXT_LIMIT))
              for d in seen.values()}
@@ -883,14 +909,22 @@ def singular_loci(
             if verdict is not None and verdict.proven:
                 continue  # its numerator is a Gram minor, positive on the surface by Cauchy-Binet: no locus
         searched += d.structural
+        limit: float | None = None  # the searches for divisors not read off trees share SEARCH_BUDGET
+        if not d.structural:
+            search_deadline = time.process_time() + SEARCH_BUDGET if search_deadline is None else search_deadline
+            limit = search_deadline
         try:
-            points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS)
-        except AnalysisError:
+            if limit is not None and time.process_time() > limit:
+                raise _SearchSpent
+            points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS, deadline=limit)
+        except (AnalysisError, _SearchSpent):
+            cut = limit is not None and time.process_time() > limit
             if undecided is not None and (d.structural or not sum_of_squares_on_surface(d.divisor, surface, variables, memo)):
                 verdict = gram(d.divisor) if gram is not None else None
                 if verdict is not None and verdict.proven:
                     continue  # its numerator is a Gram minor, positive on the surface by Cauchy-Binet: no locus
-                reason = NOT_FOUND + (f"; {verdict.reason}" if verdict is not None and verdict.reason else "")
+                reason = (SEARCH_OUT_OF_TIME if cut else NOT_FOUND) + (
+                    f"; {verdict.reason}" if verdict is not None and verdict.reason else "")
                 undecided.append(Undecided(d.divisor, d.stage, d.what, reason, *(() if d.structural else (FACTOR_ORIGIN,))))
             continue  # no point found: proven nonzero, or said not ruled out
         what = d.what

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import itertools
 import random
+import time
 from collections.abc import Callable, Sequence
 
 import sympy
@@ -48,6 +49,9 @@ from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.divisors import GramVerdict, constant_on_surface, sum_of_squares_on_surface
 
 __all__ = ["GramProver", "GramVerdict", "GRAM_BUDGET"]
+
+#: ``expr -> ({q: d expr/dq}, {q: d expr/dp_q})``, the non-zero partial derivatives keyed by the coordinate
+Partials = Callable[[sympy.Expr], tuple[dict, dict]]
 
 #: CPU seconds that the Gram proofs of one analysis may take in all (past it, divisors stay not ruled out)
 GRAM_BUDGET = 2.0
@@ -59,6 +63,39 @@ GRAM_SUBSETS = 64
 GRAM_TERMS = 2000
 #: largest number of terms of a group's expanded sum of squares that is factored (larger groups are not tried)
 GROUP_TERMS = 400
+
+
+def _momentum_hessian(
+    hamiltonian: sympy.Expr, coordinates: Sequence[sympy.Symbol], momenta: Sequence[sympy.Symbol],
+    partials: Partials | None = None,
+) -> tuple[list[int], sympy.Matrix]:
+    """``(used, W)``: the momenta ``H`` contains (indices) and ``W_ij = d^2 H / dp_i dp_j`` over them.
+
+    Each first derivative is taken once and differentiated again only by the momenta it contains
+    (``sympy.hessian`` differentiates ``H`` itself for each of the ``n^2`` entries: 6.9 s for the 48
+    momenta of a 24-link chain). With ``partials`` (:meth:`~dirac.analysis.core.phase_space.PhaseSpace.partials`,
+    ``expr -> ({q: d/dq}, {q: d/dp_q})``) the derivatives the analysis has taken already are read from its cache.
+    """
+    if partials is not None:
+        by_coordinate = partials(hamiltonian)[1]
+        used = [k for k, q in enumerate(coordinates) if q in by_coordinate]
+        first = {k: by_coordinate[coordinates[k]] for k in used}
+    else:
+        used = [k for k, p in enumerate(momenta) if hamiltonian.has(p)]
+        first = {k: sympy.diff(hamiltonian, momenta[k]) for k in used}
+    position = {k: i for i, k in enumerate(used)}
+    entries: dict[tuple[int, int], sympy.Expr] = {}
+    for k in used:
+        d = first[k]
+        if partials is not None:
+            seconds = partials(d)[1]
+            found = {position[j]: seconds[coordinates[j]] for j in used if coordinates[j] in seconds}
+        else:
+            present = d.free_symbols
+            found = {position[j]: sympy.diff(d, momenta[j]) for j in used if momenta[j] in present}
+        entries.update({(position[k], j): value for j, value in found.items() if value != 0})
+    n = len(used)
+    return used, sympy.Matrix(n, n, lambda i, j: entries.get((i, j), sympy.S.Zero))
 
 
 class GramProver:
@@ -76,18 +113,23 @@ class GramProver:
     surface, variables
         All constraints of the surface, and the phase-space variables.
     budget
-        CPU seconds for all calls together (:data:`GRAM_BUDGET`).
+        CPU seconds for all calls together (:data:`GRAM_BUDGET`), or the running budget they share.
+    partials
+        The analysis' cached partial derivatives (``expr -> ({q: d/dq}, {q: d/dp_q})``), or None
+        (``sympy.diff``).
     """
 
     def __init__(
         self, holonomic: Sequence[sympy.Expr], coordinates: Sequence[sympy.Symbol], weights: sympy.Matrix,
-        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float = GRAM_BUDGET,
+        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float | CpuBudget = GRAM_BUDGET,
+        partials: Partials | None = None,
     ) -> None:
         self.holonomic = list(holonomic)
         self.coordinates = list(coordinates)
         self.surface = list(surface)
         self.variables = list(variables)
-        self.budget = CpuBudget(budget)
+        self.budget = budget if isinstance(budget, CpuBudget) else CpuBudget(budget)
+        self._partials = partials
         self._memo: dict = {}
         self._jacobian: sympy.Matrix | None = None
         self._diagonal: list[sympy.Expr] | None = None
@@ -99,39 +141,53 @@ class GramProver:
     @classmethod
     def from_hamiltonian(
         cls, hamiltonian: sympy.Expr, coordinates: Sequence[sympy.Symbol], momenta: Sequence[sympy.Symbol],
-        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float = GRAM_BUDGET,
+        surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float | CpuBudget = GRAM_BUDGET,
+        partials: Partials | None = None,
     ) -> GramProver | None:
         """The prover for ``H_c`` and the surface, or None when there is no Gram structure to use: no
-        constraint in the coordinates alone, or ``d^2 H_c / dp^2`` not constant on phase space."""
+        constraint in the coordinates alone, or ``d^2 H_c / dp^2`` not constant on phase space. ``partials``
+        (the analysis' cached derivatives, ``expr -> ({q: d/dq}, {q: d/dp_q})``) spares taking them again."""
         names = set(variables)
         own = set(coordinates)
         holonomic = [c for c in surface if (c.free_symbols & names) and (c.free_symbols & names) <= own]
         if not holonomic or not momenta:
             return None
-        used = [k for k, p in enumerate(momenta) if hamiltonian.has(p)]
-        if not used:
-            return None
-        ps = [momenta[k] for k in used]
         try:
-            W = sympy.hessian(hamiltonian, ps)
+            used, W = _momentum_hessian(hamiltonian, coordinates, momenta, partials)
         except (TypeError, ValueError):
+            return None
+        if not used:
             return None
         if any(entry.free_symbols & names for entry in W) or W != W.T:
             return None
-        return cls(holonomic, [coordinates[k] for k in used], W, surface, variables, budget)
+        return cls(holonomic, [coordinates[k] for k in used], W, surface, variables, budget, partials)
 
     @classmethod
     def on_first_use(
         cls, hamiltonian: sympy.Expr, coordinates: Sequence[sympy.Symbol], momenta: Sequence[sympy.Symbol],
         surface: Sequence[sympy.Expr], variables: Sequence[sympy.Symbol], budget: float = GRAM_BUDGET,
+        partials: Partials | None = None,
     ) -> Callable[[sympy.Expr], GramVerdict | None]:
         """``divisor -> verdict`` that builds the prover (:meth:`from_hamiltonian`) on its first call: an analysis
-        whose divisors are all decided otherwise never takes the Hessian of ``H_c``."""
+        whose divisors are all decided otherwise never takes the Hessian of ``H_c``. Building it counts in the
+        budget (a step past it leaves every divisor to the other proofs, with the reason)."""
         built: list[GramProver | None] = []
+        started: list[bool] = []
+        clock = CpuBudget(budget)
+        spent = GramVerdict(False, f"the Cauchy-Binet proof for Gram determinants was not tried: its budget "
+                                   f"({clock.seconds:g} s of CPU time) ran out")
 
         def prove(divisor: sympy.Expr) -> GramVerdict | None:
             if not built:
-                built.append(cls.from_hamiltonian(hamiltonian, coordinates, momenta, surface, variables, budget))
+                if not started:  # the clock counts from the first use, not from the analysis' end
+                    started.append(True)
+                    clock.deadline = time.process_time() + clock.seconds
+                try:
+                    with clock.interrupting():
+                        built.append(cls.from_hamiltonian(hamiltonian, coordinates, momenta, surface, variables, clock,
+                                                          partials))
+                except OverBudget:
+                    return spent  # tried again on the next divisor: the clock says at once that it ran out
             prover = built[0]
             return None if prover is None else prover(divisor)
 
@@ -142,7 +198,11 @@ class GramProver:
         """``(J L, diag D)`` with ``W = L D L^T`` (``L = 1`` for a diagonal ``W``); None when ``W`` has no such form."""
         if self._jacobian is None:
             W = self._weights
-            J = sympy.Matrix([[sympy.diff(c, q) for q in self.coordinates] for c in self.holonomic])
+            if self._partials is not None:  # the constraints' gradients, from the analysis' cache
+                rows = [self._partials(c)[0] for c in self.holonomic]
+                J = sympy.Matrix([[row.get(q, sympy.S.Zero) for q in self.coordinates] for row in rows])
+            else:
+                J = sympy.Matrix([[sympy.diff(c, q) for q in self.coordinates] for c in self.holonomic])
             if W.is_diagonal():
                 self._jacobian, self._diagonal = J, [W[i, i] for i in range(W.shape[0])]
             else:

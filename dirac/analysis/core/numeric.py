@@ -16,6 +16,7 @@ they do not are found by :mod:`dirac.analysis.chain.special_values`).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 from typing import TYPE_CHECKING, Any, Protocol
@@ -24,7 +25,7 @@ import numpy as np
 import sympy
 
 from dirac.analysis.core.graphs import issparse
-from dirac.analysis.core.phase_space import PhaseSpace
+from dirac.analysis.core.phase_space import PhaseSpace, free_symbols_of
 from dirac.analysis.core.scaled_function import BOTH, ScaledFunction, scaled_function, terms_of
 from dirac.analysis.core.sparse_numeric import independent_rows_eliminated, independent_rows_one_pass
 from dirac.analysis.core.sparse_surface import LARGE_SYSTEM, SparseJacobian
@@ -256,6 +257,8 @@ class Numerics:
         self.rng = np.random.default_rng(seed)
         self._index: dict[sympy.Expr, tuple[int, int]] = {}
         self._batches: list[Callable] = []
+        #: batch -> positions in ``(z, parameters)`` of the arguments it takes, when not all of them
+        self._picks: dict[int, np.ndarray] = {}
         #: batches compiled by :func:`scaled_function`: they also give their expressions' term sizes
         self._scaled: dict[int, ScaledFunction] = {}
         #: evaluation plans of expression lists met before (:meth:`function`), and their split into terms (:meth:`term_scale`)
@@ -268,6 +271,7 @@ class Numerics:
         self._values_with_sizes: dict[tuple, Any] = {}
         self._kept = 0  # numbers held in it
         self._args = (*phase_space.variables, *([time] if time is not None else []), *self.parameters)
+        self._arg_set = frozenset(self._args)
         #: expressions assumed nonzero (``--assume "EXPR != 0"``): surface points near their zeros are rejected
         self.avoid: list[sympy.Expr] = []
         #: indices of variables that projections hold two of at their start values (:meth:`_held_variables`)
@@ -285,7 +289,7 @@ class Numerics:
         variables, no notes.
         """
         other = Numerics(self.phase_space, parameter_values, seed=seed, time=self.time)
-        other._index, other._batches, other._scaled = self._index, self._batches, self._scaled
+        other._index, other._batches, other._scaled, other._picks = self._index, self._batches, self._scaled, self._picks
         return other
 
     # ------------------------------------------------------------------ compiled functions
@@ -338,12 +342,21 @@ class Numerics:
             return
         raw: Callable
         batch = len(self._batches)
+        arguments = self._args
+        # a batch takes the arguments its expressions hold: one Gauss law of a 256-site lattice held all
+        # 1,024 phase-space variables as arguments, and each of its thousands of calls passed them all
+        # (work quadratic in the size); a symbol that is no argument keeps them all (the error as before)
+        used = free_symbols_of(missing, self.phase_space._free)  # the phase space's memo: nodes walked once
+        if used <= self._arg_set and len(used) < len(arguments):
+            positions = [k for k, a in enumerate(arguments) if a in used]
+            arguments = tuple(arguments[k] for k in positions)
+            self._picks[batch] = np.asarray(positions, dtype=np.intp)
         try:
-            scaled = scaled_function(self._args, missing)
+            scaled = scaled_function(arguments, missing)
             raw = partial(scaled, False)
             self._scaled[batch] = scaled
         except UnsupportedExpression:  # an unusual function: evaluate with numpy instead
-            raw = array_function(self._args, missing)
+            raw = array_function(arguments, missing)
         self._batches.append(raw)
         for i, e in enumerate(missing):
             self._index[e] = (batch, i)
@@ -358,7 +371,11 @@ class Numerics:
         The values are the same numbers either way (the same code).
         """
         z = np.asarray(z, dtype=float)
-        args = [*z.tolist(), *self.parameter_vector.tolist()]
+        pick = self._picks.get(batch)
+        if pick is None:
+            args = [*z.tolist(), *self.parameter_vector.tolist()]
+        else:
+            args = np.concatenate((z, self.parameter_vector))[pick].tolist()
         if batch in self._scaled:  # Python floats through math: nothing for numpy to warn about
             key = (batch, z.tobytes(), self.parameter_vector.tobytes())  # bit-exact (0.0 and -0.0 differ)
             if sizes:
@@ -567,6 +584,7 @@ class Numerics:
         start: np.ndarray | None = None,
         regular: int = 0,
         minors: Sequence[RankTest] = (),
+        deadline: float | None = None,
     ) -> list[np.ndarray]:
         """``count`` points on the surface ``constraints = 0`` (Gauss–Newton projection).
 
@@ -595,6 +613,9 @@ class Numerics:
             fall within ``1e-3`` of one. Only when ``attempts`` run out are the set-aside
             points used, those farthest from the locus first, and a note in :attr:`notes`
             says so.
+        deadline
+            ``time.process_time()`` past which no further random start is tried (the first
+            always is): a search with a CPU-time budget (:func:`~dirac.analysis.core.divisors.singular_loci`).
 
         Raises
         ------
@@ -623,6 +644,8 @@ class Numerics:
         tries = 0
         singular = 0
         while len(points) < count and tries < attempts:
+            if tries and deadline is not None and time.process_time() > deadline:
+                break
             tries += 1
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
             for i, v in fixed.items():

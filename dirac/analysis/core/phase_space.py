@@ -240,7 +240,7 @@ class PhaseSpace:
         system.
         """
         position = self._positions()
-        momentum = {q: position[p] for q, p in zip(self.coordinates, self.momenta)}  # dp is keyed by q
+        shift = len(self.coordinates)  # dp is keyed by q, and p_q sits this far after q in the variables
         rows: list[int] = []
         cols: list[int] = []
         entries: list[sympy.Expr] = []
@@ -252,7 +252,7 @@ class PhaseSpace:
                 entries.append(d)
             for q, d in dp.items():
                 rows.append(i)
-                cols.append(momentum[q])
+                cols.append(position[q] + shift)
                 entries.append(d)
         return rows, cols, entries
 

@@ -222,14 +222,25 @@ class GaugeGenerator:
         return sum((e * g for e, g in zip(self.parameter_symbols(), self.terms)), sympy.S.Zero)
 
 
-def sharing_pairs(space: PhaseSpace, left: Sequence[sympy.Expr], right: Sequence[sympy.Expr]) -> list[tuple[int, int]]:
-    """Index pairs ``(i, j)`` whose expressions share a canonical pair (a ``q_k`` or ``p_k`` each):
-    every other bracket ``{left_i, right_j}`` vanishes identically. In the order ``i``, then ``j``."""
+def touching_index(space: PhaseSpace, right: Sequence[sympy.Expr]) -> dict[sympy.Symbol, list[int]]:
+    """Coordinate ``q_k`` -> indices of the expressions of ``right`` that contain ``q_k`` or ``p_k``
+    (for :func:`sharing_pairs`; built once for a list met again and again)."""
     touching: dict[sympy.Symbol, list[int]] = {}
     for j, e in enumerate(right):
         dq, dp = space.partials(e)
         for q in set(dq) | set(dp):
             touching.setdefault(q, []).append(j)
+    return touching
+
+
+def sharing_pairs(space: PhaseSpace, left: Sequence[sympy.Expr], right: Sequence[sympy.Expr],
+                  touching: dict[sympy.Symbol, list[int]] | None = None) -> list[tuple[int, int]]:
+    """Index pairs ``(i, j)`` whose expressions share a canonical pair (a ``q_k`` or ``p_k`` each):
+    every other bracket ``{left_i, right_j}`` vanishes identically. In the order ``i``, then ``j``.
+    ``touching`` is :func:`touching_index` of ``right`` when the caller has it: each generator of a
+    256-site lattice's gauge structure indexed all 768 constraints again (quadratic in the size)."""
+    if touching is None:
+        touching = touching_index(space, right)
     out: list[tuple[int, int]] = []
     for i, e in enumerate(left):
         dq, dp = space.partials(e)
@@ -244,9 +255,10 @@ def transformation(space: PhaseSpace, G: sympy.Expr) -> dict[sympy.Symbol, sympy
     out = {}
     dq, dp = space.partials(G)
     moved = set(dq) | set(dp)
-    momentum = dict(zip(space.coordinates, space.momenta))
-    candidates = {z for q in moved for z in (q, momentum[q])}
-    for z in (z for z in space.variables if z in candidates):
+    position = space._positions()  # a coordinate's momentum sits len(coordinates) further on
+    variables, n = space.variables, len(space.coordinates)
+    candidates = sorted({k for q in moved for k in (position[q], position[q] + n)})  # in the order of the variables
+    for z in (variables[k] for k in candidates):
         d = sympy.expand(space.poisson_bracket(z, G))
         if d != 0:
             out[z] = d
@@ -402,6 +414,7 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
     secondary = [evolve(g) for g in gammas]  # S_a = {gamma_a, H'} (+ d_t gamma_a)
     expansion_basis = gammas + secondary + constraints
     chain_limit = max(CHAIN_TERM_LIMIT, CHAIN_TERM_PER_VARIABLE * len(space.variables))
+    touching = touching_index(space, constraints)  # for every chain's first-class check
     for index, (gamma, f) in enumerate(zip(gammas, split.free), start=1):
         chain = [gamma]  # G_N, G_{N-1}, ...
         closed = swollen = False
@@ -432,7 +445,7 @@ def gauge_structure(analysis: Any) -> GaugeStructure:
         if not closed:
             structure.unclosed.append(gamma)
             continue
-        problem = _first_class_problem(space, numerics, chain, constraints, points) or _chain_problem(
+        problem = _first_class_problem(space, numerics, chain, constraints, points, touching) or _chain_problem(
             space, numerics, list(reversed(chain)), H1, points, closing_basis, time
         )
         if problem:
@@ -513,10 +526,11 @@ def _chain_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], H1:
     return ""
 
 
-def _first_class_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], constraints, points) -> str:
+def _first_class_problem(space: PhaseSpace, numerics, terms: Sequence[sympy.Expr], constraints, points,
+                         touching: dict[sympy.Symbol, list[int]] | None = None) -> str:
     """Every ``G_k`` is weakly zero and has weakly zero brackets with every constraint;
-    returns what fails, or ``""``."""
-    pairs = sharing_pairs(space, terms, constraints)  # every other bracket vanishes identically
+    returns what fails, or ``""`` (``touching``: :func:`touching_index` of ``constraints``)."""
+    pairs = sharing_pairs(space, terms, constraints, touching)  # every other bracket vanishes identically
     owner = list(range(len(terms))) + [k for k, _ in pairs]
     exprs = list(terms) + [space.poisson_bracket(terms[k], constraints[j]) for k, j in pairs]
     zero = numerics.weakly_zero(exprs, points)

@@ -74,6 +74,7 @@ class BlockBasis:
         for base in basis:
             base = sp.csr_matrix(base)
             base.eliminate_zeros()
+            base.sum_duplicates()
             b, n = base.shape
             pattern = (base != 0).astype(np.int8)
             graph = sp.bmat([[sp.csr_matrix((b, b), dtype=np.int8), pattern], [pattern.T, sp.csr_matrix((n, n), dtype=np.int8)]]).tocsr()
@@ -115,6 +116,7 @@ def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatri
     for point, (vec, base, col_label, big) in enumerate(zip(vectors, blocks.matrices, blocks.col_label, blocks.big)):
         vec = sp.csr_matrix(vec)
         vec.eliminate_zeros()
+        vec.sum_duplicates()
         groups: dict[tuple[int, ...], list[int]] = {}
         for j in range(k):
             if not inside[j]:
@@ -123,9 +125,9 @@ def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatri
             groups.setdefault(tuple(sorted(set(col_label[cols].tolist()))), []).append(j)
         for touched, members in groups.items():
             rows, columns = blocks.gather(point, touched)
-            V = vec[members][:, columns].toarray() if len(columns) else np.zeros((len(members), 0))
+            V = _dense_rows(vec, members, columns)
             if len(rows) and len(columns):
-                Bt = base[rows][:, columns].toarray().T
+                Bt = _dense_rows(base, rows, columns).T
                 coeff = np.linalg.lstsq(Bt, V.T, rcond=None)[0]
                 residual = V - (Bt @ coeff).T
             else:
@@ -134,3 +136,20 @@ def in_span_by_blocks(vectors: Sequence[sp.spmatrix], basis: Sequence[sp.spmatri
             bad = np.linalg.norm(residual, axis=1) > tolerance * size * (1.0 + big)
             inside[np.array(members)[bad]] = False
     return inside
+
+
+def _dense_rows(matrix: sp.csr_matrix, rows: Sequence[int] | np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """``matrix[rows][:, columns].toarray()`` for sorted ``columns`` that hold every non-zero of those rows
+    (rows of the touched blocks: a block's rows have their non-zeros in its columns), read off the CSR
+    arrays: scipy's fancy indexing cost about 0.1 ms an operation, 3 s of a 256-site lattice's gauge
+    structure, whose 512 span tests each took a few small blocks."""
+    out = np.zeros((len(rows), len(columns)))
+    indptr, indices, data = matrix.indptr, matrix.indices, matrix.data
+    for r_out, r in enumerate(rows):
+        lo, hi = indptr[r], indptr[r + 1]
+        if hi > lo:
+            at = np.searchsorted(columns, indices[lo:hi])
+            if np.any(at >= len(columns)) or not np.array_equal(columns[np.minimum(at, len(columns) - 1)], indices[lo:hi]):
+                return matrix[rows][:, columns].toarray()  # a non-zero outside the columns: scipy's own indexing
+            out[r_out, at] = data[lo:hi]
+    return out

@@ -180,3 +180,42 @@ def test_a_regular_system_searched_everything():
         a = dirac.analyze(dirac.load_system("pendulum"))
     assert a.singular_loci_unsearched == ()
     assert a.to_json()["singular_loci_unsearched"] == []
+
+
+def test_a_search_cut_by_its_budget_is_said_not_to_rule_the_locus_out(monkeypatch):
+    """The null vector of ``L = x y y' + x y z'`` divides by ``x`` or ``y`` (by hand, above). With the budget of
+    the searches for the loci of factors set to nothing, no point of ``x = 0`` or ``y = 0`` is looked for: the
+    divisors are said not ruled out, naming the budget, and never counted as proven nonzero."""
+    from dirac.analysis.core import divisors
+
+    monkeypatch.setattr(divisors, "SEARCH_BUDGET", -1.0)
+    L = dirac.Lagrangian.from_strings("null_vector", ["x", "y", "z"], "x*y*y_dot + x*y*z_dot", [])
+    a = dirac.analyze(L)
+    assert not [locus for locus in a.singular_loci if locus.what == MULTIPLIERS_SINGULAR]
+    cut = [u for u in a.singular_loci_unsearched if u.what == MULTIPLIERS_SINGULAR]
+    assert cut and all("before the budget of these searches" in u.reason for u in cut)
+    assert {str(u.divisor) for u in cut} <= {"x", "y"}
+
+
+def test_a_deadline_stops_the_random_starts_after_the_first():
+    """``surface_points(..., deadline=...)`` past its deadline tries one start, not ``attempts``: on
+    ``x^2 + 1 = 0`` (no real point) one start, then the usual error."""
+    from dirac.analysis.core.numeric import Numerics
+    from dirac.analysis.core.phase_space import PhaseSpace
+
+    x, p = sympy.symbols("x p_x")
+    numerics = Numerics(PhaseSpace((x,), (p,)), {})
+    starts = []
+    original = numerics.random_point
+
+    def counted():
+        starts.append(1)
+        return original()
+
+    numerics.random_point = counted  # type: ignore[method-assign]
+    with pytest.raises(AnalysisError):
+        numerics.surface_points([x**2 + 1], 1, attempts=8, deadline=0.0)
+    assert len(starts) == 1
+    with pytest.raises(AnalysisError):
+        numerics.surface_points([x**2 + 1], 1, attempts=8)
+    assert len(starts) == 1 + 8

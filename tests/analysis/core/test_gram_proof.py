@@ -150,3 +150,45 @@ def test_a_one_row_minor_beside_a_turning_constraint_is_proven():
     assert verdict is not None and verdict.proven
     verdict = prover(x**2 + y**2)  # the cylinder's |grad|^2 is no principal minor here: not recognised
     assert verdict is None
+
+
+def test_the_momentum_hessian_is_the_hand_one_from_sympy_and_from_the_cached_partials():
+    """``H = p1^2/(2 m) + p1 p2/k + q^2 p2^2/2 + g q`` (``p3`` absent): by hand ``W = [[1/m, 1/k], [1/k, q^2]]``
+    over the momenta ``H`` holds (``p1``, ``p2``), whether the derivatives come from ``sympy.diff`` or from a
+    phase space's cache (``PhaseSpace.partials``, keyed by the coordinate)."""
+    from dirac.analysis.core.gram_proof import _momentum_hessian
+
+    q1, q2, q3, p1, p2, p3, m, k, g = sympy.symbols("q1 q2 q3 p1 p2 p3 m k g")
+    H = p1**2 / (2 * m) + p1 * p2 / k + q1**2 * p2**2 / 2 + g * q1
+    by_hand = sympy.Matrix([[1 / m, 1 / k], [1 / k, q1**2]])
+    space = PhaseSpace((q1, q2, q3), (p1, p2, p3), (m, k, g))
+    for partials in (None, space.partials):
+        used, W = _momentum_hessian(H, (q1, q2, q3), (p1, p2, p3), partials)
+        assert used == [0, 1]
+        assert (W - by_hand).applyfunc(sympy.simplify) == sympy.zeros(2, 2)
+
+
+def test_the_prover_built_from_the_cached_partials_proves_the_same():
+    """The double pendulum's Schur complement (module docstring) with the derivatives read from a phase space."""
+    m1, m2 = sympy.symbols("m1 m2", positive=True)
+    _, schur, chi = _double_pendulum(m1, m2)
+    space = PhaseSpace((x1, y1, x2, y2), (px1, py1, px2, py2), (m1, m2, l1, l2))
+    H = (px1**2 + py1**2) / (2 * m1) + (px2**2 + py2**2) / (2 * m2)
+    prover = GramProver.from_hamiltonian(H, space.coordinates, space.momenta, chi, space.variables,
+                                         partials=space.partials)
+    assert prover is not None
+    verdict = prover(schur)
+    assert verdict is not None and verdict.proven
+    assert prover(x1**2 - 2 * y1) is None
+
+
+def test_building_the_prover_counts_in_its_budget():
+    """A prover whose budget is spent before it is built says so for every divisor (it never proves)."""
+    m1, m2 = sympy.symbols("m1 m2", positive=True)
+    _, schur, chi = _double_pendulum(m1, m2)
+    H = (px1**2 + py1**2) / (2 * m1) + (px2**2 + py2**2) / (2 * m2)
+    prove = GramProver.on_first_use(H, (x1, y1, x2, y2), (px1, py1, px2, py2), chi,
+                                    (x1, y1, x2, y2, px1, py1, px2, py2), budget=0.0)
+    for _ in range(2):
+        verdict = prove(schur)
+        assert verdict is not None and not verdict.proven and "budget" in verdict.reason

@@ -111,3 +111,16 @@ def test_the_angular_momentum_lagrangian_divides_by_pivots_only_where_its_multip
     assert not [locus for locus in loci if locus.what == MULTIPLIERS_SINGULAR]
     assert not [locus for locus in loci if "Legendre" in locus.what]
     assert "singular locus: R_11 = 0 (divisor R_11, stage 3): the multiplier solution as written" in a_.to_text()
+
+
+def test_the_divisions_of_many_entries_are_the_factors_of_their_denominators_whatever_form_the_variables_take():
+    """By hand: ``0``, ``3`` and ``x y`` divide by nothing, ``1/x`` and ``y/(x (x^2 + 1))`` by ``x`` (``x^2 + 1`` has
+    no real zero), ``1/(x^2 - y^2)`` by ``x - y`` and ``x + y``; ``1/m`` by no variable. The variables given as a
+    list or as a set give the same divisions (a large multiplier solution passes them as a set, once)."""
+    from dirac.analysis.core.divisors import divisions
+
+    m = sympy.Symbol("m", real=True)  # x, y: real (module level), so that x^2 + 1 has no zero
+    entries = [sympy.S.Zero, sympy.Integer(3), x * y, 1 / x, y / (x * (x**2 + 1)), 1 / (x**2 - y**2), 1 / m]
+    for variables in ([x, y], {x, y}):
+        found = {d.divisor for d in divisions(entries, 2, "the multiplier solution divides by zero", variables)}
+        assert found == {x, x - y, x + y}
