@@ -23,6 +23,7 @@ from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.blas_threads import one_blas_thread
+from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.divisors import (
     LEGENDRE_SINGULAR,
     MULTIPLIERS_SINGULAR,
@@ -507,7 +508,8 @@ class ConstraintAnalysis:
         """Canonical Poisson bracket ``{f, g}`` (``{q, p} = 1``; Sect. X)."""
         return self._space.poisson_bracket(self._bracket._sympify(f), self._bracket._sympify(g))
 
-    def dirac_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str, at: Mapping[str, float] | None = None):
+    def dirac_bracket(self, f: sympy.Expr | str, g: sympy.Expr | str, at: Mapping[str, float] | None = None,
+                      time_limit: float | None = EXACT_BRACKET_SECONDS):
         """Dirac bracket (240) over the second-class constraints.
 
         Parameters
@@ -517,15 +519,34 @@ class ConstraintAnalysis:
         at
             Optional numeric point ``{name: value}``; then a float is returned, computed
             without any symbolic inverse of ``C`` (compiled once per pair ``f, g``).
+        time_limit
+            CPU seconds the exact bracket may take (``None``: no limit); the numeric one has none.
 
         Returns
         -------
         sympy.Expr or float
             Exact bracket, weakly simplified on the constraint surface; or its value.
+
+        Raises
+        ------
+        AnalysisError
+            When the exact bracket takes longer than ``time_limit`` (the message names ``at=point``).
         """
         if at is not None:
             return self._bracket.at(f, g, at)
-        return self._bracket.exact(self._bracket._sympify(f), self._bracket._sympify(g))
+        f_expr, g_expr = self._bracket._sympify(f), self._bracket._sympify(g)
+        if time_limit is None:
+            return self._bracket.exact(f_expr, g_expr)
+        clock = CpuBudget(time_limit)
+        try:
+            with clock.interrupting():
+                return self._bracket.exact(f_expr, g_expr)
+        except OverBudget:
+            raise AnalysisError(
+                f"the exact Dirac bracket {{{f_expr}, {g_expr}}}_D of {self.name!r} took more than {time_limit:g} s of "
+                "CPU time (its solve of C x = {Phi, g} grows with the second-class constraints); evaluate it at a point "
+                "with dirac_bracket(f, g, at=point), or give a larger time_limit (None: no limit)"
+            ) from None
 
     def equations_of_motion(
         self,

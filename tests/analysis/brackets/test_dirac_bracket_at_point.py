@@ -119,3 +119,24 @@ def test_singular_point_is_refused():
     point = {s.name: 0.0 for s in analysis.phase_space}
     with pytest.raises(InputError, match="singular"):
         analysis.dirac_bracket("x1", "p_x1", at=point)
+
+
+def test_the_exact_bracket_has_a_budget_that_names_the_numeric_road():
+    """The exact ``{x1, p_x1}_D`` of the one-link chain is ``1 - x1^2 / (x1^2 + y1^2)`` by hand (the tangent
+    projector above, ``J = (2 x1, 2 y1)``), with or without a budget (compared at a point of the rod's circle,
+    where the weakly simplified form agrees); with no CPU time at all it is refused, naming ``at=point``, and
+    the analysis stays usable."""
+    from dirac.errors import AnalysisError
+
+    analysis = dirac.analyze(chain(1))
+    s = analysis.symbols
+    x1, y1 = s["x1"], s["y1"]
+    by_hand = 1 - x1**2 / (x1**2 + y1**2)
+    for limit in (None, 60.0):
+        exact = analysis.dirac_bracket("x1", "p_x1", time_limit=limit)
+        point = {x1: 0.6, y1: -0.8}
+        assert abs(float(exact.subs(point)) - float(by_hand.subs(point))) < 1e-12
+    with pytest.raises(AnalysisError, match=r"at=point"):
+        analysis.dirac_bracket("x1", "p_x1", time_limit=0.0)
+    again = analysis.dirac_bracket("x1", "p_x1")
+    assert abs(float(again.subs(point)) - float(by_hand.subs(point))) < 1e-12
