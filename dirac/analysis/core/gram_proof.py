@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import itertools
 import random
-import time
 from collections.abc import Callable, Sequence
 
 import sympy
@@ -172,16 +171,15 @@ class GramProver:
         whose divisors are all decided otherwise never takes the Hessian of ``H_c``. Building it counts in the
         budget (a step past it leaves every divisor to the other proofs, with the reason)."""
         built: list[GramProver | None] = []
-        started: list[bool] = []
-        clock = CpuBudget(budget)
+        clocks: list[CpuBudget] = []  # started at the first use, not at the analysis' end
         spent = GramVerdict(False, f"the Cauchy-Binet proof for Gram determinants was not tried: its budget "
-                                   f"({clock.seconds:g} s of CPU time) ran out")
+                                   f"({float(budget):g} s of CPU time) ran out")
 
         def prove(divisor: sympy.Expr) -> GramVerdict | None:
             if not built:
-                if not started:  # the clock counts from the first use, not from the analysis' end
-                    started.append(True)
-                    clock.deadline = time.process_time() + clock.seconds
+                if not clocks:
+                    clocks.append(CpuBudget(budget))
+                clock = clocks[0]
                 try:
                     with clock.interrupting():
                         built.append(cls.from_hamiltonian(hamiltonian, coordinates, momenta, surface, variables, clock,

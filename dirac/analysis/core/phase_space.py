@@ -240,7 +240,6 @@ class PhaseSpace:
         system.
         """
         position = self._positions()
-        shift = len(self.coordinates)  # dp is keyed by q, and p_q sits this far after q in the variables
         rows: list[int] = []
         cols: list[int] = []
         entries: list[sympy.Expr] = []
@@ -252,9 +251,14 @@ class PhaseSpace:
                 entries.append(d)
             for q, d in dp.items():
                 rows.append(i)
-                cols.append(position[q] + shift)
+                cols.append(self.pair_positions(q)[1])  # dp is keyed by q
                 entries.append(d)
         return rows, cols, entries
+
+    def pair_positions(self, coordinate: sympy.Symbol) -> tuple[int, int]:
+        """Positions in :attr:`variables` of ``coordinate`` and of its momentum (``len(coordinates)`` further on)."""
+        k = self._positions()[coordinate]
+        return k, k + len(self.coordinates)
 
     def _positions(self) -> dict[sympy.Symbol, int]:
         """Variable -> its position in :attr:`variables` (built once per tuple of variables)."""

@@ -255,9 +255,8 @@ def transformation(space: PhaseSpace, G: sympy.Expr) -> dict[sympy.Symbol, sympy
     out = {}
     dq, dp = space.partials(G)
     moved = set(dq) | set(dp)
-    position = space._positions()  # a coordinate's momentum sits len(coordinates) further on
-    variables, n = space.variables, len(space.coordinates)
-    candidates = sorted({k for q in moved for k in (position[q], position[q] + n)})  # in the order of the variables
+    variables = space.variables
+    candidates = sorted({k for q in moved for k in space.pair_positions(q)})  # in the order of the variables
     for z in (variables[k] for k in candidates):
         d = sympy.expand(space.poisson_bracket(z, G))
         if d != 0:
