@@ -52,7 +52,7 @@ import numpy as np
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from dirac.analysis.core.algebra import printed, prints_shorter
+from dirac.analysis.core.algebra import printed, prints_shorter, rational_parts
 from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.errors import AnalysisError
 
@@ -150,7 +150,11 @@ def denominator_factors(
 
     The bases of the negative powers in ``expr`` (its denominators) are factored
     (``sympy.factor_list``; ``sin(theta)`` counts as a factor of ``sin(theta)**2``); a
-    factor that a numerator would cancel is kept (no gcd is taken). Factors without real zeros and numbers are left out; an
+    factor that a numerator would cancel is kept (no gcd is taken). A base is factored
+    as the polynomial it is (:func:`~dirac.analysis.core.algebra.rational_parts`): one with
+    parameters in its own denominators through its numerator (``x**2/m - y**2/m`` gives
+    ``x - y`` and ``x + y``), one whose reduced denominator holds the variables (the pivot
+    ``x - y**2/x`` of an elimination) is kept whole. Factors without real zeros and numbers are left out; an
     expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``. A denominator for which
     ``settled`` is true (proven nonzero on the surface, :func:`nonvanishing_on`) is not factored:
     a factor of a function that never vanishes there never vanishes there either.
@@ -171,8 +175,15 @@ def _irreducible_factors(bases: Sequence[sympy.Expr], names: AbstractSet[sympy.S
     """The distinct irreducible factors of the ``bases`` that depend on ``names``, without real-zero-free ones."""
     found: list[sympy.Expr] = []
     for base in bases:
-        try:
-            _, listed = sympy.factor_list(sympy.expand(base))
+        parts = rational_parts(base)
+        if parts is not None and parts[1].free_symbols & names:
+            # a quotient whose reduced denominator holds the variables (a pivot a - b c/d of an
+            # elimination): no polynomial to factor, kept whole (sympy's factor_list refuses it, after
+            # expanding it for up to seconds)
+            found.append(base)
+            continue
+        try:  # a polynomial over numbers and parameters: its numerator's factors (those of the parameters drop out below)
+            _, listed = sympy.factor_list(parts[0] if parts is not None else sympy.expand(base))
             found += [f for f, _ in listed]
         except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
             found.append(base)
@@ -376,6 +387,9 @@ def constant_on_surface(
     own = sorted(divisor.free_symbols & set(variables), key=lambda s: s.name)
     if not own:
         return None
+    parts = rational_parts(divisor)
+    if parts is not None and parts[1].free_symbols & set(own):
+        return None  # no polynomial in its variables (a reduced denominator holds them): no such identity
     names = set(variables)
     memo = {} if memo is None else memo
     key = ("constraint polynomials", tuple(own))
