@@ -220,9 +220,10 @@ def rational_parts(expr: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr] | None:
 
     ``expr`` is taken into the fraction field ``QQ(symbols)`` by one walk of its graph
     (:func:`ring_value`; ``FracField`` reduces after every operation, so ``N`` and ``D``
-    have no common factor and ``D`` has a positive leading coefficient). ``None`` for an
+    have no common factor and ``D`` has a positive leading coefficient); a function of the
+    symbols (``sin(theta)``) is a generator of its own, as in sympy's polynomials. ``None`` for an
     expression that is not a rational function with rational coefficients (a ``Float``, a
-    function, a fractional power). What it answers that ``sympy.expand`` cannot say
+    fractional power). What it answers that ``sympy.expand`` cannot say
     cheaply: whether ``expr`` is a polynomial in some of its symbols (``D`` free of them),
     for a nested quotient such as the pivot ``a - b c / d`` of an elimination, whose
     expansion costs seconds (Geddes, Czapor & Labahn, "Algorithms for Computer Algebra",
@@ -232,8 +233,10 @@ def rational_parts(expr: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr] | None:
     symbols = sorted(expr.free_symbols, key=lambda s: s.name)
     if not symbols or not all(s.is_Symbol for s in symbols):
         return None
-    field = FracField(symbols, sympy.QQ)
-    gens = dict(zip(symbols, field.gens))
+    # a function of the symbols (sin(theta), exp(x)) is one more generator, as for sympy's polynomials
+    applied = sorted({node for node in distinct_nodes(expr) if isinstance(node, sympy.Function)}, key=sympy.default_sort_key)
+    field = FracField([*symbols, *applied], sympy.QQ)
+    gens = dict(zip([*symbols, *applied], field.gens))
     try:
         value = ring_value(expr, gens, field, invert=lambda base: field(1) / base)
     except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):

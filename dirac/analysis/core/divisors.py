@@ -54,6 +54,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from dirac.analysis.core.algebra import printed, prints_shorter, rational_parts
 from dirac.analysis.core.phase_space import free_symbols_of
+from dirac.analysis.core.pythagoras import pythagorean_form
 from dirac.errors import AnalysisError
 
 __all__ = [
@@ -66,7 +67,7 @@ __all__ = [
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
 DIVISOR_TEXT_LIMIT = 4000
 
-#: a trigonometric factor with at most this many terms is simplified (``sin(x)**2 + cos(x)**2`` is no divisor)
+#: a trigonometric factor with at most this many terms is reduced with Pythagoras (``sin(x)**2 + cos(x)**2`` is no divisor)
 TRIG_TERMS = 8
 
 #: projections onto a locus tried before it counts as not meeting the surface
@@ -188,13 +189,32 @@ def _irreducible_factors(bases: Sequence[sympy.Expr], names: AbstractSet[sympy.S
         except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
             found.append(base)
     out = []
-    for f in found:
-        if f.has(sympy.sin, sympy.cos) and len(f.args) <= TRIG_TERMS:
-            f = sympy.trigsimp(f)  # sin(psi)**2 + cos(psi)**2 is 1
+    for f in _reduced_trigonometric(found):
         if f.free_symbols & names and not _never_zero(f):
             f = -f if f.could_extract_minus_sign() else f
             if f not in out:
                 out.append(f)
+    return out
+
+
+def _reduced_trigonometric(factors: list[sympy.Expr]) -> list[sympy.Expr]:
+    """The ``factors``, each of at most ``TRIG_TERMS`` terms in sines and cosines reduced with Pythagoras
+    (:func:`~dirac.analysis.core.pythagoras.pythagorean_form`: ``sin(psi)**2 + cos(psi)**2`` is 1, exactly
+    and in milliseconds, where ``trigsimp`` could take minutes) and factored again when that changed it
+    (``sin(x)**2 + cos(x)**2 - y**2`` is ``(1 - y)(1 + y)``)."""
+    out: list[sympy.Expr] = []
+    for f in factors:
+        if not (f.has(sympy.sin, sympy.cos) and len(f.args) <= TRIG_TERMS):
+            out.append(f)
+            continue
+        reduced = pythagorean_form(f)
+        if reduced == f:
+            out.append(f)
+            continue
+        try:
+            out += [g for g, _ in sympy.factor_list(reduced)[1]]
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            out.append(reduced)
     return out
 
 
