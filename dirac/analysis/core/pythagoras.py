@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import sympy
 
+from dirac.analysis.core.algebra import rational_parts
+
 __all__ = ["CirclePolynomial", "circle_polynomial", "pythagorean_form", "trig_arguments"]
 
 
@@ -60,22 +62,36 @@ def circle_polynomial(expr: sympy.Expr) -> CirclePolynomial | None:
     polynomial = sympy.expand(expr.xreplace(to_symbols))
     if polynomial.has(sympy.sin, sympy.cos) or not polynomial.is_polynomial(*sines, *cosines):
         return None  # sines of sums written another way, or not a polynomial in them
-    both = [(s, c) for s, c in zip(sines, cosines) if polynomial.has(s) and polynomial.has(c)]
-    if both:  # Pythagoras, eliminating the sines or the cosines: the shorter of the two (or none)
-        others = sorted(polynomial.free_symbols - set(sines) - set(cosines), key=str)
-        circle = [s**2 + c**2 - 1 for s, c in both]
-        candidates = [polynomial]
-        for first in ([s for s, _ in both], [c for _, c in both]):
-            rest = [g for g in (*sines, *cosines) if g not in first]
-            try:
-                remainder = sympy.reduced(polynomial, circle, *first, *rest, *others)[1]
-            except sympy.PolynomialError:  # a parameter in a denominator: the parameters as coefficients
-                try:
-                    remainder = sympy.reduced(polynomial, circle, *first, *rest)[1]
-                except (sympy.PolynomialError, sympy.CoercionFailed):
-                    return None
-            candidates.append(sympy.expand(remainder))
-        polynomial = min(candidates, key=lambda p: len(sympy.Add.make_args(p)))
+    # Pythagoras, eliminating the squares of the sines or of the cosines of all the angles, or
+    # angle by angle whichever of (neither, the sine, the cosine) leaves the fewest terms: the
+    # shortest of these (the first of the shortest; ``M + m - m cos(u)^2`` is ``M + m sin(u)^2``)
+    present = [(s, c) for s, c in zip(sines, cosines) if polynomial.has(s) or polynomial.has(c)]
+    others = sorted(polynomial.free_symbols - set(sines) - set(cosines), key=str)
+    every = [*sines, *cosines]
+
+    def reduced(p: sympy.Expr, leading: list[sympy.Symbol], pairs: list[tuple[sympy.Symbol, sympy.Symbol]]) -> sympy.Expr:
+        circle = [s**2 + c**2 - 1 for s, c in pairs]
+        rest = [g for g in every if g not in leading]
+        try:
+            remainder = sympy.reduced(p, circle, *leading, *rest, *others)[1]
+        except sympy.PolynomialError:  # a parameter in a denominator: the parameters as coefficients
+            remainder = sympy.reduced(p, circle, *leading, *rest)[1]
+        return sympy.expand(remainder)
+
+    def size(p: sympy.Expr) -> int:
+        return len(sympy.Add.make_args(p))
+
+    candidates = [polynomial]
+    try:
+        if present:
+            candidates += [reduced(polynomial, [pair[k] for pair in present], present) for k in (0, 1)]
+            step = polynomial
+            for pair in present:
+                step = min([step, *(reduced(step, [pair[k]], [pair]) for k in (0, 1))], key=size)
+            candidates.append(step)
+    except (sympy.PolynomialError, sympy.CoercionFailed):
+        return None
+    polynomial = min(candidates, key=size)
     back = {symbol: function for function, symbol in to_symbols.items()}
     return CirclePolynomial(polynomial, sines, cosines, back)
 
@@ -84,12 +100,24 @@ def pythagorean_form(expr: sympy.Expr) -> sympy.Expr:
     """``expr`` with ``sin(u)^2 + cos(u)^2 = 1`` used where that leaves fewer terms, else ``expr``.
 
     The same function of the angles (:func:`circle_polynomial`): ``sin(psi)**2 + cos(psi)**2``
-    is ``1``, ``a*sin(u)**2 + a*cos(u)**2 + b`` is ``a + b``.
+    is ``1``, ``a*sin(u)**2 + a*cos(u)**2 + b`` is ``a + b``. A quotient is taken as its
+    reduced numerator over its reduced denominator
+    (:func:`~dirac.analysis.core.algebra.rational_parts`, sines and cosines as generators).
     """
     reduced = circle_polynomial(expr)
-    if reduced is None:
+    if reduced is not None:
+        if len(sympy.Add.make_args(reduced.polynomial)) >= len(sympy.Add.make_args(sympy.expand(expr))):
+            return expr
+        return reduced.polynomial.xreplace(reduced.back)
+    parts = rational_parts(expr)
+    if parts is None or parts[1] == 1:
         return expr
-    terms = len(sympy.Add.make_args(sympy.expand(expr)))
-    if len(sympy.Add.make_args(reduced.polynomial)) >= terms:
+    pieces = [circle_polynomial(part) for part in parts]
+    if all(piece is None for piece in pieces):
         return expr
-    return reduced.polynomial.xreplace(reduced.back)
+    numerator, denominator = (part if piece is None else piece.polynomial.xreplace(piece.back)
+                              for part, piece in zip(parts, pieces))
+    before = sum(len(sympy.Add.make_args(part)) for part in parts)
+    if len(sympy.Add.make_args(numerator)) + len(sympy.Add.make_args(denominator)) >= before:
+        return expr
+    return sympy.factor(numerator) / sympy.factor(denominator)
