@@ -170,7 +170,7 @@ def _locus(det: Any, q: list[Any], factors: Callable[[Any, list[Any]], list[Any]
     """
     from dirac.analysis.core.pythagoras import circle_polynomial
 
-    reduced = circle_polynomial(det)
+    reduced = circle_polynomial(det, by_angle=False)  # all sines or all cosines: the loci as they were named
     if reduced is None:  # no sines or cosines, or not a polynomial in them: as before
         return factors(1 / det, q), False
     polynomial, sines, cosines, back = reduced.polynomial, reduced.sines, reduced.cosines, reduced.back

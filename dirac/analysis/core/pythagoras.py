@@ -49,9 +49,15 @@ class CirclePolynomial:
     back: dict[sympy.Symbol, sympy.Expr]
 
 
-def circle_polynomial(expr: sympy.Expr) -> CirclePolynomial | None:
+def circle_polynomial(expr: sympy.Expr, by_angle: bool = True) -> CirclePolynomial | None:
     """``expr`` reduced modulo ``s_u^2 + c_u^2 - 1`` (see the module text); ``None`` when it has
-    no sines or cosines or is not a polynomial in them (a sine in a denominator)."""
+    no sines or cosines or is not a polynomial in them (a sine in a denominator).
+
+    The shortest of: ``expr`` as it is, all sines eliminated, all cosines eliminated (of the
+    angles whose sine and cosine both occur), and
+    (with ``by_angle``) each angle in turn left alone or reduced by its sine or its cosine,
+    whichever leaves the fewest terms (``M + m - m cos(u)^2`` is ``M + m sin(u)^2``).
+    """
     arguments = sorted(trig_arguments(expr), key=sympy.default_sort_key)
     if not arguments:
         return None
@@ -62,9 +68,6 @@ def circle_polynomial(expr: sympy.Expr) -> CirclePolynomial | None:
     polynomial = sympy.expand(expr.xreplace(to_symbols))
     if polynomial.has(sympy.sin, sympy.cos) or not polynomial.is_polynomial(*sines, *cosines):
         return None  # sines of sums written another way, or not a polynomial in them
-    # Pythagoras, eliminating the squares of the sines or of the cosines of all the angles, or
-    # angle by angle whichever of (neither, the sine, the cosine) leaves the fewest terms: the
-    # shortest of these (the first of the shortest; ``M + m - m cos(u)^2`` is ``M + m sin(u)^2``)
     present = [(s, c) for s, c in zip(sines, cosines) if polynomial.has(s) or polynomial.has(c)]
     others = sorted(polynomial.free_symbols - set(sines) - set(cosines), key=str)
     every = [*sines, *cosines]
@@ -81,10 +84,12 @@ def circle_polynomial(expr: sympy.Expr) -> CirclePolynomial | None:
     def size(p: sympy.Expr) -> int:
         return len(sympy.Add.make_args(p))
 
+    both = [(s, c) for s, c in present if polynomial.has(s) and polynomial.has(c)]
     candidates = [polynomial]
     try:
-        if present:
-            candidates += [reduced(polynomial, [pair[k] for pair in present], present) for k in (0, 1)]
+        if both:  # all the sines, or all the cosines, of the angles that have both
+            candidates += [reduced(polynomial, [pair[k] for pair in both], both) for k in (0, 1)]
+        if present and by_angle:
             step = polynomial
             for pair in present:
                 step = min([step, *(reduced(step, [pair[k]], [pair]) for k in (0, 1))], key=size)
