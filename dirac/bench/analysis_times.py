@@ -20,6 +20,11 @@ meet; the figure is the time to that answer), and the regular relativistic parti
 with all four parameters symbolic (4 second class, 1 degree of freedom; its
 special-parameter-value search has square roots in every entry of ``C``).
 
+:data:`REPORT_CASES` time the analysis with its text report on everyday systems users write
+(a pendulum on a cart, a triple pendulum in Cartesian coordinates, a slider-crank, a
+spherical double pendulum, a triple pendulum in its angles, an asymmetric top in Euler
+angles): target 5 s of CPU each, "a few seconds" for a system of a few coordinates.
+
 :data:`ANALYZE_COMMAND_TARGETS` are the end-to-end times of ``dirac analyze NAME`` as a
 user meets them (:func:`dirac.bench.targets.analyze_command_targets`).
 """
@@ -31,16 +36,22 @@ import subprocess
 import sys
 from dataclasses import dataclass
 
-__all__ = ["ANALYSIS_CASES", "ANALYZE_COMMAND_TARGETS", "BOUNDED_CASES", "AnalysisCase", "analysis_time", "analysis_runs"]
+__all__ = ["ANALYSIS_CASES", "ANALYZE_COMMAND_TARGETS", "BOUNDED_CASES", "REPORT_CASES", "AnalysisCase", "analysis_time",
+           "analysis_runs"]
 
 
 @dataclass(frozen=True)
 class AnalysisCase:
-    """One Lagrangian to analyse: Python that builds ``L``, and the CPU-time target (s)."""
+    """One Lagrangian to analyse: Python that builds ``L``, and the CPU-time target (s).
+
+    With ``report`` the text report (``analysis.to_text()``, what ``dirac analyze`` prints)
+    is timed with the analysis.
+    """
 
     name: str
     build: str
     target: float
+    report: bool = False
 
 
 #: the ellipse the square-root particle is held on (a regular curve: its gradient never vanishes on it)
@@ -69,6 +80,15 @@ BOUNDED_CASES = (
     ),
 )
 
+#: everyday systems as users write them (``dirac_systems.report_models``): the analysis and its text report, whose
+#: proofs and factorisations once took seconds to minutes (a trigsimp that did not end, a divisor expanded for 3 s)
+REPORT_CASES = tuple(
+    AnalysisCase(f"{name.replace('_', ' ')}, analysis and report",
+                 f"__import__('dirac_systems.report_models', fromlist=['MODELS']).MODELS[{name!r}]()", 5.0, report=True)
+    for name in ("pendulum_on_a_cart", "triple_pendulum_cartesian", "slider_crank", "spherical_double_pendulum",
+                 "triple_pendulum_angles", "asymmetric_top")
+)
+
 #: ``dirac analyze NAME`` end to end (fresh process: interpreter, imports, analysis, report): target CPU seconds
 ANALYZE_COMMAND_TARGETS = {"rigid_body_momentum": 3.0, "rigid_body_particles": 2.5, "rigid_body_matrix": 2.0}
 
@@ -80,7 +100,9 @@ L = {build}
 analyze = dirac.analyze  # a lazy export: resolving it imports the analysis modules, outside the timed region
 c0, w0 = time.process_time(), time.perf_counter()
 try:
-    analyze(L)
+    analysis = analyze(L)
+    if {report}:
+        analysis.to_text()
     outcome = "analysed"
 except dirac.DiracError as exc:
     outcome = type(exc).__name__
@@ -91,7 +113,7 @@ print(json.dumps({{"cpu": time.process_time() - c0, "wall": time.perf_counter() 
 def analysis_time(case: AnalysisCase) -> dict:
     """CPU and wall seconds of ``dirac.analyze`` on ``case`` in a fresh process, and its outcome."""
     completed = subprocess.run(
-        [sys.executable, "-c", _CHILD.format(build=case.build)], capture_output=True, text=True, timeout=900
+        [sys.executable, "-c", _CHILD.format(build=case.build, report=case.report)], capture_output=True, text=True, timeout=900
     )
     if completed.returncode != 0:
         raise RuntimeError(f"{case.name}: the analysis process failed: {completed.stderr.strip().splitlines()[-1:]}")
@@ -104,7 +126,7 @@ def analysis_runs(repeats: int) -> list[tuple[AnalysisCase, list[dict]]]:
     The cases are run in turn (case 1, 2, 3, 4, then again), so that a change in the
     load of the machine touches them alike.
     """
-    cases = (*ANALYSIS_CASES, *BOUNDED_CASES)
+    cases = (*ANALYSIS_CASES, *BOUNDED_CASES, *REPORT_CASES)
     runs: dict[str, list[dict]] = {case.name: [] for case in cases}
     for _ in range(repeats):
         for case in cases:

@@ -111,13 +111,6 @@ class ChartGuard:
         )
 
 
-def _trig_arguments(expr: Any) -> set[Any]:
-    """The arguments ``u`` of the ``sin(u)`` and ``cos(u)`` in ``expr``."""
-    import sympy
-
-    return {node.args[0] for node in sympy.preorder_traversal(expr) if isinstance(node, (sympy.sin, sympy.cos))}
-
-
 def never_zero(factor: Any, bounded: list[Any], values: dict[Any, float]) -> bool:
     """Whether ``factor``, a polynomial in the symbols ``bounded`` (sines and cosines, each in
     ``[-1, 1]``) with the parameters of ``values`` set to their values, is never zero there.
@@ -163,9 +156,9 @@ def _locus(det: Any, q: list[Any], factors: Callable[[Any, list[Any]], list[Any]
 
     ``det W`` in sines and cosines of angles is factored as a polynomial in them: each
     ``sin(u)``, ``cos(u)`` becomes a real symbol ``s_u``, ``c_u``, the polynomial is reduced
-    modulo ``s_u^2 + c_u^2 - 1`` (Pythagoras, exactly: the same function of the angles;
-    eliminating the squares of the sines or of the cosines, whichever leaves fewer terms),
-    factored, and the factors are written back in ``sin`` and ``cos``. Each factor is the
+    modulo ``s_u^2 + c_u^2 - 1`` (:func:`~dirac.analysis.core.pythagoras.circle_polynomial`:
+    Pythagoras, exactly, the same function of the angles; eliminating the squares of the sines
+    or of the cosines, whichever leaves fewer terms), factored, and the factors are written back in ``sin`` and ``cos``. Each factor is the
     same function of the angles as a product of them is of ``det W``, so every zero of
     ``det W`` is a zero of a factor kept: no singularity is missed; only factors that cannot
     vanish for real sines and cosines are left out (``1 + c_u^2``). ``sin(psi)^2 +
@@ -175,28 +168,12 @@ def _locus(det: Any, q: list[Any], factors: Callable[[Any, list[Any]], list[Any]
     the triple pendulum's ``det W`` in three angle differences (this road: 0.04 s) and
     decided nothing more.
     """
-    import sympy
+    from dirac.analysis.core.pythagoras import circle_polynomial
 
-    arguments = sorted(_trig_arguments(det), key=sympy.default_sort_key)
-    if not arguments:
+    reduced = circle_polynomial(det, by_angle=False)  # all sines or all cosines: the loci as they were named
+    if reduced is None:  # no sines or cosines, or not a polynomial in them: as before
         return factors(1 / det, q), False
-    sines = [sympy.Symbol(f"_s{k}", real=True) for k in range(len(arguments))]
-    cosines = [sympy.Symbol(f"_c{k}", real=True) for k in range(len(arguments))]
-    to_symbols = {sympy.sin(u): s for u, s in zip(arguments, sines)}
-    to_symbols.update({sympy.cos(u): c for u, c in zip(arguments, cosines)})
-    polynomial = sympy.expand(det.xreplace(to_symbols))
-    if polynomial.has(sympy.sin, sympy.cos) or not polynomial.is_polynomial(*sines, *cosines):
-        return factors(1 / det, q), False  # sines of sums written another way, or not a polynomial in them: as before
-    both = [(s, c) for s, c in zip(sines, cosines) if polynomial.has(s) and polynomial.has(c)]
-    if both:  # Pythagoras, eliminating the sines or the cosines: the shorter of the two (or none)
-        others = sorted(polynomial.free_symbols - set(sines) - set(cosines), key=str)
-        circle = [s**2 + c**2 - 1 for s, c in both]
-        candidates = [polynomial]
-        for first in ([s for s, _ in both], [c for _, c in both]):
-            rest = [g for g in (*sines, *cosines) if g not in first]
-            candidates.append(sympy.expand(sympy.reduced(polynomial, circle, *first, *rest, *others)[1]))
-        polynomial = min(candidates, key=lambda p: len(sympy.Add.make_args(p)))
-    back = {symbol: function for function, symbol in to_symbols.items()}
+    polynomial, sines, cosines, back = reduced.polynomial, reduced.sines, reduced.cosines, reduced.back
     found = factors(1 / polynomial, [*q, *sines, *cosines])
     kept = found if values is None else [f for f in found if not never_zero(f, [*sines, *cosines], values)]
     return [f.xreplace(back) for f in kept], len(kept) < len(found)

@@ -20,7 +20,7 @@ from sympy.printing.str import StrPrinter
 
 from dirac.codegen.printer import distinct_nodes
 
-__all__ = ["NotInRing", "shared_xreplace", "tidy", "prints_shorter", "printed", "printed_at_most", "text_of", "present_in_order", "ring_value"]
+__all__ = ["NotInRing", "shared_xreplace", "tidy", "prints_shorter", "printed", "printed_at_most", "text_of", "present_in_order", "ring_value", "rational_parts"]
 
 
 class NotInRing(Exception):
@@ -212,6 +212,36 @@ def ring_value(expr: sympy.Expr, gens: Mapping, domain: Any, invert: Callable[[A
         return out
 
     return walk(expr)
+
+
+@functools.lru_cache(maxsize=256)
+def rational_parts(expr: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr] | None:
+    """``(N, D)`` with ``expr = N / D`` in lowest terms, polynomials over ``QQ`` in all its symbols; else ``None``.
+
+    ``expr`` is taken into the fraction field ``QQ(symbols)`` by one walk of its graph
+    (:func:`ring_value`; ``FracField`` reduces after every operation, so ``N`` and ``D``
+    have no common factor and ``D`` has a positive leading coefficient); a function of the
+    symbols (``sin(theta)``) is a generator of its own, as in sympy's polynomials. ``None`` for an
+    expression that is not a rational function with rational coefficients (a ``Float``, a
+    fractional power). What it answers that ``sympy.expand`` cannot say
+    cheaply: whether ``expr`` is a polynomial in some of its symbols (``D`` free of them),
+    for a nested quotient such as the pivot ``a - b c / d`` of an elimination, whose
+    expansion costs seconds (Geddes, Czapor & Labahn, "Algorithms for Computer Algebra",
+    1992, Sect. 2.8 on the canonical form of rational functions). Remembered for the last
+    256 expressions (the divisor searches ask about the same bases several times).
+    """
+    symbols = sorted(expr.free_symbols, key=lambda s: s.name)
+    if not symbols or not all(s.is_Symbol for s in symbols):
+        return None
+    # a function of the symbols (sin(theta), exp(x)) is one more generator, as for sympy's polynomials
+    applied = sorted({node for node in distinct_nodes(expr) if isinstance(node, sympy.Function)}, key=sympy.default_sort_key)
+    field = FracField([*symbols, *applied], sympy.QQ)
+    gens = dict(zip([*symbols, *applied], field.gens))
+    try:
+        value = ring_value(expr, gens, field, invert=lambda base: field(1) / base)
+    except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+        return None
+    return value.numer.as_expr(), value.denom.as_expr()
 
 
 def _split_denominators(expr: sympy.Expr, variables: set) -> tuple[sympy.Expr, dict, list]:

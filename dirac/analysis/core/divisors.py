@@ -52,8 +52,9 @@ import numpy as np
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
-from dirac.analysis.core.algebra import printed, prints_shorter
+from dirac.analysis.core.algebra import printed, prints_shorter, rational_parts
 from dirac.analysis.core.phase_space import free_symbols_of
+from dirac.analysis.core.pythagoras import pythagorean_form
 from dirac.errors import AnalysisError
 
 __all__ = [
@@ -66,7 +67,7 @@ __all__ = [
 #: expressions longer than this (characters) are not searched for denominators (a gcd of large ones costs more than the analysis)
 DIVISOR_TEXT_LIMIT = 4000
 
-#: a trigonometric factor with at most this many terms is simplified (``sin(x)**2 + cos(x)**2`` is no divisor)
+#: a trigonometric factor with at most this many terms is reduced with Pythagoras (``sin(x)**2 + cos(x)**2`` is no divisor)
 TRIG_TERMS = 8
 
 #: projections onto a locus tried before it counts as not meeting the surface
@@ -150,7 +151,11 @@ def denominator_factors(
 
     The bases of the negative powers in ``expr`` (its denominators) are factored
     (``sympy.factor_list``; ``sin(theta)`` counts as a factor of ``sin(theta)**2``); a
-    factor that a numerator would cancel is kept (no gcd is taken). Factors without real zeros and numbers are left out; an
+    factor that a numerator would cancel is kept (no gcd is taken). A base is factored
+    as the polynomial it is (:func:`~dirac.analysis.core.algebra.rational_parts`): one with
+    parameters in its own denominators through its numerator (``x**2/m - y**2/m`` gives
+    ``x - y`` and ``x + y``), one whose reduced denominator holds the variables (the pivot
+    ``x - y**2/x`` of an elimination) is kept whole. Factors without real zeros and numbers are left out; an
     expression longer than ``DIVISOR_TEXT_LIMIT`` characters gives ``[]``. A denominator for which
     ``settled`` is true (proven nonzero on the surface, :func:`nonvanishing_on`) is not factored:
     a factor of a function that never vanishes there never vanishes there either.
@@ -171,19 +176,45 @@ def _irreducible_factors(bases: Sequence[sympy.Expr], names: AbstractSet[sympy.S
     """The distinct irreducible factors of the ``bases`` that depend on ``names``, without real-zero-free ones."""
     found: list[sympy.Expr] = []
     for base in bases:
-        try:
-            _, listed = sympy.factor_list(sympy.expand(base))
+        parts = rational_parts(base)
+        if parts is not None and parts[1].free_symbols & names:
+            # a quotient whose reduced denominator holds the variables (a pivot a - b c/d of an
+            # elimination): no polynomial to factor, kept whole (sympy's factor_list refuses it, after
+            # expanding it for up to seconds)
+            found.append(base)
+            continue
+        try:  # a polynomial over numbers and parameters: its numerator's factors (those of the parameters drop out below)
+            _, listed = sympy.factor_list(parts[0] if parts is not None else sympy.expand(base))
             found += [f for f, _ in listed]
         except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
             found.append(base)
     out = []
-    for f in found:
-        if f.has(sympy.sin, sympy.cos) and len(f.args) <= TRIG_TERMS:
-            f = sympy.trigsimp(f)  # sin(psi)**2 + cos(psi)**2 is 1
+    for f in _reduced_trigonometric(found):
         if f.free_symbols & names and not _never_zero(f):
             f = -f if f.could_extract_minus_sign() else f
             if f not in out:
                 out.append(f)
+    return out
+
+
+def _reduced_trigonometric(factors: list[sympy.Expr]) -> list[sympy.Expr]:
+    """The ``factors``, each of at most ``TRIG_TERMS`` terms in sines and cosines reduced with Pythagoras
+    (:func:`~dirac.analysis.core.pythagoras.pythagorean_form`: ``sin(psi)**2 + cos(psi)**2`` is 1, exactly
+    and in milliseconds, where ``trigsimp`` could take minutes) and factored again when that changed it
+    (``sin(x)**2 + cos(x)**2 - y**2`` is ``(1 - y)(1 + y)``)."""
+    out: list[sympy.Expr] = []
+    for f in factors:
+        if not (f.has(sympy.sin, sympy.cos) and len(f.args) <= TRIG_TERMS):
+            out.append(f)
+            continue
+        reduced = pythagorean_form(f)
+        if reduced == f:
+            out.append(f)
+            continue
+        try:
+            out += [g for g, _ in sympy.factor_list(reduced)[1]]
+        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+            out.append(reduced)
     return out
 
 
@@ -376,6 +407,9 @@ def constant_on_surface(
     own = sorted(divisor.free_symbols & set(variables), key=lambda s: s.name)
     if not own:
         return None
+    parts = rational_parts(divisor)
+    if parts is not None and parts[1].free_symbols & set(own):
+        return None  # no polynomial in its variables (a reduced denominator holds them): no such identity
     names = set(variables)
     memo = {} if memo is None else memo
     key = ("constraint polynomials", tuple(own))
