@@ -257,10 +257,18 @@ def divisions(
     return list(found.values())
 
 
-def _nested(expr: sympy.Expr) -> bool:
-    """Whether ``expr`` holds a division or a fractional power (a pivot ``a - b c/d`` of an elimination)."""
-    return any(isinstance(node, sympy.Pow) and not (node.exp.is_Integer and node.exp > 0)
-               for node in _nodes(expr))
+def _nested(expr: sympy.Expr, names: AbstractSet[sympy.Symbol] | None = None) -> bool:
+    """Whether ``expr`` holds a division or a fractional power (a pivot ``a - b c/d`` of an elimination).
+
+    With ``names`` (the phase-space variables) a division by an expression free of them
+    (``4 x1^2/m1 + 4 y1^2/m1``: a mass in a denominator) does not count: the expression is
+    a polynomial in the variables, which the proofs take as it is.
+    """
+    for node in _nodes(expr):
+        if isinstance(node, sympy.Pow) and not (node.exp.is_Integer and node.exp > 0):
+            if names is None or not node.exp.is_Integer or node.base.free_symbols & names:
+                return True
+    return False
 
 
 def _nodes(expr: sympy.Expr) -> set:
@@ -913,7 +921,8 @@ def singular_loci(
     deadline: float | None = None
     search_deadline: float | None = None  # of the searches for the other divisors' loci (SEARCH_BUDGET)
     searched = 0  # divisors read off trees searched for a point so far (at most STRUCTURAL_SEARCHES)
-    plain = {d.divisor: not d.structural or (not _nested(d.divisor) and prints_shorter(d.divisor, DIVISOR_TEXT_LIMIT))
+    names = set(variables)
+    plain = {d.divisor: not d.structural or (not _nested(d.divisor, names) and prints_shorter(d.divisor, DIVISOR_TEXT_LIMIT))
              for d in seen.values()}
     # the divisors read off trees after the others, short polynomials first: the budget goes to the cheap ones
     for d in sorted(seen.values(), key=lambda d: (d.structural, not plain[d.divisor])):

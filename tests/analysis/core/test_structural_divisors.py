@@ -124,3 +124,25 @@ def test_the_divisions_of_many_entries_are_the_factors_of_their_denominators_wha
     for variables in ([x, y], {x, y}):
         found = {d.divisor for d in divisions(entries, 2, "the multiplier solution divides by zero", variables)}
         assert found == {x, x - y, x + y}
+
+
+class _NoSearch:
+    """Numerics that must not be asked: a certificate decides without sampling."""
+
+    def surface_points(self, *args, **kwargs):
+        raise AssertionError("the divisor was searched although a certificate proves it nonzero")
+
+
+def test_a_divisor_read_off_a_tree_with_a_mass_in_its_denominators_is_proven_as_a_polynomial():
+    """By hand: on the rod ``x^2 + y^2 = l^2`` of a bob of mass ``m``, ``4 x^2/m + 4 y^2/m = 4 l^2/m``, a
+    nonzero constant. Read off the tree of a long multiplier solution it was taken for a nested pivot
+    (it holds ``1/m``) and searched, then left "not ruled out"; a division by a parameter is no pivot,
+    and the identity proves it without a search."""
+    from dirac.analysis.core.divisors import Division, singular_loci
+
+    m, l_ = sympy.symbols("m l", positive=True)
+    divisor = 4 * x**2 / m + 4 * y**2 / m
+    undecided: list = []
+    loci = singular_loci([Division(divisor, 4, MULTIPLIERS_SINGULAR, structural=True)], [x**2 + y**2 - l_**2],
+                         _NoSearch(), [x, y], undecided=undecided)
+    assert loci == () and undecided == []
