@@ -15,6 +15,7 @@ from typing import Any
 import sympy
 from sympy.core.add import _addsort
 from sympy.polys.fields import FracField
+from sympy.polys.polyerrors import BasePolynomialError
 from sympy.polys.rings import PolyRing
 from sympy.printing.str import StrPrinter
 
@@ -239,7 +240,7 @@ def rational_parts(expr: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr] | None:
     gens = dict(zip([*symbols, *applied], field.gens))
     try:
         value = ring_value(expr, gens, field, invert=lambda base: field(1) / base)
-    except (NotInRing, ZeroDivisionError, TypeError, ValueError, sympy.CoercionFailed, sympy.PolynomialError):
+    except (NotInRing, ZeroDivisionError, TypeError, ValueError, BasePolynomialError):
         return None
     return value.numer.as_expr(), value.denom.as_expr()
 

@@ -51,6 +51,7 @@ from math import factorial
 import numpy as np
 import sympy
 from sympy.polys.matrices import DomainMatrix
+from sympy.polys.polyerrors import BasePolynomialError
 
 from dirac.analysis.core.algebra import printed, prints_shorter, rational_parts
 from dirac.analysis.core.phase_space import free_symbols_of
@@ -213,7 +214,7 @@ def _reduced_trigonometric(factors: list[sympy.Expr]) -> list[sympy.Expr]:
             continue
         try:
             out += [g for g, _ in sympy.factor_list(reduced)[1]]
-        except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError):
+        except (BasePolynomialError, NotImplementedError):
             out.append(reduced)
     return out
 

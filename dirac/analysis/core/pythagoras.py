@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import sympy
+from sympy.polys.polyerrors import BasePolynomialError, PolynomialError
 
 from dirac.analysis.core.algebra import rational_parts
 
@@ -77,7 +78,7 @@ def circle_polynomial(expr: sympy.Expr, by_angle: bool = True) -> CirclePolynomi
         rest = [g for g in every if g not in leading]
         try:
             remainder = sympy.reduced(p, circle, *leading, *rest, *others)[1]
-        except sympy.PolynomialError:  # a parameter in a denominator: the parameters as coefficients
+        except PolynomialError:  # a parameter in a denominator: the parameters as coefficients
             remainder = sympy.reduced(p, circle, *leading, *rest)[1]
         return sympy.expand(remainder)
 
@@ -94,7 +95,7 @@ def circle_polynomial(expr: sympy.Expr, by_angle: bool = True) -> CirclePolynomi
             for pair in present:
                 step = min([step, *(reduced(step, [pair[k]], [pair]) for k in (0, 1))], key=size)
             candidates.append(step)
-    except (sympy.PolynomialError, sympy.CoercionFailed):
+    except (BasePolynomialError, NotImplementedError):  # sympy could not divide: no reduction claimed
         return None
     polynomial = min(candidates, key=size)
     back = {symbol: function for function, symbol in to_symbols.items()}
@@ -125,4 +126,7 @@ def pythagorean_form(expr: sympy.Expr) -> sympy.Expr:
     before = sum(len(sympy.Add.make_args(part)) for part in parts)
     if len(sympy.Add.make_args(numerator)) + len(sympy.Add.make_args(denominator)) >= before:
         return expr
-    return sympy.factor(numerator) / sympy.factor(denominator)
+    try:
+        return sympy.factor(numerator) / sympy.factor(denominator)
+    except (BasePolynomialError, NotImplementedError):
+        return numerator / denominator

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import sympy
+from sympy.polys.polyerrors import BasePolynomialError
 
 from dirac.analysis.core.algebra import tidy
 from dirac.analysis.core.fast_partials import SPARSE_HESSIAN, quadratic_parts
@@ -378,9 +379,12 @@ def _trig_factored(expr: sympy.Expr) -> sympy.Expr:
     more. Anything that is not such a polynomial is factored as it is.
     """
     reduced = circle_polynomial(expr)
-    if reduced is None:
-        return sympy.factor(expr)
-    return sympy.factor(reduced.polynomial).xreplace(reduced.back)
+    polynomial = expr if reduced is None else reduced.polynomial
+    try:
+        polynomial = sympy.factor(polynomial)
+    except (BasePolynomialError, NotImplementedError):  # not factored: the same function as it is
+        pass
+    return polynomial if reduced is None else polynomial.xreplace(reduced.back)
 
 
 def _inverse(M: sympy.Matrix) -> sympy.Matrix:

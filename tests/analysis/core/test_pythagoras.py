@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import sympy
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from dirac.analysis.core.pythagoras import circle_polynomial, pythagorean_form, trig_arguments
 
@@ -14,8 +16,13 @@ s, c = sympy.sin, sympy.cos
 def _same_function(f: sympy.Expr, g: sympy.Expr, symbols: list[sympy.Symbol]) -> bool:
     """``f`` and ``g`` agree at random real points (the reduction must not change the function)."""
     rng = np.random.default_rng(7)
-    fn = sympy.lambdify(symbols, f - g, "math")
-    return all(abs(fn(*rng.uniform(-3.0, 3.0, len(symbols)))) < 1e-9 for _ in range(20))
+    first, second = (sympy.lambdify(symbols, e, "math") for e in (f, g))
+    for _ in range(20):
+        point = rng.uniform(0.5, 3.0, len(symbols)) * rng.choice([-1.0, 1.0], len(symbols))
+        u, v = first(*point), second(*point)
+        if abs(u - v) > 1e-9 * (1.0 + abs(u) + abs(v)):
+            return False
+    return True
 
 
 def test_the_circle_identity_is_one():
@@ -56,3 +63,23 @@ def test_no_sines_or_no_polynomial_is_left_alone():
     assert pythagorean_form(a**2 + b) == a**2 + b
     assert trig_arguments(s(a - b) * c(th)) == {a - b, th}
     assert pythagorean_form(sympy.sqrt(s(a) ** 2 + c(a) ** 2 + b)) == sympy.sqrt(s(a) ** 2 + c(a) ** 2 + b)
+
+
+_ANGLES = (a, b, a - b)
+_COEFFICIENTS = (1, -2, 3, m, M / 2, 1 / m)
+
+
+@given(st.lists(st.tuples(st.sampled_from(_COEFFICIENTS), st.sampled_from(_ANGLES), st.integers(0, 3), st.integers(0, 3),
+                          st.sampled_from(_ANGLES), st.integers(0, 2)), min_size=1, max_size=5))
+@settings(max_examples=40, deadline=None)
+def test_the_reduction_is_the_same_function_of_the_angles(terms):
+    """Random sums of ``k sin(u)^i cos(u)^j cos(v)^l`` (parameters in coefficients, one in a denominator): the
+    reduced forms, written back in sines and cosines, take the same values at random angles and masses."""
+    expr = sympy.Add(*(k * s(u) ** i * c(u) ** j * c(v) ** e for k, u, i, j, v, e in terms))
+    symbols = [a, b, m, M]
+    for by_angle in (True, False):
+        reduced = circle_polynomial(expr, by_angle=by_angle)
+        if reduced is not None:
+            assert _same_function(reduced.polynomial.xreplace(reduced.back), expr, symbols)
+    assert _same_function(pythagorean_form(expr), expr, symbols)
+    assert _same_function(pythagorean_form(expr / (s(a) ** 2 + c(a) ** 2 + m**2)), expr / (1 + m**2), symbols)
