@@ -86,7 +86,7 @@ REPORT_CASES = tuple(
     AnalysisCase(f"{name.replace('_', ' ')}, analysis and report",
                  f"__import__('dirac_systems.report_models', fromlist=['MODELS']).MODELS[{name!r}]()", 5.0, report=True)
     for name in ("pendulum_on_a_cart", "triple_pendulum_cartesian", "slider_crank", "spherical_double_pendulum",
-                 "triple_pendulum_angles", "asymmetric_top")
+                 "triple_pendulum_angles", "asymmetric_top_euler")
 )
 
 #: ``dirac analyze NAME`` end to end (fresh process: interpreter, imports, analysis, report): target CPU seconds

@@ -178,10 +178,9 @@ def _irreducible_factors(bases: Sequence[sympy.Expr], names: AbstractSet[sympy.S
     found: list[sympy.Expr] = []
     for base in bases:
         parts = rational_parts(base)
-        if parts is not None and parts[1].free_symbols & names:
-            # a quotient whose reduced denominator holds the variables (a pivot a - b c/d of an
-            # elimination): no polynomial to factor, kept whole (sympy's factor_list refuses it, after
-            # expanding it for up to seconds)
+        if _quotient_in(parts, names):
+            # a pivot a - b c/d of an elimination: no polynomial to factor, kept whole (sympy's
+            # factor_list refuses it, after expanding it for up to seconds)
             found.append(base)
             continue
         try:  # a polynomial over numbers and parameters: its numerator's factors (those of the parameters drop out below)
@@ -196,6 +195,12 @@ def _irreducible_factors(bases: Sequence[sympy.Expr], names: AbstractSet[sympy.S
             if f not in out:
                 out.append(f)
     return out
+
+
+def _quotient_in(parts: tuple[sympy.Expr, sympy.Expr] | None, names: AbstractSet[sympy.Symbol]) -> bool:
+    """Whether the reduced fraction ``parts`` (:func:`~dirac.analysis.core.algebra.rational_parts`) has ``names``
+    in its denominator: then the expression is no polynomial in them, however it is expanded."""
+    return parts is not None and bool(parts[1].free_symbols & names)
 
 
 def _reduced_trigonometric(factors: list[sympy.Expr]) -> list[sympy.Expr]:
@@ -416,9 +421,8 @@ def constant_on_surface(
     own = sorted(divisor.free_symbols & set(variables), key=lambda s: s.name)
     if not own:
         return None
-    parts = rational_parts(divisor)
-    if parts is not None and parts[1].free_symbols & set(own):
-        return None  # no polynomial in its variables (a reduced denominator holds them): no such identity
+    if _quotient_in(rational_parts(divisor), set(own)):
+        return None  # no polynomial in its variables: no such identity
     names = set(variables)
     memo = {} if memo is None else memo
     key = ("constraint polynomials", tuple(own))

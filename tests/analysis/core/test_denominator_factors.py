@@ -13,6 +13,7 @@ import sympy
 import dirac
 from dirac.analysis.core.algebra import rational_parts
 from dirac.analysis.core.divisors import constant_on_surface, denominator_factors
+from dirac_systems.report_models import pendulum_on_a_cart, slider_crank
 
 x, y, m, M = sympy.symbols("x y m M", real=True)
 
@@ -64,10 +65,7 @@ def test_the_dirac_bracket_of_a_pendulum_on_a_cart_divides_by_the_gram_determina
     multipliers, and ``det C`` of the four second-class constraints is ``256 G^4 / (M^4 m^4)`` with
     ``G = M (X - x)^2 + M y^2 + m (X - x)^2`` (the square of its Pfaffian ``16 G^2 / (M^2 m^2)``): its
     only divisor is ``G`` again, so the report names one divisor, not a second one too long to print."""
-    cart = dirac.Lagrangian.from_strings(
-        "pendulum_on_cart", ["X", "x", "y"], "M/2*X_dot**2 + m/2*(x_dot**2 + y_dot**2) - m*g*y",
-        constraints=["(x - X)**2 + y**2 - l**2"], parameters={"M": None, "m": None, "g": None, "l": None})
-    text = dirac.analyze(cart).to_text()
+    text = dirac.analyze(pendulum_on_a_cart()).to_text()
     lines = [line for line in text.splitlines() if line.startswith("singular loci")]
     assert len(lines) == 1, lines
     assert "M*X**2 - 2*M*X*x + M*x**2 + M*y**2 + X**2*m - 2*X*m*x + m*x**2" in lines[0]
@@ -80,9 +78,6 @@ def test_the_report_of_a_slider_crank_names_its_divisor():
     ``J W^-1 J^T``, with ``J = (2 r s sin th, 2 (s - r cos th))`` and ``W = diag(I, m)``: ``4 (m r^2 s^2
     sin^2 th + I (s - r cos th)^2) / (I m)``, by hand. Its factor with the angle was put to ``trigsimp``,
     which did not end in five minutes; reduced with Pythagoras it is named in the report."""
-    crank = dirac.Lagrangian.from_strings(
-        "slider_crank", ["th", "s"], "I/2*th_dot**2 + m/2*s_dot**2",
-        constraints=["(s - r*cos(th))**2 + r**2*sin(th)**2 - L**2"], parameters={"I": None, "m": None, "r": None, "L": None})
-    lines = [line for line in dirac.analyze(crank).to_text().splitlines() if line.startswith("singular loci")]
+    lines = [line for line in dirac.analyze(slider_crank()).to_text().splitlines() if line.startswith("singular loci")]
     assert len(lines) == 1, lines
     assert "I*r**2*cos(th)**2 - 2*I*r*s*cos(th) + I*s**2 + m*r**2*s**2*sin(th)**2" in lines[0]
