@@ -43,9 +43,11 @@ import numpy as np
 import sympy
 from sympy.polys.matrices import DomainMatrix
 
+from dirac.analysis.core.algebra import rational_parts
 from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics, numeric_rank
 from dirac.analysis.core.phase_space import PhaseSpace, free_symbols_of
+from dirac.codegen.printer import distinct_nodes
 from dirac.errors import AnalysisError
 
 __all__ = ["SpecialValue", "admissible", "special_parameter_values", "MAX_BLOCK", "SEARCH_SECONDS", "SCAN_SECONDS", "SCAN_VALUES"]
@@ -228,7 +230,9 @@ def _is_radical(power: sympy.Basic) -> bool:
 
 
 def _radicals(matrix: sympy.Matrix) -> set[sympy.Pow]:
-    return {p for entry in matrix for p in entry.atoms(sympy.Pow) if _is_radical(p)}
+    # each shared sub-tree walked once (``atoms`` walks every occurrence: the bracket matrix of a relativistic
+    # particle repeats its square root and the sums around it many times)
+    return {p for entry in matrix for p in distinct_nodes(entry) if _is_radical(p)}
 
 
 def _radicals_to_symbols(matrix: sympy.Matrix) -> tuple[sympy.Matrix, list[tuple[sympy.Symbol, int, sympy.Expr]]]:
@@ -300,22 +304,66 @@ def _radical_free_numerator(block: sympy.Matrix) -> sympy.Expr:
     matrix, relations = _radicals_to_symbols(block)
     try:
         if _is_antisymmetric(matrix):
-            numerator = sympy.fraction(sympy.cancel(sympy.together(_pfaffian(matrix))))[0]
+            numerator = _numerator(_pfaffian(matrix))
         else:
             field = DomainMatrix.from_Matrix(matrix).to_field()
             if field.domain.is_EX or field.domain.is_EXRAW:
                 raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block is not a rational function of the parameters and its radicals")
             numerator = sympy.fraction(field.domain.to_sympy(field.det()))[0]
         for r, order, base in reversed(relations):  # outer radicals first: their relations may hold inner ones
-            num, den = sympy.fraction(sympy.together(base))
-            numerator = sympy.resultant(sympy.expand(numerator), sympy.expand(den * r**order - num), r)
-            numerator = sympy.fraction(sympy.together(numerator))[0]
+            num, den = _fraction(base)
+            numerator = _resultant(numerator, den * r**order - num, r)
         numerator = sympy.expand(numerator)
     except (sympy.PolynomialError, sympy.CoercionFailed, NotImplementedError, ValueError, TypeError) as exc:
         raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block with radicals: {exc}") from None
     if numerator.atoms(sympy.Function) or _radicals(sympy.Matrix([numerator])):
         raise NotPolynomial(f"det of the {block.shape[0]}x{block.shape[0]} block is not a polynomial in the parameters")
     return numerator
+
+
+def _fraction(expr: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr]:
+    """``(N, D)`` with ``expr = N / D`` in lowest terms.
+
+    One walk into the field of rational functions over ``QQ``
+    (:func:`~dirac.analysis.core.algebra.rational_parts`), where ``together`` and
+    ``cancel`` on the expression tree took three times as long on the relativistic
+    particle's bracket matrix; an expression outside that field (a float) goes to them.
+    """
+    parts = rational_parts(expr) if expr.free_symbols else None
+    if parts is None:
+        return sympy.fraction(sympy.cancel(sympy.together(expr)))
+    return parts
+
+
+def _numerator(expr: sympy.Expr) -> sympy.Expr:
+    """The numerator of ``expr`` in lowest terms (:func:`_fraction`)."""
+    return _fraction(expr)[0]
+
+
+def _resultant(f: sympy.Expr, g: sympy.Expr, r: sympy.Symbol) -> sympy.Expr:
+    """``Res_r(f, g)`` of two polynomials, with its rational coefficients cleared.
+
+    Taken on ``Poly`` objects with ``r`` as the main variable (sympy's subresultant
+    PRS; Cox, Little, O'Shea, Sect. 3.6), without the expansions and the ``together`` of
+    the expression road; with rational coefficients, up to a non-zero rational factor,
+    which leaves its zeros alone.
+    """
+    gens = [r, *sorted((f.free_symbols | g.free_symbols) - {r}, key=lambda s: s.name)]
+    resultant = sympy.Poly(f, *gens).resultant(sympy.Poly(g, *gens))
+    if not isinstance(resultant, sympy.Poly):
+        return sympy.sympify(resultant)
+    if resultant.domain.is_QQ or resultant.domain.is_ZZ:
+        return resultant.clear_denoms()[1].as_expr()
+    return sympy.fraction(sympy.together(resultant.as_expr()))[0]  # floats among the coefficients: as before
+
+
+def _gcd(f: sympy.Expr, g: sympy.Expr) -> sympy.Expr:
+    """``gcd(f, g)`` of two polynomials, taken on ``Poly`` objects in their symbols (a quarter of the time of
+    ``sympy.gcd`` on the expressions, which guesses the generators and the domain again)."""
+    gens = sorted(f.free_symbols | g.free_symbols, key=lambda s: s.name)
+    if not gens:
+        return sympy.gcd(f, g)
+    return sympy.Poly(f, *gens).gcd(sympy.Poly(g, *gens)).as_expr()
 
 
 class NotPolynomial(ValueError):
@@ -351,7 +399,7 @@ def _candidates(
             return []  # free of parameters at one point: no parameter-only factor anywhere
     found: list[tuple[sympy.Expr, list[tuple[sympy.Symbol, sympy.Expr]]]] = []
     try:
-        content = numerators[0] if len(numerators) == 1 else sympy.gcd(numerators[0], numerators[1])
+        content = numerators[0] if len(numerators) == 1 else _gcd(numerators[0], numerators[1])
         if content == 0:
             return found
         factors = sympy.factor_list(content)[1]

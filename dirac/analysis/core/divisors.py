@@ -42,7 +42,6 @@ or left open with the reason (:class:`Undecided`): no point found is no proof.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Sequence
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
@@ -54,6 +53,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.polyerrors import BasePolynomialError
 
 from dirac.analysis.core.algebra import printed, prints_shorter, rational_parts
+from dirac.analysis.core.budget import cpu_clock
 from dirac.analysis.core.phase_space import free_symbols_of
 from dirac.analysis.core.pythagoras import pythagorean_form
 from dirac.errors import AnalysisError
@@ -933,8 +933,8 @@ def singular_loci(
     for d in sorted(seen.values(), key=lambda d: (d.structural, not plain[d.divisor])):
         short = plain[d.divisor]
         if d.structural:
-            deadline = time.process_time() + budget if deadline is None else deadline
-            if time.process_time() > deadline or searched >= STRUCTURAL_SEARCHES:
+            deadline = cpu_clock() + budget if deadline is None else deadline
+            if cpu_clock() > deadline or searched >= STRUCTURAL_SEARCHES:
                 if undecided is not None:
                     undecided.append(Undecided(d.divisor, d.stage, d.what, OUT_OF_TIME))
                 continue
@@ -959,14 +959,14 @@ def singular_loci(
         searched += d.structural
         limit: float | None = None  # the searches for divisors not read off trees share SEARCH_BUDGET
         if not d.structural:
-            search_deadline = time.process_time() + SEARCH_BUDGET if search_deadline is None else search_deadline
+            search_deadline = cpu_clock() + SEARCH_BUDGET if search_deadline is None else search_deadline
             limit = search_deadline
         try:
-            if limit is not None and time.process_time() > limit:
+            if limit is not None and cpu_clock() > limit:
                 raise _SearchSpent
             points = numerics.surface_points([*surface, d.divisor], 1, attempts=LOCUS_ATTEMPTS, deadline=limit)
         except (AnalysisError, _SearchSpent):
-            cut = limit is not None and time.process_time() > limit
+            cut = limit is not None and cpu_clock() > limit
             if undecided is not None and (d.structural or not sum_of_squares_on_surface(d.divisor, surface, variables, memo)):
                 verdict = gram(d.divisor) if gram is not None else None
                 if verdict is not None and verdict.proven:

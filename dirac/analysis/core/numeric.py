@@ -16,7 +16,6 @@ they do not are found by :mod:`dirac.analysis.chain.special_values`).
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 from typing import TYPE_CHECKING, Any, Protocol
@@ -24,6 +23,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 import sympy
 
+from dirac.analysis.core.budget import cpu_clock
 from dirac.analysis.core.graphs import issparse
 from dirac.analysis.core.phase_space import PhaseSpace, free_symbols_of
 from dirac.analysis.core.scaled_function import BOTH, ScaledFunction, scaled_function, terms_of
@@ -614,7 +614,7 @@ class Numerics:
             points used, those farthest from the locus first, and a note in :attr:`notes`
             says so.
         deadline
-            ``time.process_time()`` past which no further random start is tried (the first
+            :func:`~dirac.analysis.core.budget.cpu_clock` past which no further random start is tried (the first
             always is): a search with a CPU-time budget (:func:`~dirac.analysis.core.divisors.singular_loci`).
 
         Raises
@@ -644,7 +644,7 @@ class Numerics:
         tries = 0
         singular = 0
         while len(points) < count and tries < attempts:
-            if tries and deadline is not None and time.process_time() > deadline:
+            if tries and deadline is not None and cpu_clock() > deadline:
                 break
             tries += 1
             z = start.copy() if (start is not None and tries == 1) else self.random_point()
