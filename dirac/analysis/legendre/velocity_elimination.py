@@ -7,7 +7,11 @@ mechanics", Lecture 1; Henneaux–Teitelboim, Sect. 1.1; Gitman–Tyutin, Sect. 
 - ``W`` regular (generic rank ``n``): the velocity map ``q_dot -> p`` is inverted,
   ``q_dot = v(q, p)``, on the branch through the physical velocities, and
   ``H = p . v(q, p) - L(q, v(q, p))`` (e.g. ``L = -m sqrt(1 - x_dot^2)`` gives
-  ``H = sqrt(p^2 + m^2)``);
+  ``H = sqrt(p^2 + m^2)``); each velocity's relation to the momenta comes from a
+  lexicographic Gröbner basis, unless exchanging two axes (coordinate, velocity and
+  momentum) maps the relations onto themselves: then it is an earlier velocity's relation
+  with the axes exchanged (:func:`_mirrored`; a relativistic particle in 3-D needs one
+  basis instead of three);
 - ``W`` singular (rank ``r < n``): ``n - r`` primary constraints ``phi(q, p) = 0`` are the
   relations among the momenta left when the velocities are eliminated from
   ``p = dL/dq_dot``. The elimination is algebraic: every root ``b^(k/s)`` is named by a
@@ -350,6 +354,40 @@ def _momentum_relations(
     return alg, relations, list(alg.roots.values()), w
 
 
+def _mirrored(
+    relations: Sequence[sympy.Expr],
+    q: Sequence[sympy.Symbol],
+    v: Sequence[sympy.Symbol],
+    p: Sequence[sympy.Symbol],
+    found: Sequence[sympy.Expr],
+    i: int,
+) -> sympy.Expr | None:
+    """The relation of velocity ``i`` read off an earlier one's by a symmetry of the momentum relations, or ``None``.
+
+    The swap ``sigma`` of ``(q_i, v_i, p_i)`` with ``(q_j, v_j, p_j)`` is a ring automorphism;
+    when it maps the set of relations (the equations ``p = dL/dq_dot`` cleared of
+    denominators, the roots' defining relations, the Rabinowitsch relation; each up to its
+    sign) onto itself, it maps the ideal ``I`` they generate onto itself, so that
+    ``sigma(g)`` lies in ``I`` and in ``Q[v_i, p]`` for the relation ``g`` of ``v_j`` found by
+    elimination (Cox, Little, O'Shea, Ch. 3): a relation between ``v_i`` and the momenta
+    without another Gröbner basis. An isotropic Lagrangian (a relativistic particle in 3-D,
+    ``-m c^2 sqrt(1 - v^2/c^2)``) needs one basis instead of three. The root symbols are not
+    swapped: a symmetry that exchanges two roots is not used.
+    """
+    def signed(e: sympy.Expr) -> sympy.Expr:
+        e = sympy.expand(e)
+        return -e if e.could_extract_minus_sign() else e
+
+    own = None
+    for j in range(i):
+        swap = {q[i]: q[j], q[j]: q[i], v[i]: v[j], v[j]: v[i], p[i]: p[j], p[j]: p[i]}
+        if own is None:
+            own = {signed(r) for r in relations}
+        if {signed(r.xreplace(swap)) for r in relations} == own:
+            return found[j].xreplace(swap)
+    return None
+
+
 def _regular(
     lagrangian: Lagrangian, P: list[sympy.Expr], p: list[sympy.Symbol], samples: _Samples, parameter_values: Mapping, seconds: float
 ) -> tuple[dict[sympy.Symbol, sympy.Expr], sympy.Expr, str]:
@@ -358,19 +396,25 @@ def _regular(
     n = len(v)
     alg, relations, roots, w = _momentum_relations(lagrangian, P, p)
     candidates: list[list[sympy.Expr]] = []
+    relations_of: list[sympy.Expr] = []  # the relation between each velocity and the momenta, in the named roots
     for i, vi in enumerate(v):
-        others = [vj for j, vj in enumerate(v) if j != i]
-        gens = [w, *roots, *others, vi, *p]
-        basis = _step(
-            f"the Gröbner basis eliminating the roots and the other velocities (for {vi.name})",
-            lagrangian, seconds, partial(sympy.groebner, relations, *gens, order="lex"),
-        )
-        assert isinstance(basis, sympy.GroebnerBasis)
-        eliminated = set(gens) - {vi, *p}
-        univariate = [g for g in basis.exprs if not (g.free_symbols & eliminated) and vi in g.free_symbols]
-        if not univariate:
-            raise _refuse(lagrangian, f"no relation between {vi.name} and the momenta was found")
-        poly = min(univariate, key=lambda g: sympy.degree(g, vi))
+        mirrored = _mirrored(relations, lagrangian.coordinates, v, p, relations_of, i)
+        if mirrored is not None:
+            poly = mirrored
+        else:
+            others = [vj for j, vj in enumerate(v) if j != i]
+            gens = [w, *roots, *others, vi, *p]
+            basis = _step(
+                f"the Gröbner basis eliminating the roots and the other velocities (for {vi.name})",
+                lagrangian, seconds, partial(sympy.groebner, relations, *gens, order="lex"),
+            )
+            assert isinstance(basis, sympy.GroebnerBasis)
+            eliminated = set(gens) - {vi, *p}
+            univariate = [g for g in basis.exprs if not (g.free_symbols & eliminated) and vi in g.free_symbols]
+            if not univariate:
+                raise _refuse(lagrangian, f"no relation between {vi.name} and the momenta was found")
+            poly = min(univariate, key=lambda g: sympy.degree(g, vi))
+        relations_of.append(poly)
         found = _step(
             f"the roots of the inverse velocity map for {vi.name}",
             lagrangian, seconds, partial(sympy.roots, alg.back(poly), vi),
