@@ -304,7 +304,7 @@ def _radical_free_numerator(block: sympy.Matrix) -> sympy.Expr:
     matrix, relations = _radicals_to_symbols(block)
     try:
         if _is_antisymmetric(matrix):
-            numerator = _numerator(_pfaffian(matrix))
+            numerator = _fraction(_pfaffian(matrix))[0]
         else:
             field = DomainMatrix.from_Matrix(matrix).to_field()
             if field.domain.is_EX or field.domain.is_EXRAW:
@@ -333,11 +333,6 @@ def _fraction(expr: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr]:
     if parts is None:
         return sympy.fraction(sympy.cancel(sympy.together(expr)))
     return parts
-
-
-def _numerator(expr: sympy.Expr) -> sympy.Expr:
-    """The numerator of ``expr`` in lowest terms (:func:`_fraction`)."""
-    return _fraction(expr)[0]
 
 
 def _resultant(f: sympy.Expr, g: sympy.Expr, r: sympy.Symbol) -> sympy.Expr:

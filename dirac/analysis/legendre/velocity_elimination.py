@@ -354,8 +354,15 @@ def _momentum_relations(
     return alg, relations, list(alg.roots.values()), w
 
 
+def _signed(e: sympy.Expr) -> sympy.Expr:
+    """``e`` expanded, of the one sign of ``+-e`` that sympy writes without a leading minus."""
+    e = sympy.expand(e)
+    return -e if e.could_extract_minus_sign() else e
+
+
 def _mirrored(
     relations: Sequence[sympy.Expr],
+    signed: set[sympy.Expr],
     q: Sequence[sympy.Symbol],
     v: Sequence[sympy.Symbol],
     p: Sequence[sympy.Symbol],
@@ -372,18 +379,12 @@ def _mirrored(
     elimination (Cox, Little, O'Shea, Ch. 3): a relation between ``v_i`` and the momenta
     without another Gröbner basis. An isotropic Lagrangian (a relativistic particle in 3-D,
     ``-m c^2 sqrt(1 - v^2/c^2)``) needs one basis instead of three. The root symbols are not
-    swapped: a symmetry that exchanges two roots is not used.
+    swapped: a symmetry that exchanges two roots is not used. ``signed`` is the set of the
+    relations up to their signs (:func:`_signed`), taken once by the caller.
     """
-    def signed(e: sympy.Expr) -> sympy.Expr:
-        e = sympy.expand(e)
-        return -e if e.could_extract_minus_sign() else e
-
-    own = None
     for j in range(i):
         swap = {q[i]: q[j], q[j]: q[i], v[i]: v[j], v[j]: v[i], p[i]: p[j], p[j]: p[i]}
-        if own is None:
-            own = {signed(r) for r in relations}
-        if {signed(r.xreplace(swap)) for r in relations} == own:
+        if {_signed(r.xreplace(swap)) for r in relations} == signed:
             return found[j].xreplace(swap)
     return None
 
@@ -397,8 +398,9 @@ def _regular(
     alg, relations, roots, w = _momentum_relations(lagrangian, P, p)
     candidates: list[list[sympy.Expr]] = []
     relations_of: list[sympy.Expr] = []  # the relation between each velocity and the momenta, in the named roots
+    signed = {_signed(r) for r in relations} if n > 1 else set()  # the relations up to their signs, for _mirrored
     for i, vi in enumerate(v):
-        mirrored = _mirrored(relations, lagrangian.coordinates, v, p, relations_of, i)
+        mirrored = _mirrored(relations, signed, lagrangian.coordinates, v, p, relations_of, i)
         if mirrored is not None:
             poly = mirrored
         else:

@@ -16,7 +16,7 @@ import sympy
 
 import dirac
 from dirac.analysis.legendre import velocity_elimination
-from dirac.analysis.legendre.velocity_elimination import _mirrored
+from dirac.analysis.legendre.velocity_elimination import _mirrored, _signed
 from dirac.model.lagrangian import Lagrangian
 
 
@@ -96,6 +96,6 @@ def test_a_swap_that_does_not_map_the_relations_onto_themselves_is_not_used():
     v = sympy.symbols("x_dot y_dot")
     p = sympy.symbols("p_x p_y")
     relations = [p[0] - 2 * v[0], p[1] - 3 * v[1]]
-    assert _mirrored(relations, q, v, p, [p[0] - 2 * v[0]], 1) is None
+    assert _mirrored(relations, {_signed(r) for r in relations}, q, v, p, [p[0] - 2 * v[0]], 1) is None
     symmetric = [p[0] - 2 * v[0], 2 * v[1] - p[1]]  # the second written with the other sign
-    assert _mirrored(symmetric, q, v, p, [p[0] - 2 * v[0]], 1) == p[1] - 2 * v[1]
+    assert _mirrored(symmetric, {_signed(r) for r in symmetric}, q, v, p, [p[0] - 2 * v[0]], 1) == p[1] - 2 * v[1]
