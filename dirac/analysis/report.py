@@ -155,7 +155,8 @@ def shared_form(exprs: dict) -> tuple[dict, dict]:
 
     Returns ``(texts, definitions)``: ``texts[name]`` is the expression's text, in which
     the names ``cse_0, cse_1, ...`` stand for ``definitions[cse_k]`` (each definition may
-    use earlier ones; :func:`~dirac.analysis.core.common_subexpressions.named_subexpressions`).
+    use earlier ones; :func:`~dirac.analysis.core.common_subexpressions.named_subexpressions`;
+    the definitions keep the stored order of their terms).
     ``definitions`` is empty when every tree is small.
     """
     sizes: dict = {}  # one walk of the shared graph for all of them
@@ -163,7 +164,11 @@ def shared_form(exprs: dict) -> tuple[dict, dict]:
     texts = {k: expression_text(e) for k, e in exprs.items() if k not in big}
     definitions: dict = {}
     if big:
-        shared, definitions = named_subexpressions([exprs[k] for k in big], SUBEXPRESSION_PREFIX, expression_text)
+        # the definitions are pieces of a graph: printed in stored order (sorting the terms of each
+        # took most of the JSON of (228)); the expressions themselves as any other text
+        shared, definitions = named_subexpressions(
+            [exprs[k] for k in big], SUBEXPRESSION_PREFIX, expression_text, lambda e: text_of(e, order="none")
+        )
         texts.update(zip(big, shared))
     return {k: texts[k] for k in exprs}, definitions
 

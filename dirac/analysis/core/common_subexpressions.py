@@ -83,7 +83,11 @@ def _repeated(exprs: Sequence[sympy.Basic]) -> list[sympy.Basic]:
 
 
 def named_subexpressions(
-    exprs: Sequence[sympy.Basic], prefix: str, text: Callable[[sympy.Basic], str], taken: Iterable[str] = ()
+    exprs: Sequence[sympy.Basic],
+    prefix: str,
+    text: Callable[[sympy.Basic], str],
+    definition_text: Callable[[sympy.Basic], str] | None = None,
+    taken: Iterable[str] = (),
 ) -> tuple[list[str], dict[str, str]]:
     """Texts of ``exprs`` in which names ``<prefix>0, <prefix>1, ...`` stand for their shared sub-trees.
 
@@ -100,6 +104,8 @@ def named_subexpressions(
         ``taken``) is skipped.
     text
         The printer of one expression (the report's ``str`` with its order of terms).
+    definition_text
+        The printer of a definition (default: ``text``).
     taken
         Further names the texts may not use.
 
@@ -118,6 +124,7 @@ def named_subexpressions(
     def inside(node: sympy.Basic) -> sympy.Basic:  # the node with the names of the sub-trees it holds
         return node.func(*[shared_xreplace(a, rule) for a in node.args])
 
-    definitions = {rule[node].name: text(inside(node)) for node in repeated}
+    definition_text = text if definition_text is None else definition_text
+    definitions = {rule[node].name: definition_text(inside(node)) for node in repeated}
     texts = [text(shared_xreplace(e, rule)) for e in exprs]
     return texts, definitions
