@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import random
 import re
+from pathlib import Path
 
 import pytest
 import sympy
@@ -116,3 +117,8 @@ def test_json_multipliers_read_back_to_the_analysis_multipliers(small_tree_limit
         point = {s: sympy.Rational(rng.randint(1, 40), rng.randint(1, 40)) for s in symbols}
         for k in names:
             assert back[k].xreplace(point) == solved[k].xreplace(point)
+
+
+def test_the_documented_tree_limit_is_the_reports():
+    text = (Path(__file__).resolve().parents[3] / "docs" / "file_formats.md").read_text()
+    assert f"more than {report.TREE_LIMIT:,} nodes" in text.replace("\n", " ")
