@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import sympy
 
 from dirac.analysis.core.algebra import printed, printed_at_most, text_of
+from dirac.analysis.core.common_subexpressions import named_subexpressions
 from dirac.analysis.gauge.generators import GaugeStructure
 from dirac.model.lagrangian import Lagrangian, latex_names
 
@@ -154,16 +155,21 @@ def shared_form(exprs: dict) -> tuple[dict, dict]:
 
     Returns ``(texts, definitions)``: ``texts[name]`` is the expression's text, in which
     the names ``cse_0, cse_1, ...`` stand for ``definitions[cse_k]`` (each definition may
-    use earlier ones). ``definitions`` is empty when every tree is small.
+    use earlier ones; :func:`~dirac.analysis.core.common_subexpressions.named_subexpressions`;
+    the definitions keep the stored order of their terms).
+    ``definitions`` is empty when every tree is small.
     """
-    big = [k for k, e in exprs.items() if tree_size(e) > TREE_LIMIT]
+    sizes: dict = {}  # one walk of the shared graph for all of them
+    big = [k for k, e in exprs.items() if tree_size(e, sizes) > TREE_LIMIT]
     texts = {k: expression_text(e) for k, e in exprs.items() if k not in big}
     definitions: dict = {}
     if big:
-        names = sympy.numbered_symbols(SUBEXPRESSION_PREFIX)
-        replacements, reduced = sympy.cse([exprs[k] for k in big], symbols=names, optimizations=None, order="none")
-        definitions = {str(s): expression_text(e) for s, e in replacements}
-        texts.update({k: expression_text(r) for k, r in zip(big, reduced)})
+        # the definitions are pieces of a graph: printed in stored order (sorting the terms of each
+        # took most of the JSON of (228)); the expressions themselves as any other text
+        shared, definitions = named_subexpressions(
+            [exprs[k] for k in big], SUBEXPRESSION_PREFIX, expression_text, lambda e: text_of(e, order="none")
+        )
+        texts.update(zip(big, shared))
     return {k: texts[k] for k in exprs}, definitions
 
 

@@ -270,7 +270,9 @@ class GramProver:
             assert factors is not None
             J, w = factors
             rows = J.extract(list(K), list(range(J.shape[1])))
-            gram = (rows * sympy.diag(*w) * rows.T).applyfunc(sympy.expand)
+            # J_K W J_K^T with W diagonal: the columns of J_K scaled by their weights (no n x n matrix W)
+            weighted = sympy.Matrix(rows.shape[0], rows.shape[1], lambda i, s: rows[i, s] * w[s])
+            gram = (weighted * rows.T).applyfunc(sympy.expand)
             try:  # in the polynomial ring: a tenth of the time of sympy's Berkowitz on expressions
                 matrix = DomainMatrix.from_Matrix(gram)
                 det = sympy.expand(matrix.domain.to_sympy(matrix.det()))
