@@ -17,7 +17,7 @@ earlier names only) and then the texts gives the expressions again.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from itertools import count
 
 import sympy
@@ -87,7 +87,6 @@ def named_subexpressions(
     prefix: str,
     text: Callable[[sympy.Basic], str],
     definition_text: Callable[[sympy.Basic], str] | None = None,
-    taken: Iterable[str] = (),
 ) -> tuple[list[str], dict[str, str]]:
     """Texts of ``exprs`` in which names ``<prefix>0, <prefix>1, ...`` stand for their shared sub-trees.
 
@@ -100,14 +99,11 @@ def named_subexpressions(
     exprs
         The expressions.
     prefix
-        Stem of the names; a name that is also the name of a symbol of ``exprs`` (or in
-        ``taken``) is skipped.
+        Stem of the names; a name that is also the name of a symbol of ``exprs`` is skipped.
     text
         The printer of one expression (the report's ``str`` with its order of terms).
     definition_text
         The printer of a definition (default: ``text``).
-    taken
-        Further names the texts may not use.
 
     Returns
     -------
@@ -116,7 +112,7 @@ def named_subexpressions(
         text of its sub-tree, in which only earlier names occur.
     """
     exprs = list(exprs)
-    used = set(taken) | {s.name for s in free_symbols_of(exprs) if isinstance(s, sympy.Symbol)}
+    used = {s.name for s in free_symbols_of(exprs) if isinstance(s, sympy.Symbol)}
     fresh = (name for name in (f"{prefix}{k}" for k in count()) if name not in used)
     repeated = _repeated(exprs)
     rule = {node: sympy.Symbol(next(fresh)) for node in repeated}
