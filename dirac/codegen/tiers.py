@@ -391,6 +391,8 @@ class TieredFunction:
         self.tape_failed = False
         self.tape_seconds = 0.0
         self.tape_steps = 0
+        #: a run of this loop over a longer span follows the runs made now (:meth:`expect_longer_run`)
+        self.longer_run_follows = False
 
     @property
     def tier(self) -> str:
@@ -405,6 +407,19 @@ class TieredFunction:
         if self._compiled is not None:
             return "compiled"
         return "tape" if self.on_tape else "interpreted"
+
+    def expect_longer_run(self) -> None:
+        """Say that the runs made now are pilots of a run of this loop over a longer span (the
+        pilots of ``method = "auto"``, :mod:`dirac.flows.methods.auto`): the price of the
+        loop's translation to a tape is then counted as paid in the rent-or-buy rule of
+        :meth:`_decide`, so the pilots run on the tape from their second step when the machine
+        is there (the translation is paid once, at the first pilot, instead of after the pilots
+        have spent its price interpreted). What is bought is the translation the long run
+        makes in any case when it runs longer interpreted than the translation costs: every
+        ``t_end = 100`` run of the latency corpus does; a shorter run pays at most one
+        translation it would not have made (20-30 ms for the double pendulums). The flag stays:
+        once translated, the price is paid for every later run alike."""
+        self.longer_run_follows = True
 
     def ready_marker(self) -> Path:
         """The marker file of this function's machine code in the cache (found once)."""
@@ -665,10 +680,12 @@ class TieredFunction:
             # the translation's price estimated from the loop's own text: at the fixed 0.1 s, the
             # pilots of a double pendulum in angles ran 0.1 s interpreted before a translation of
             # 25-30 ms, and auto's pilots took 0.27 s of CPU where they take 0.17 with the estimate
+            # (a pilot whose longer run follows, :meth:`expect_longer_run`, counts the price as paid)
             translation = self.translate_estimate()
-            if machine_loaded() and (remaining > translation or self.interpreted_seconds >= translation):
+            bought = self.longer_run_follows or self.interpreted_seconds >= translation
+            if machine_loaded() and (remaining > translation or bought):
                 translated = self.name in self.module._tapes
-                cost = 0.0 if translated or self.interpreted_seconds >= translation else translation
+                cost = 0.0 if translated or bought else translation
                 tape = self.tape_estimate(planned, args)
                 if tape is not None and tape + cost < remaining:
                     self.on_tape = True

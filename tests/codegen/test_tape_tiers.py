@@ -247,6 +247,60 @@ def test_a_loop_run_again_and_again_buys_its_tape_once_it_has_spent_its_price(tm
     assert x[0] == hand_loop(0.5, 40 * runs)
 
 
+def test_the_pilots_of_a_longer_run_buy_the_tape_at_their_first_run(tmp_path, monkeypatch) -> None:
+    """The same short runs, said to be pilots of a longer run of the loop (auto's): the
+    translation counts as paid, so the first run goes on the tape after the one interpreted
+    step that measures the rate, long before the interpreted time reaches the price; the
+    iterates are still the hand loop's to the last bit."""
+    from dirac.codegen.tape_machine import machine
+
+    machine()
+    function = _loop(tmp_path, monkeypatch)
+    function.expect_longer_run()
+    x, info = np.array([0.5]), np.zeros(4)
+    function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
+    price = max(tiers.TAPE_TRANSLATE_FLOOR, tiers.TAPE_TRANSLATE_SECONDS_PER_CHAR * len(function.module._texts["run"]))
+    assert function.tier == "tape" and function.interpreted_steps == 1
+    assert function.interpreted_seconds < price
+    function.run_steps(40, 40, x, 0.0, 0.1, 40, info)
+    assert function.interpreted_steps == 1  # the second run entirely on the tape
+    assert x[0] == hand_loop(0.5, 80)
+
+
+def test_auto_says_its_pilots_are_pilots_and_its_run_is_not(monkeypatch) -> None:
+    """``method = "auto"`` runs every pilot with the ``pilot`` option (its loop then buys the tape
+    at once) and the run it chose without it."""
+    from dirac.flows.methods import constrained_stepper
+
+    calls: list[bool] = []
+    original = constrained_stepper.call_tiered
+
+    def spy(kernel, planned_steps, steps_done, steps, args, warm_up=False, pilot=False):
+        calls.append(pilot)
+        return original(kernel, planned_steps, steps_done, steps, args, warm_up, pilot=pilot)
+
+    monkeypatch.setattr(constrained_stepper, "call_tiered", spy)
+    from dirac_systems.latency_models import MODELS
+
+    model = MODELS["double_pendulum_angles"]()
+    problem = ConstrainedProblem(model.system, q0=model.state[:2], p0=model.state[2:])
+    pilots: list[int] = []
+    from dirac.flows.methods import auto
+
+    chosen = auto.choose_method
+
+    def counted(*args, **kwargs):
+        choice = chosen(*args, **kwargs)
+        pilots.append(len(calls))
+        return choice
+
+    monkeypatch.setattr(auto, "choose_method", counted)
+    run = integrate(problem, t_end=2.0, samples=11)
+    assert run.method.startswith("rattle-") and pilots
+    assert calls[:pilots[0]] and all(calls[:pilots[0]])  # every call of the choice: a pilot's
+    assert calls[pilots[0]:] and not any(calls[pilots[0]:])  # the run: not a pilot
+
+
 def test_a_run_of_unknown_length_on_the_tape_compiles(tmp_path, monkeypatch) -> None:
     """Once on the tape, a run whose length is unknown has no tape estimate: it compiles (a
     long run ends on the compiled tier)."""

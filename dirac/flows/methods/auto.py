@@ -160,7 +160,10 @@ def _frequency(problem) -> float:
 def choose_method(problem, kind: str, *, t_end: float, samples: int, tolerance: float, dt: float | None,
                   outputs: tuple[str, ...]) -> AutoChoice:
     """Choose method and step for ``problem`` (see the module docstring)."""
-    options = {"t_end": t_end, "tolerance": tolerance, "newton_tolerance": 1e-12, "max_newton_iterations": 50}
+    # "pilot": every run made here is a pilot of the run that follows over [0, t_end] on the same
+    # loop (its step loop buys its tape at once: TieredFunction.expect_longer_run)
+    options = {"t_end": t_end, "tolerance": tolerance, "newton_tolerance": 1e-12, "max_newton_iterations": 50,
+               "pilot": True}
     if kind in ("rigid_body", "heavy_top") and problem.driven:
         return _heavy_top(problem, t_end, tolerance, dt, outputs, options)
     if kind == "rigid_body":

@@ -36,12 +36,14 @@ class ConstrainedStepper(Stepper):
         self.tol, self.max_iter, self.info = newton_options(options)
         self.time = 0.0  # the time of the state (time-dependent systems)
         self.planned_steps: int | None = options.get("planned_steps")
+        #: a pilot of ``auto``: a run of the same loop over a longer span follows
+        self.pilot = bool(options.get("pilot", False))
 
     def _kernel_call(self, kernel: Any, steps: int, *args: Any, warm_up: bool = False) -> None:
         """Call a step loop of the generated module: a tiered one (interpreted while the
         steps still planned are few, :mod:`dirac.codegen.tiers`) or a compiled one;
         ``warm_up``: a one-step call on scratch arguments that decides the tier."""
-        call_tiered(kernel, self.planned_steps, self.steps, steps, args, warm_up)
+        call_tiered(kernel, self.planned_steps, self.steps, steps, args, warm_up, pilot=self.pilot)
 
     def observe(self) -> dict[str, np.ndarray]:
         return constrained_outputs(self.mechanics, self.outputs, self.q, self.p, self.time)
@@ -78,15 +80,19 @@ def singular_as_step_failure(what: str) -> Iterator[None]:
 
 
 def call_tiered(kernel: Any, planned_steps: int | None, steps_done: int, steps: int, args: tuple[Any, ...],
-                warm_up: bool = False) -> None:
+                warm_up: bool = False, pilot: bool = False) -> None:
     """``kernel(*args)`` advancing ``steps`` steps of a run of ``planned_steps`` (None:
     unknown), ``steps_done`` of them done, through its tier when it is a
-    :class:`~dirac.codegen.tiers.TieredFunction`."""
+    :class:`~dirac.codegen.tiers.TieredFunction`; ``pilot``: a pilot of ``auto``, which a
+    run of the same loop over a longer span follows
+    (:meth:`~dirac.codegen.tiers.TieredFunction.expect_longer_run`)."""
     from dirac.codegen.tiers import TieredFunction  # not at import: a rigid-body run never needs codegen
 
     if not isinstance(kernel, TieredFunction):
         kernel(*args)
         return
+    if pilot:
+        kernel.expect_longer_run()
     planned = None if planned_steps is None else max(planned_steps - steps_done, steps)
     if warm_up:
         kernel.warm_up(planned, *args)

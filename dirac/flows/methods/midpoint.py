@@ -112,10 +112,11 @@ class AnalysedMidpointStepper(Stepper):
         self._kernel = tiered(self.analysed.module, "midpoint_run")
         self.time = 0.0
         self.planned_steps: int | None = options.get("planned_steps")
+        self.pilot = bool(options.get("pilot", False))  # a pilot of auto (ConstrainedStepper.pilot)
 
     def _run(self, z: np.ndarray, n_steps: int, dt: float, warm_up: bool = False) -> None:
         args = (z, self.time, self.analysed.params, dt, n_steps, self.tol, self.max_iter, self.info)
-        call_tiered(self._kernel, self.planned_steps, self.steps, n_steps, args, warm_up)
+        call_tiered(self._kernel, self.planned_steps, self.steps, n_steps, args, warm_up, pilot=self.pilot)
 
     def warm_up(self) -> None:
         self._run(self.z[0].copy(), 1, 1e-6, warm_up=True)
