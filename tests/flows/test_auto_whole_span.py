@@ -158,3 +158,27 @@ def test_the_refined_step_aims_at_a_tenth_of_the_tolerance() -> None:
     assert whole_span.refined_steps(10, 1e-6, 1e-8, 4) == math.ceil(10 * (1e-6 / 1e-9) ** 0.25)
     assert whole_span.refined_steps(10, 1e-30, 1e-8, 4) == 15  # at least 3/2 as many steps
     assert whole_span.refined_steps(10, 1.0, 1e-8, 2) == 160  # at most 16 times as many
+
+
+class _Failing:
+    """A method whose coarse run leaves the domain of the expressions at its first step."""
+
+    order = 2
+
+    def start(self, problem, outputs, options):
+        class Stepper:
+            def step(self, n, dt):
+                raise ValueError("math domain error")
+
+        return Stepper()
+
+
+def test_a_check_that_cannot_be_made_says_why_instead_of_an_estimate() -> None:
+    """A coarse run that leaves the real domain, and a run of one step over the whole span
+    (nothing coarser): no estimate, and the reason."""
+    times = np.linspace(0.0, 1.0, 3)
+    states = [np.zeros(2)] * 3
+    failed = whole_span.coarse_check(_Failing(), None, ("q",), {}, times, 4, states)
+    assert failed.error is None and failed.why.startswith("the run at about twice the step left the real domain")
+    alone = whole_span.coarse_check(_Failing(), None, ("q",), {}, np.array([1.0]), 1, [np.zeros(2)])
+    assert alone.error is None and alone.why == "one step over the whole span: nothing coarser to compare with"

@@ -140,6 +140,9 @@ def coarse_check(method: Method, problem: Any, outputs: tuple[str, ...], options
             compared += 1
     except StepFailure as failure:
         return WholeSpanCheck(None, ratio, compared, f"the run at about twice the step failed ({failure})")
+    except (ArithmeticError, ValueError) as error:  # a coarser step that left the domain of the expressions
+        return WholeSpanCheck(None, ratio, compared, f"the run at about twice the step left the real domain of the "
+                              f"system's expressions ({error})")
     return WholeSpanCheck(worst / (ratio ** method.order - 1.0), ratio, compared)
 
 
