@@ -32,6 +32,15 @@ from dirac.flows.energy_watch import EnergyWatch, energy_watch
 from dirac.flows.methods.base import Method, StepFailure, Stepper
 from dirac.flows.methods.registry import METHODS, driven_method_names, get_method, method_names
 from dirac.flows.methods.torqued import refuse_undriven
+from dirac.flows.methods.whole_span import (
+    ENERGY_TRIGGER,
+    MAX_REFINEMENTS,
+    ORDER_SLACK,
+    coarse_check,
+    energy_shown_error,
+    refined_steps,
+    state_vector,
+)
 from dirac.flows.problems import Problem
 from dirac.flows.solution import Solution
 from dirac.validate import is_real_number, unknown_name_error, validate_integer, validate_positive
@@ -300,23 +309,95 @@ def _integrate_checked(checked, method, kind, chosen_outputs, t_end, samples, dt
         "tolerance": tolerance,
         "newton_tolerance": float(newton_tolerance),
         "max_newton_iterations": int(max_newton_iterations),
+    }
+
+    def run(step: float | None, record: bool, extra: dict[str, Any]) -> tuple[_Loop, Solution]:
         # steps the run will take (all members of a batch): generated kernels run
         # interpreted for short runs and compile when that pays (dirac.codegen.tiers)
-        "planned_steps": (int(math.ceil(t_end / dt * (1.0 - 1e-12))) * int(getattr(checked, "batch", 1))
-                          if dt is not None else None),
-    }
-    try:
-        stepper = method_object.start(checked, chosen_outputs, options)
-        stepper.warm_up()
-        if stepper.kind != "exact":
-            stepper.observe()  # compiles what the outputs need before the timed loop
-    except (ArithmeticError, ValueError) as exc:
-        if not is_domain_error(exc):
-            raise
-        raise IntegrationError(
-            f"the system's expressions have no real value at the initial state ({exc}): {DOMAIN_HINT}"
-        ) from None
-    return _Loop(checked, method_object, stepper, chosen_outputs, t_end, samples, dt, progress, drift_limit, extra).run()
+        planned = (int(math.ceil(t_end / step * (1.0 - 1e-12))) * int(getattr(checked, "batch", 1))
+                   if step is not None else None)
+        try:
+            stepper = method_object.start(checked, chosen_outputs, {**options, "planned_steps": planned})
+            stepper.warm_up()
+            if stepper.kind != "exact":
+                stepper.observe()  # compiles what the outputs need before the timed loop
+        except (ArithmeticError, ValueError) as exc:
+            if not is_domain_error(exc):
+                raise
+            raise IntegrationError(
+                f"the system's expressions have no real value at the initial state ({exc}): {DOMAIN_HINT}"
+            ) from None
+        loop = _Loop(checked, method_object, stepper, chosen_outputs, t_end, samples, step, progress, drift_limit,
+                     extra, record)
+        return loop, loop.run()
+
+    if "auto" not in extra or kind not in ("constrained", "analysed") or method_object.kind != "fixed":
+        return run(dt, False, extra)[1]
+    return _checked_over_the_whole_span(run, dt, method_object, checked, chosen_outputs, options, t_end, samples,
+                                        tolerance, extra)
+
+
+def _checked_over_the_whole_span(run, dt: float | None, method_object: Method, checked, chosen_outputs, options, t_end: float,
+                                 samples: int, tolerance: float, extra: dict[str, Any]) -> Solution:
+    """A run of ``auto`` on a constrained or analysed system, its error estimated over the whole
+    span by Richardson's rule and the run made again with a smaller step while the estimate exceeds
+    ``tolerance`` (:mod:`dirac.flows.methods.whole_span`); the estimate, the refinements and the
+    step are recorded in ``meta()["auto"]``; a run that still misses after
+    :data:`~dirac.flows.methods.whole_span.MAX_REFINEMENTS` refinements warns."""
+    from dirac.errors import warn
+
+    times = sample_times(t_end, samples)
+    loop, solution = run(dt, True, dict(extra, auto=dict(extra["auto"])))
+    assert loop.states is not None and loop.per_interval is not None
+    record = solution.extra["auto"]
+    if loop.energy is not None:  # a conservative system: what its energy shows decides whether to check
+        bound = energy_shown_error(checked, loop.states)
+        record["energy_error_bound"] = bound
+        if bound <= ENERGY_TRIGGER * tolerance:
+            record["whole_span_error"] = None
+            record["refinements"] = 0
+            record["whole_span_note"] = (f"not checked: the energy shows an error of {bound:.2g} at most to first order, "
+                                         f"below {ENERGY_TRIGGER:g} of the tolerance")
+            return solution
+    check = coarse_check(method_object, checked, chosen_outputs, options, times, loop.per_interval, loop.states)
+    refinements = 0
+    order = method_object.order or 1
+    erratic = ""  # a refinement whose error did not shrink as the order predicts
+    while check.error is not None and check.error > tolerance and refinements < MAX_REFINEMENTS:
+        per_interval = refined_steps(loop.per_interval, check.error, tolerance, order)
+        predicted = check.error * (loop.per_interval / per_interval) ** order
+        spacing = float(times[1] - times[0]) if times[0] == 0.0 else float(times[0])
+        loop, solution = run(spacing / per_interval, True, dict(extra, auto=dict(extra["auto"])))
+        assert loop.states is not None and loop.per_interval is not None
+        # the refined run is checked as the first was (at about twice its step), not by Richardson's rule
+        # between the two runs: that extrapolates by r^p over the ratio r of their steps, past an error that
+        # does not shrink with the step (round-off grown by chaotic motion) to a figure far below it
+        check = coarse_check(method_object, checked, chosen_outputs, options, times, loop.per_interval, loop.states)
+        refinements += 1
+        if check.error is not None and check.error > ORDER_SLACK * predicted and not erratic:
+            erratic = (f"{predicted:.2g} expected after refinement {refinements}, {check.error:.2g} estimated: the error did "
+                       f"not shrink as the order {order} of {method_object.name} predicts")
+    record = solution.extra["auto"]
+    record["whole_span_error"] = check.error
+    record["refinements"] = refinements
+    if refinements:
+        record["refined_dt"] = solution.dt
+        if loop.energy is not None:  # of the run whose samples the solution holds
+            record["energy_error_bound"] = energy_shown_error(checked, loop.states)
+    if check.error is None:
+        record["whole_span_note"] = check.why
+    elif check.error > tolerance or erratic:
+        what = (f"is {check.error:.2g}, above the tolerance {tolerance:g}" if not erratic else
+                f"is {check.error:.2g}, but that estimate may be far too small ({erratic}; round-off grown by the "
+                "motion does not shrink with the step)")
+        text = (f"method auto: the error of the run of {str(checked.system)!r} with {method_object.name} at dt = "
+                f"{solution.dt:.3g}, estimated over the whole span after {refinements} refinement(s) (Richardson's "
+                f"rule against a run of steps {check.ratio:.3g} times as long), {what}: the motion may be chaotic (its "
+                "error then grows exponentially with time) or pass close to a singularity of the coordinates; compare "
+                "runs at two tolerances")
+        record["whole_span_warning"] = text
+        warn(text)
+    return solution
 
 
 def _names_for(kind: str) -> list[str]:
@@ -337,7 +418,7 @@ class _Loop:
     """One run of the loop (keeps the bookkeeping out of :func:`integrate`)."""
 
     def __init__(self, problem: Problem, method: Method, stepper: Stepper, outputs, t_end, samples, dt, progress,
-                 drift_limit, extra) -> None:
+                 drift_limit, extra, record: bool = False) -> None:
         self.problem = problem
         self.method = method
         self.stepper = stepper
@@ -354,6 +435,10 @@ class _Loop:
         self.cpu = 0.0
         self._checked_at = 0
         self.energy: EnergyWatch | None = None
+        #: the whole state at each sample kept (``record``: the check of auto's run over its span)
+        self.states: list[np.ndarray] | None = [] if record else None
+        #: steps per sample interval of a fixed-step run (set by :meth:`_intervals`)
+        self.per_interval: int | None = None
 
     # ------------------------------------------------------------------ storage
     def _keep(self, index: int, values: dict[str, np.ndarray]) -> None:
@@ -363,6 +448,8 @@ class _Loop:
                 self.store[name] = np.empty((len(self.times),) + value.shape, dtype=float)
             self.store[name][index] = value
         self.stored = index + 1
+        if self.states is not None:
+            self.states.append(state_vector(self.stepper))
 
     def _solution(self, complete: bool, message: str = "") -> Solution:
         """The samples kept so far; ``message`` says why the run stopped, or what a complete run warned."""
@@ -495,6 +582,7 @@ class _Loop:
         spacing = float(ends[0] - starts[0])
         per_interval = max(1, int(math.ceil(spacing / self.dt * (1.0 - 1e-12))))
         self.dt = spacing / per_interval
+        self.per_interval = per_interval
         return [(float(a), float(b), per_interval) for a, b in zip(starts, ends)]
 
     def _run_fixed(self, bar, intervals: list[tuple[float, float, int]]) -> None:

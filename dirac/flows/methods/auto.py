@@ -50,6 +50,7 @@ from dirac.errors import InputError
 from dirac.flows.methods.base import Method, StepFailure
 from dirac.flows.methods.registry import get_method
 from dirac.flows.methods.rigid_body_stepper import exact_flow, needs_attitude
+from dirac.flows.methods.whole_span import state_vector as _state
 from dirac.rigidbody.schemes import CompositionScheme
 
 __all__ = ["AutoChoice", "choose_method"]
@@ -112,17 +113,6 @@ def _stages(method: Method) -> int:
     if isinstance(method.data, tuple):
         return len(method.data)
     return 1
-
-
-def _state(stepper) -> np.ndarray:
-    if hasattr(stepper, "analysed"):
-        return stepper.z.ravel().copy()
-    if hasattr(stepper, "q"):
-        return np.concatenate([stepper.q.ravel(), stepper.p.ravel()])
-    parts = [stepper.M.ravel()]
-    if stepper.with_R:
-        parts.append(stepper.R.ravel())
-    return np.concatenate(parts)
 
 
 def _pilot(method_name: str, problem, outputs, span: float, dt: float, options) -> np.ndarray:
