@@ -15,16 +15,22 @@ run (``K = p^T M^{-1} p / 2`` of a natural system) and finds the first sample in
 exchanged between kinetic and potential, which does not depend on the constant added to ``V``.
 The loop then warns (:func:`dirac.errors.warn`) and keeps the figures in the solution's
 ``extra["energy_change"]``: the numbers stand, and the user reads what they are worth.
+
+The watch also keeps, for each member, the largest change of ``H`` read and the state where it
+was read: :meth:`EnergyWatch.shown_error` turns them into the error the energy shows
+(:func:`first_order_error`), which decides whether ``auto`` checks its run over its whole span
+(:mod:`dirac.flows.methods.whole_span`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-__all__ = ["ENERGY_CHANGE", "EnergyWatch", "energy_watch"]
+__all__ = ["ENERGY_CHANGE", "EnergyWatch", "energy_watch", "first_order_error"]
 
 #: A change of ``H`` beyond this fraction of the largest kinetic energy sampled is reported.
 #: Stormer-Verlet (``rattle-2``) changes the energy of a small oscillation by ``(omega dt)^2 / 4`` of
@@ -56,27 +62,39 @@ class EnergyWatch:
     ----------
     readings
         ``readings(state)`` -> ``(H, K)``, arrays of one entry per member of the batch, from the
-        stepper's state.
+        stepper's state, or ``(H, K, rows)`` with each member's whole state (one row each).
+    energy
+        ``energy(row)`` -> ``H`` of one member's whole state (:meth:`shown_error`), or None.
     """
 
-    def __init__(self, readings: Any) -> None:
+    def __init__(self, readings: Any, energy: Any = None) -> None:
         self.readings = readings
+        self.energy = energy
         self.first: np.ndarray | None = None
         self.scale: np.ndarray | None = None
         self.last: np.ndarray | None = None
         self.t_last = 0.0
         self.found: _Change | None = None
+        #: per member, the largest ``|H - H(0)|`` read and the whole state where it was read
+        self.largest: np.ndarray | None = None
+        self.largest_rows: np.ndarray | None = None
 
     def read(self, stepper: Any, t: float, energy: np.ndarray | None = None) -> None:
         """Read the state of ``stepper`` at the sample time ``t`` (``energy``: ``H`` if the run computed it)."""
         if self.found is not None:
             return
-        values, kinetic = self.readings(stepper, energy)
+        values, kinetic, *rows = self.readings(stepper, energy)
         if self.first is None or self.scale is None or self.last is None:
             self.first, self.scale, self.last, self.t_last = values.copy(), np.abs(kinetic), values.copy(), t
+            if rows:
+                self.largest, self.largest_rows = np.zeros_like(values), np.array(rows[0], dtype=float)
             return
         self.scale = np.maximum(self.scale, np.abs(kinetic))
         change = np.abs(values - self.first)
+        if rows and self.largest is not None and self.largest_rows is not None:
+            larger = ~(change <= self.largest)  # NaN counts as larger
+            self.largest = np.where(larger, change, self.largest)
+            self.largest_rows[larger] = np.asarray(rows[0], dtype=float)[larger]
         # the floor keeps rounding at rest (K = 0) from counting: 1e-12 of |H| is far below any step's error
         scale = np.maximum(self.scale, 1e-12 * np.abs(self.first))
         over = np.flatnonzero(~(change <= ENERGY_CHANGE * scale))  # NaN counts: the drift check names it first
@@ -104,6 +122,19 @@ class EnergyWatch:
                 f"keeps it: the steps of {method}{step} do not resolve the motion there (a close pass by a pole, a "
                 f"fast turn); {cure}{halving}")
 
+    def shown_error(self) -> float:
+        """The error the energy shows: the largest over the members of :func:`first_order_error` at
+        the largest change of ``H`` read; infinity when the watch stopped reading at a change it
+        reported (:attr:`found`) or keeps no states."""
+        if self.found is not None or self.energy is None or self.largest is None or self.largest_rows is None:
+            return math.inf
+        try:
+            with np.errstate(all="ignore"):
+                return max((first_order_error(self.energy, float(change), row)
+                            for change, row in zip(self.largest, self.largest_rows)), default=0.0)
+        except (ArithmeticError, ValueError):  # H undefined next to a sample: nothing is known
+            return math.inf
+
     def extra(self) -> dict[str, float] | None:
         """The figures of the report, for the solution's ``extra["energy_change"]``."""
         w = self.found
@@ -122,18 +153,60 @@ def _state(stepper: Any, half: int) -> tuple[np.ndarray, np.ndarray, float]:
     return z[:, :half], z[:, half:], float(getattr(stepper, "time", getattr(stepper, "t", 0.0)))
 
 
+def first_order_error(energy: Any, change: float, row: np.ndarray) -> float:
+    """The error of a state ``row`` of a conservative system whose ``H`` is off by ``change``, to first order.
+
+    The exact motion keeps ``H``; a numerical state ``z`` with ``|H(z) - H(z_0)| = change`` is at least
+    ``change / |grad H(z)|_1`` away from the exact one in its largest component
+    (``|H(z) - H(z*)| <= |grad H|_1 |z - z*|_max`` along the short segment between them); the gradient by
+    central differences. A zero gradient gives infinity (nothing is known), no change zero."""
+    if change == 0.0:
+        return 0.0
+    if not math.isfinite(change):
+        return math.inf
+    z = np.asarray(row, dtype=float)
+    gradient = 0.0
+    for i in range(z.size):
+        h = 1e-6 * (1.0 + abs(float(z[i])))
+        up, down = z.copy(), z.copy()
+        up[i] += h
+        down[i] -= h
+        gradient += abs(energy(up) - energy(down)) / (2.0 * h)
+    return float(change / gradient) if gradient > 0.0 else math.inf
+
+
+def _mechanical_energy(mechanics: Any) -> Any:
+    """``H`` of one whole state ``(q, p)`` of a mechanical system (its generated ``energy``; no time)."""
+    kernel, params, n = mechanics.module.function("energy"), mechanics.params, mechanics.dimension
+
+    def energy(row: np.ndarray) -> float:
+        return float(kernel(np.ascontiguousarray(row[:n]), np.ascontiguousarray(row[n:]), 0.0, params))
+
+    return energy
+
+
+def _analysed_energy(analysed: Any) -> Any:
+    """``H`` of one whole state ``z`` of an analysed system (its generated ``energy``; no time)."""
+    kernel, params = analysed.module.function("energy"), analysed.params
+
+    def energy(row: np.ndarray) -> float:
+        return float(kernel(np.ascontiguousarray(row), 0.0, params))
+
+    return energy
+
+
 def _mechanical_readings(mechanics: Any) -> Any:
     energy_kernel = mechanics.module.function("energy")
     potential = mechanics.module.function("potential")
 
-    def readings(stepper: Any, energy: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    def readings(stepper: Any, energy: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         q, p, t = _state(stepper, mechanics.dimension)
         c = mechanics.params
         q, p = np.ascontiguousarray(q), np.ascontiguousarray(p)
         if energy is None:
             energy = np.array([energy_kernel(a, b, t, c) for a, b in zip(q, p)])
         rest = np.array([float(potential(a, t, c)) for a in q])
-        return np.asarray(energy, dtype=float), np.asarray(energy, dtype=float) - rest
+        return np.asarray(energy, dtype=float), np.asarray(energy, dtype=float) - rest, np.concatenate([q, p], axis=1)
 
     return readings
 
@@ -142,7 +215,7 @@ def _analysed_readings(analysed: Any) -> Any:
     energy_kernel = analysed.module.function("energy")
     half = analysed.dimension // 2
 
-    def readings(stepper: Any, energy: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    def readings(stepper: Any, energy: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         coordinates, momenta, t = _state(stepper, half)
         c = analysed.params
         z = np.ascontiguousarray(np.concatenate([coordinates, momenta], axis=1))
@@ -154,7 +227,7 @@ def _analysed_readings(analysed: Any) -> Any:
             rest = np.array([energy_kernel(x, t, c) for x in at_rest])
         kinetic = np.asarray(energy, dtype=float) - rest
         # H(q, 0) may be undefined where H(q, p) is not (a division by a momentum): no kinetic scale then
-        return np.asarray(energy, dtype=float), np.where(np.isfinite(kinetic), kinetic, 0.0)
+        return np.asarray(energy, dtype=float), np.where(np.isfinite(kinetic), kinetic, 0.0), z
 
     return readings
 
@@ -170,13 +243,13 @@ def energy_watch(problem: Any, stepper: Any) -> EnergyWatch | None:
         if (getattr(mechanics, "time_symbol", None) is not None or getattr(mechanics, "forced", False)
                 or getattr(mechanics, "rotation", None) is not None or getattr(mechanics, "module", None) is None):
             return None
-        return EnergyWatch(_mechanical_readings(mechanics))
+        return EnergyWatch(_mechanical_readings(mechanics), _mechanical_energy(mechanics))
     analysed = getattr(problem, "analysed", None)
     if problem.kind == "analysed" and analysed is not None and _reads_state(stepper, "analysed"):
         lagrangian = getattr(getattr(analysed, "analysis", None), "lagrangian", None)
         if lagrangian is None or lagrangian.is_time_dependent:
             return None
-        return EnergyWatch(_analysed_readings(analysed))
+        return EnergyWatch(_analysed_readings(analysed), _analysed_energy(analysed))
     return None
 
 

@@ -37,7 +37,6 @@ from dirac.flows.methods.whole_span import (
     MAX_REFINEMENTS,
     ORDER_SLACK,
     coarse_check,
-    energy_shown_error,
     refined_steps,
     state_vector,
 )
@@ -351,7 +350,7 @@ def _checked_over_the_whole_span(run, dt: float | None, method_object: Method, c
     assert loop.states is not None and loop.per_interval is not None
     record = solution.extra["auto"]
     if loop.energy is not None:  # a conservative system: what its energy shows decides whether to check
-        bound = energy_shown_error(checked, loop.states)
+        bound = loop.energy.shown_error()
         record["energy_error_bound"] = bound
         if bound <= ENERGY_TRIGGER * tolerance:
             record["whole_span_error"] = None
@@ -383,7 +382,7 @@ def _checked_over_the_whole_span(run, dt: float | None, method_object: Method, c
     if refinements:
         record["refined_dt"] = solution.dt
         if loop.energy is not None:  # of the run whose samples the solution holds
-            record["energy_error_bound"] = energy_shown_error(checked, loop.states)
+            record["energy_error_bound"] = loop.energy.shown_error()
     if check.error is None:
         record["whole_span_note"] = check.why
     elif check.error > tolerance or erratic:

@@ -30,7 +30,8 @@ to a figure far below it.)
 
 The check is not run where the run's energy shows it is not needed: a conservative system's
 exact motion keeps ``H``, and the run's largest change of ``H`` over ``|grad H|_1`` there is, to
-first order, a lower bound of its error (:func:`energy_bound`). Every run that missed its
+first order, a lower bound of its error
+(:meth:`~dirac.flows.energy_watch.EnergyWatch.shown_error`). Every run that missed its
 tolerance above showed more than a hundredth of the tolerance that way (from 3.7e-10 to 2.3e-7
 at ``tolerance = 1e-8``; eight runs, ``t_end = 1`` and ``10``, of five everyday systems), and the
 long runs that met it far less (1e-13 to 1e-11 for the pendulums of the latency corpus at
@@ -47,7 +48,7 @@ needed. Chaotic motion makes every estimate grow with the span: a run that still
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -55,7 +56,7 @@ import numpy as np
 
 from dirac.flows.methods.base import Method, StepFailure
 
-__all__ = ["ENERGY_TRIGGER", "MAX_REFINEMENTS", "ORDER_SLACK", "WholeSpanCheck", "coarse_check", "energy_bound", "energy_shown_error", "refined_steps", "state_vector"]
+__all__ = ["ENERGY_TRIGGER", "MAX_REFINEMENTS", "ORDER_SLACK", "WholeSpanCheck", "coarse_check", "refined_steps", "state_vector"]
 
 #: runs made again after the first when the estimate exceeds the tolerance
 MAX_REFINEMENTS = 2
@@ -67,7 +68,7 @@ REFINE_SAFETY = 0.1
 #: released from large angles (chaotic), at ``t = 10``, 34 times
 ORDER_SLACK = 4.0
 #: a conservative system's run is checked when its energy shows an error above this fraction
-#: of the tolerance (:func:`energy_bound`); below it the check is not run
+#: of the tolerance (:meth:`~dirac.flows.energy_watch.EnergyWatch.shown_error`); below it the check is not run
 ENERGY_TRIGGER = 0.01
 
 
@@ -144,68 +145,6 @@ def coarse_check(method: Method, problem: Any, outputs: tuple[str, ...], options
         return WholeSpanCheck(None, ratio, compared, f"the run at about twice the step left the real domain of the "
                               f"system's expressions ({error})")
     return WholeSpanCheck(worst / (ratio ** method.order - 1.0), ratio, compared)
-
-
-def energy_bound(energy: Callable[[np.ndarray], float], start: np.ndarray, states: Sequence[np.ndarray]) -> float:
-    """The error of a run of a conservative system that its energy shows, to first order.
-
-    The exact motion keeps ``H``; a numerical state ``z_k`` with ``H(z_k) != H(z_0)`` is at least
-    ``|H(z_k) - H(z_0)| / |grad H(z_k)|_1`` away from the exact one in the largest component
-    (``|H(z) - H(z*)| <= |grad H|_1 |z - z*|_max`` along the short segment between them). Taken at
-    the sample where ``|H - H(z_0)|`` is largest, for each member (``start``: the members' initial
-    states, one per row; ``states``: the same at each sample), the gradient by central differences.
-    A zero gradient there gives infinity (nothing is known)."""
-    worst = 0.0
-    for member, first in enumerate(np.atleast_2d(start)):
-        initial = energy(first)
-        changes = [abs(energy(np.atleast_2d(state)[member]) - initial) for state in states]
-        k = int(np.argmax(changes)) if changes else 0
-        if not changes or changes[k] == 0.0:
-            continue
-        z = np.atleast_2d(states[k])[member].astype(float)
-        gradient = 0.0
-        for i in range(z.size):
-            h = 1e-6 * (1.0 + abs(z[i]))
-            up, down = z.copy(), z.copy()
-            up[i] += h
-            down[i] -= h
-            gradient += abs(energy(up) - energy(down)) / (2.0 * h)
-        if not math.isfinite(changes[k]):
-            return math.inf
-        worst = max(worst, float(changes[k] / gradient) if gradient > 0.0 else math.inf)
-    return worst
-
-
-def energy_shown_error(checked: Any, states: Sequence[np.ndarray]) -> float:
-    """:func:`energy_bound` of a run of a conservative constrained
-    or analysed system (``states``: the whole state at each sample, as the run recorded it);
-    infinity where the energy cannot be evaluated near a sample."""
-    if checked.kind == "analysed":
-        analysed = checked.analysed
-        kernel, params = analysed.module.function("energy"), analysed.params
-        start = np.atleast_2d(np.asarray(checked.z0, dtype=float))
-
-        def energy(row: np.ndarray) -> float:
-            return float(kernel(np.ascontiguousarray(row), 0.0, params))
-    else:
-        mechanics = checked.mechanics
-        kernel, params, n = mechanics.module.function("energy"), mechanics.params, mechanics.dimension
-        start = np.concatenate([np.atleast_2d(checked.q0), np.atleast_2d(checked.p0)], axis=1).astype(float)
-
-        def energy(row: np.ndarray) -> float:
-            return float(kernel(np.ascontiguousarray(row[:n]), np.ascontiguousarray(row[n:]), 0.0, params))
-
-    members = start.shape[0]
-    if checked.kind == "analysed":
-        rows = [np.asarray(v).reshape(members, -1) for v in states]
-    else:  # (q of every member, then p of every member): one row (q, p) per member
-        rows = [np.concatenate([v[: v.size // 2].reshape(members, -1), v[v.size // 2:].reshape(members, -1)], axis=1)
-                for v in states]
-    try:
-        with np.errstate(all="ignore"):
-            return energy_bound(energy, start, rows)
-    except (ArithmeticError, ValueError):
-        return math.inf
 
 
 def refined_steps(per_interval: int, error: float, tolerance: float, order: int) -> int:
