@@ -22,7 +22,7 @@ import sympy
 
 from dirac.analysis.core.numeric import ZERO_TOLERANCE, Numerics
 
-__all__ = ["SINGULAR_MINOR", "BracketBlocks", "DivisorLocus", "EntryBlock", "magnitude", "near_rank_drop"]
+__all__ = ["POLE_DISTANCE", "SINGULAR_MINOR", "BracketBlocks", "DivisorLocus", "EntryBlock", "magnitude", "near_rank_drop"]
 
 #: a singular value of a matrix whose rank the analysis uses (``W``, ``{Phi_a, Phi_b}``,
 #: ``{Phi_a, phi_k}``), relative to the size of the terms its entries are computed from,
@@ -30,6 +30,13 @@ __all__ = ["SINGULAR_MINOR", "BracketBlocks", "DivisorLocus", "EntryBlock", "mag
 #: (:func:`near_rank_drop`): the rank is still read right there, but everything built on
 #: the inverse of that block is ill-conditioned at the point (by ``1 / s`` per inverse)
 SINGULAR_MINOR = 1e-4
+
+#: a point whose first-order distance ``|d| / |grad d|`` to the zero set of a divisor ``d`` of
+#: ``H_c`` is below this fraction of its size (``max(1, max_i |z_i|)``) lies next to a pole
+#: (:class:`DivisorLocus`): a pole of order ``k`` amplifies the round-off of every quantity
+#: evaluated there by about ``distance^-k``, which no relative test of cancellation sees when
+#: the divisor is a monomial (``|q_1| / magnitude(q_1) = 1`` at every point)
+POLE_DISTANCE = 0.05
 
 
 def magnitude(expr: sympy.Expr, memo: dict[sympy.Expr, sympy.Expr] | None = None) -> sympy.Expr:
@@ -209,14 +216,27 @@ class DivisorLocus:
     consistency condition have a pole, and ranks read there are meaningless. Gauss–Newton
     projections are drawn there too: onto the primary surface of the rigid body in its
     matrix coordinates (``R p_R^T`` symmetric), three of four projections landed within
-    ``1e-11`` of ``det R = 0`` (one exactly on it). A point where ``|d| / magnitude(d)`` is
-    below :data:`SINGULAR_MINOR` (or not finite) is reported like a point next to a rank
-    drop, and :meth:`dirac.analysis.core.numeric.Numerics.surface_points` sets it aside.
+    ``1e-11`` of ``det R = 0`` (one exactly on it). A point is *next to* the pole of a
+    divisor ``d`` when either
+
+    * ``|d| / magnitude(d)`` is below :data:`SINGULAR_MINOR` (or not finite): ``d`` is
+      cancellation of its terms there, or
+    * its first-order (Newton) distance to ``d = 0``, ``|d(z)| / |grad d(z)|``, is below
+      :data:`POLE_DISTANCE` times ``max(1, max_i |z_i|)``. The first test cannot see a
+      monomial divisor: ``q_1`` is never cancellation, yet onto ``p_3 + q_1^2 = 0`` three
+      of four projections landed within ``0.03`` of ``q_1 = 0`` (``L = -q_1 q_2'^2 - 2 q_1'
+      - 2 q_2' - q_1^2 q_3'``, ``H_c`` divides by ``q_1``), where the rate of ``p_3 + q_1^2``
+      under ``H_T``, ``~ 1 / q_1^4``, carried the round-off of the point to ``2e-6`` of its
+      terms (Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., 2002,
+      Sect. 1.6: a condition number that grows as the point nears a singularity).
+
+    Such a point is reported like a point next to a rank drop, and
+    :meth:`dirac.analysis.core.numeric.Numerics.surface_points` sets it aside.
 
     Parameters
     ----------
     numerics
-        Where the divisors and their :func:`magnitude` are compiled.
+        Where the divisors, their gradients and their :func:`magnitude` are compiled.
     divisors
         The factors of the denominators of ``H_c``.
     """
@@ -224,15 +244,27 @@ class DivisorLocus:
     def __init__(self, numerics: Numerics, divisors: Sequence[sympy.Expr]) -> None:
         self.divisors = list(divisors)
         memo: dict[sympy.Expr, sympy.Expr] = {}
+        space = numerics.phase_space
+        self._width = len(space.variables)
         self._values = numerics.function(self.divisors)
         self._sizes = numerics.function([magnitude(d, memo) for d in self.divisors])
+        self._gradients = numerics.function([g for d in self.divisors for g in space.gradient(d)])
 
     def near_rank_drop(self, z: np.ndarray) -> tuple[float, str] | None:
-        """The smallest ``|d| / magnitude(d)`` at ``z`` when it is below :data:`SINGULAR_MINOR`, with the divisor's name."""
+        """The smaller of ``|d| / magnitude(d)`` (when below :data:`SINGULAR_MINOR`) and the relative
+        distance to ``d = 0`` (when below :data:`POLE_DISTANCE`) at ``z``, over the divisors,
+        with the divisor's name; ``None`` when neither test fires."""
         with np.errstate(all="ignore"):
-            ratios = np.abs(self._values(z)) / self._sizes(z)
+            values = np.abs(self._values(z))
+            ratios = values / self._sizes(z)
+            slopes = np.linalg.norm(self._gradients(z).reshape(len(self.divisors), self._width), axis=1)
+            scale = max(1.0, float(np.max(np.abs(z[: self._width]), initial=0.0)))
+            distances = values / (slopes * scale)
         ratios = np.where(np.isfinite(ratios), ratios, 0.0)
-        k = int(np.argmin(ratios))
-        if ratios[k] >= SINGULAR_MINOR:
+        distances = np.where(np.isnan(distances), 0.0, distances)  # 0/0: on a singular point of d = 0
+        found = [(float(ratios[k]), k) for k in range(len(ratios)) if ratios[k] < SINGULAR_MINOR]
+        found += [(float(distances[k]), k) for k in range(len(distances)) if distances[k] < POLE_DISTANCE]
+        if not found:
             return None
-        return float(ratios[k]), f"the block of W the velocities are solved from (its determinant {self.divisors[k]} divides H_c)"
+        value, k = min(found)
+        return value, f"the block of W the velocities are solved from (its determinant {self.divisors[k]} divides H_c)"

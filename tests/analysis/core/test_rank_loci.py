@@ -9,7 +9,14 @@ import sympy
 import dirac
 from dirac.analysis.core.numeric import Numerics
 from dirac.analysis.core.phase_space import PhaseSpace
-from dirac.analysis.core.rank_loci import SINGULAR_MINOR, BracketBlocks, magnitude, near_rank_drop
+from dirac.analysis.core.rank_loci import (
+    POLE_DISTANCE,
+    SINGULAR_MINOR,
+    BracketBlocks,
+    DivisorLocus,
+    magnitude,
+    near_rank_drop,
+)
 from dirac.errors import AnalysisError
 
 q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2", real=True)
@@ -140,3 +147,41 @@ def test_stage_points_keep_off_the_poles_of_the_canonical_hamiltonian(monkeypatc
         products = [r[0, i] * r[1, j] * r[2, k] for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1), (0, 2, 1), (1, 0, 2), (2, 1, 0))]
         det = products[0] + products[1] + products[2] - products[3] - products[4] - products[5]
         assert abs(det) >= SINGULAR_MINOR * sum(abs(p) for p in products), r
+
+
+def test_a_monomial_divisor_is_kept_at_a_distance():
+    """``d = q1`` is never cancellation of its terms (``|q1| / magnitude(q1) = 1``): the test of
+    distance sees the pole. At ``z = (q1, q2, p1, p2) = (0.01, 1, -1, 0.5)``, by hand,
+    ``|d| / |grad d| = 0.01`` over the size ``max(1, 1) = 1``: next to the pole; at ``q1 = 0.2``
+    not; ``d = 1 - 2 q2`` at ``q2 = 0.5 + 1e-6`` is both cancellation (``2e-6 / 2``) and near
+    (``2e-6 / 2``); at ``q2 = 0.3`` with ``q1 = 0.2`` neither fires."""
+    numerics = Numerics(PhaseSpace((q1, q2), (p1, p2)), {})
+    locus = DivisorLocus(numerics, [q1, 1 - 2 * q2])
+    near = locus.near_rank_drop(np.array([0.01, 1.0, -1.0, 0.5]))
+    assert near is not None and near[0] == pytest.approx(0.01, rel=1e-12) and "q1" in near[1]
+    assert locus.near_rank_drop(np.array([0.2, 0.3, -1.0, 0.5])) is None
+    both = locus.near_rank_drop(np.array([0.2, 0.5 + 1e-6, -1.0, 0.5]))
+    assert both is not None and both[0] == pytest.approx(1e-6, rel=1e-6) and "1 - 2*q2" in both[1]
+    # the size of the point scales the distance: q1 = 0.2 at |p1| = 10 is 0.02 of it
+    assert locus.near_rank_drop(np.array([0.2, 0.3, 10.0, 0.5]))[0] == pytest.approx(0.02, rel=1e-12)
+
+
+def test_sample_points_keep_off_a_monomial_pole():
+    """A random Lagrangian the long run drew: ``L = -q1 q2'^2 - 2 q1' - 2 q2' - q1^2 q3'``.
+
+    By hand: ``p1 = -2``, ``p2 = -2 q1 q2' - 2``, ``p3 = -q1^2``, so ``p1 + 2`` and ``p3 + q1^2``
+    are primary and, where ``q1 != 0``, ``q2' = -(p2 + 2)/(2 q1)`` and ``H_c = -(p2 + 2)^2/(4 q1)``:
+    a pole on ``q1 = 0``. Projections onto ``p3 + q1^2 = 0`` were drawn there: three of the four
+    points the analysis read had ``|q1| < 0.03``, where the rate of ``p3 + q1^2`` under ``H_T``
+    (with ``1 / q1^4``) was ``2e-6`` of its terms instead of round-off. Every point is now at
+    least ``POLE_DISTANCE`` of its size away from ``q1 = 0``.
+    """
+    lagrangian = dirac.Lagrangian.from_strings("drawn", ["q1", "q2", "q3"], "-q1*q2_dot**2 - 2*q1_dot - 2*q2_dot - q1**2*q3_dot", [])
+    analysis = dirac.analyze(lagrangian)
+    q_1 = analysis.symbols["q1"]
+    assert [locus.expression for locus in analysis.singular_loci] == [q_1]
+    assert sympy.simplify(analysis.canonical_hamiltonian.subs(analysis.symbols["p_q1"], -2)
+                          + (analysis.symbols["p_q2"] + 2) ** 2 / (4 * q_1)) == 0
+    assert len(analysis._points) >= 4
+    for z in analysis._points:
+        assert abs(z[0]) >= POLE_DISTANCE * max(1.0, float(np.max(np.abs(z[:6])))), z
