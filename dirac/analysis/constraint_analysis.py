@@ -21,7 +21,7 @@ from dirac.analysis.chain.constraint_chain import ConstraintChain
 from dirac.analysis.chain.special_values import RankUse, SpecialValue, special_parameter_values
 from dirac.analysis.classes.classification import bracket_matrix, classify
 from dirac.analysis.classes.multiplier_solution import MultiplierSolution, unsolved_multipliers
-from dirac.analysis.core.algebra import tidy
+from dirac.analysis.core.algebra import rational_parts, tidy
 from dirac.analysis.core.blas_threads import one_blas_thread
 from dirac.analysis.core.budget import CpuBudget, OverBudget
 from dirac.analysis.core.divisors import (
@@ -347,11 +347,18 @@ class ConstraintAnalysis:
                                structural=True)
         if 0 < len(self.second_class) <= SMALL_DETERMINANT:
             C = bracket_matrix(self._space, self.second_class)
-        # det C = Pf(C)^2: a Pfaffian proven nonzero on the surface leaves no division by zero
-        if 0 < len(self.second_class) <= SMALL_DETERMINANT and not self._pfaffian_settled(C, surface, settled):
-            found += divisions([1 / C.det(method="berkowitz")] if C.shape[0] > 1 else [1 / C[0, 0]], len(self.stages),
-                               "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
-                               "constraints drops rank)", variables, unsearched=skipped, structural=True)
+            # det C = Pf(C)^2 (C is antisymmetric, of even size): det C vanishes where the numerator of
+            # Pf(C) in lowest terms does, and a Pfaffian proven nonzero on the surface leaves no division
+            # by zero. Read off Pf(C), a sum of products of entries reduced in the fraction field:
+            # sympy's det of even a 2 x 2 C with rational entries cancels their products as
+            # expressions and ran for minutes (a random 3-coordinate Lagrangian)
+            pf = pfaffian(C) if C.shape[0] % 2 == 0 else sympy.Integer(0)
+            if pf == 0 or not self._pfaffian_settled(pf, surface, settled):
+                parts = rational_parts(pf) if pf != 0 else None
+                vanishing = parts[0] if parts is not None else pf if pf != 0 else C.det(method="berkowitz")
+                found += divisions([1 / vanishing], len(self.stages),
+                                   "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
+                                   "constraints drops rank)", variables, unsearched=skipped, structural=True)
         unsearched += skipped
         if not found:
             self._unsearched = tuple(unsearched)
@@ -367,14 +374,11 @@ class ConstraintAnalysis:
         self._unsearched = (*unsearched, *undecided)
         return loci
 
-    def _pfaffian_settled(self, C: sympy.Matrix, surface: list, settled: Callable[[sympy.Expr], bool]) -> bool:
-        """Whether ``det C = Pf(C)^2`` is proven nonzero on the surface: ``Pf(C)`` a nonzero
+    def _pfaffian_settled(self, pf: sympy.Expr, surface: list, settled: Callable[[sympy.Expr], bool]) -> bool:
+        """Whether ``det C = Pf(C)^2`` is proven nonzero on the surface from ``pf = Pf(C)``: a nonzero
         constant there, or, factored, a product of such constants and sums of squares
         (:func:`~dirac.analysis.core.divisors.sum_of_squares_on_surface`; a pendulum's
         ``Pf(C) = -16 (x^2 + y^2)^2 / m^2``)."""
-        if C.shape[0] % 2:
-            return False
-        pf = pfaffian(C)
         return settled(pf) or sum_of_squares_on_surface(sympy.factor(pf), surface, self._space.variables)
 
     def _solved_block_regular(self, numerics: Numerics) -> Callable[[np.ndarray], bool] | None:

@@ -16,6 +16,8 @@ Hand derivations:
   that is a nonzero constant on the surface makes it positive there.
 """
 
+import signal
+
 import sympy
 
 import dirac
@@ -75,3 +77,46 @@ def test_the_pendulum_bracket_matrix_is_proven_regular_by_its_pfaffian():
     analysis = dirac.analyze(L)
     assert analysis.singular_loci == ()
     assert analysis.singular_loci_unsearched == ()
+
+
+def test_the_bracket_divisor_is_read_off_the_pfaffian_not_a_determinant_of_expressions():
+    """A random Lagrangian the long stress run drew: ``L = q3 q2'^2 + 3 q1 q2' q3'/2 + 3 q1 q3'^2/2
+    - q2 q1' - 2 q1 q2 q3'``, two second-class constraints (``p1 + q2`` and its rate). Its
+    report's search for the zeros of ``det C`` ran sympy's determinant of the 2 x 2 bracket
+    matrix, which cancels the product of two sums of rational functions as expressions, for
+    minutes. ``det C = Pf(C)^2 = C_12^2``: the locus is where the numerator of ``C_12`` in
+    lowest terms vanishes, read here with the bracket written out by hand,
+    ``C_12 = sum_i (d phi_1/dq_i d phi_2/dp_i - d phi_1/dp_i d phi_2/dq_i)``; no determinant of
+    expressions is taken (the analysis and its loci take well under a second; the alarm turns the
+    minutes the determinant took into a failure instead of a hung run)."""
+    def hung(*args):
+        raise AssertionError("the analysis and its singular loci took more than 120 s")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(120)
+    try:
+        _check_the_drawn_bracket_locus()
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _check_the_drawn_bracket_locus() -> None:
+    L = dirac.Lagrangian.from_strings(
+        "drawn", ["q1", "q2", "q3"],
+        "(2)*q3*q2_dot*q2_dot/2 + (3)*q1*q2_dot*q3_dot/2 + (3)*q1*q3_dot*q3_dot/2 + (-1)*q2*q1_dot + (-2)*q2*q1*q3_dot", [],
+    )
+    analysis = dirac.analyze(L)
+    assert (len(analysis.first_class), len(analysis.second_class), analysis.physical_degrees_of_freedom) == (0, 2, 2)
+    q = [analysis.symbols[f"q{k}"] for k in (1, 2, 3)]
+    p = [analysis.symbols[f"p_q{k}"] for k in (1, 2, 3)]
+    phi1, phi2 = analysis.second_class
+    assert sympy.expand(phi1 - (p[0] + q[1])) == 0
+    c12 = sum(sympy.diff(phi1, a) * sympy.diff(phi2, b) - sympy.diff(phi1, b) * sympy.diff(phi2, a) for a, b in zip(q, p))
+    numerator = sympy.fraction(sympy.together(c12))[0]
+    bracket = [locus for locus in analysis.singular_loci if "the Dirac bracket divides by zero" in locus.what]
+    multipliers = [locus for locus in analysis.singular_loci if "multiplier" in locus.what]
+    # the bracket's locus is the multipliers' (u_1 = -{phi_1, H_c}/C_12): one locus, a factor of C_12's numerator
+    loci = bracket or multipliers
+    assert len(loci) == 1
+    assert sympy.rem(sympy.expand(numerator), loci[0].expression, *q, *p) == 0
