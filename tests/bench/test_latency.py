@@ -9,7 +9,17 @@ import math
 import numpy as np
 import pytest
 
-from dirac.bench.latency import CORPUS, format_breakdown, format_latency, run_breakdown, run_latency
+from dirac.bench.latency import (
+    CORPUS,
+    LatencyRow,
+    format_breakdown,
+    format_latency,
+    median_row,
+    run_breakdown,
+    run_latency,
+    scipy_ratio,
+    targets_met,
+)
 from dirac.bench.report import wrap_title
 from dirac_systems.latency_models import MODELS
 
@@ -76,3 +86,23 @@ def test_a_long_title_is_wrapped_to_the_width_with_every_word_kept() -> None:
     assert all(len(line) <= 60 for line in wrapped.splitlines())
     assert wrapped.splitlines()[0] == "dirac bench --scale"
     assert wrapped.split() == title.replace(" -- ", " ").split()
+
+
+def test_repeated_runs_give_their_medians_and_the_ratio_is_a_target() -> None:
+    """Three runs of CPU 0.5, 0.9 and 0.6 s (walls 0.6, 1.2, 0.7): the medians are 0.6 and 0.7 s,
+    the range 0.5-0.9; against a scipy baseline whose median is 0.75 s the ratio is 0.8, met;
+    a baseline of 0.5 s makes it 1.2, over target, and the exit status says so."""
+    runs = [LatencyRow("pendulum_angle", "t_end=100", wall, cpu, method="rattle-8", steps=2900)
+            for wall, cpu in ((0.6, 0.5), (1.2, 0.9), (0.7, 0.6))]
+    row = median_row(runs)
+    assert (row.cpu, row.wall, row.runs, row.cpu_range) == (0.6, 0.7, 3, (0.5, 0.9))
+    assert (row.method, row.steps) == ("rattle-8", 2900) and runs[0].cpu == 0.5  # the runs are left as they were
+    baseline = median_row([LatencyRow("scipy pendulum", "t_end=100", w, c) for w, c in ((0.8, 0.7), (0.9, 0.75), (1.0, 0.8))])
+    ratio = scipy_ratio([row, baseline], row)
+    assert ratio is not None and ratio == pytest.approx((0.6 / 0.75, 0.7 / 0.9))
+    assert targets_met([row, baseline])
+    slow = median_row([LatencyRow("scipy pendulum", "t_end=100", 0.5, 0.5)])
+    assert not targets_met([row, slow])
+    assert "(over)" in format_latency([row, slow]) and "medians of 3 fresh processes" in format_latency([row, slow])
+    failed = median_row([*runs[:2], LatencyRow("pendulum_angle", "t_end=100", 0.1, 0.1, failed="timed out after 600 s")])
+    assert failed.failed == "timed out after 600 s" and not targets_met([failed, baseline])
