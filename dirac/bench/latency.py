@@ -387,7 +387,9 @@ def run_latency(models: Sequence[str] = CORPUS, *, first_t_end: float = 1.0, stu
     import importlib
 
     if repeats < 1:
-        raise ValueError(f"repeats must be at least 1, not {repeats}")
+        from dirac.errors import InputError
+
+        raise InputError(f"repeats must be at least 1 (one fresh process per run), not {repeats}")
 
     latency_models = importlib.import_module("dirac_systems.latency_models").MODELS
     compile_bytecode(pythonpath)

@@ -21,6 +21,7 @@ from dirac.bench.latency import (
     targets_met,
 )
 from dirac.bench.report import wrap_title
+from dirac.errors import InputError
 from dirac_systems.latency_models import MODELS
 
 
@@ -106,3 +107,5 @@ def test_repeated_runs_give_their_medians_and_the_ratio_is_a_target() -> None:
     assert "(over)" in format_latency([row, slow]) and "medians of 3 fresh processes" in format_latency([row, slow])
     failed = median_row([*runs[:2], LatencyRow("pendulum_angle", "t_end=100", 0.1, 0.1, failed="timed out after 600 s")])
     assert failed.failed == "timed out after 600 s" and not targets_met([failed, baseline])
+    with pytest.raises(InputError, match="repeats must be at least 1"):
+        run_latency(["pendulum_angle"], repeats=0)

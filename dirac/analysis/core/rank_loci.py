@@ -224,8 +224,8 @@ class DivisorLocus:
     * its first-order (Newton) distance to ``d = 0``, ``|d(z)| / |grad d(z)|``, is below
       :data:`POLE_DISTANCE` times ``max(1, max_i |z_i|)``. The first test cannot see a
       monomial divisor: ``q_1`` is never cancellation, yet onto ``p_3 + q_1^2 = 0`` three
-      of four projections landed within ``0.03`` of ``q_1 = 0`` (``L = -q_1 q_2'^2 - 2 q_1'
-      - 2 q_2' - q_1^2 q_3'``, ``H_c`` divides by ``q_1``), where the rate of ``p_3 + q_1^2``
+      of four projections landed within ``0.03`` of ``q_1 = 0``
+      (``L = -q_1 q_2'^2 - 2 q_1' - 2 q_2' - q_1^2 q_3'``, ``H_c`` divides by ``q_1``), where the rate of ``p_3 + q_1^2``
       under ``H_T``, ``~ 1 / q_1^4``, carried the round-off of the point to ``2e-6`` of its
       terms (Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., 2002,
       Sect. 1.6: a condition number that grows as the point nears a singularity).
