@@ -352,11 +352,11 @@ class ConstraintAnalysis:
             # by zero. Read off Pf(C), a sum of products of entries reduced in the fraction field:
             # sympy's det of even a 2 x 2 C with rational entries cancels their products as
             # expressions and ran for minutes (a random 3-coordinate Lagrangian)
-            pf = pfaffian(C) if C.shape[0] % 2 == 0 else sympy.Integer(0)
-            if pf == 0 or not self._pfaffian_settled(pf, surface, settled):
-                parts = rational_parts(pf) if pf != 0 else None
-                vanishing = parts[0] if parts is not None else pf if pf != 0 else C.det(method="berkowitz")
-                found += divisions([1 / vanishing], len(self.stages),
+            # (the second class is even in number: an odd count is refused when the analysis is made)
+            pf = pfaffian(C)
+            if not self._pfaffian_settled(pf, surface, settled):
+                parts = rational_parts(pf)
+                found += divisions([1 / (parts[0] if parts is not None else pf)], len(self.stages),
                                    "the Dirac bracket divides by zero (det C = 0: the bracket matrix of the second-class "
                                    "constraints drops rank)", variables, unsearched=skipped, structural=True)
         unsearched += skipped

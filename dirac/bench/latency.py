@@ -394,8 +394,8 @@ def run_latency(models: Sequence[str] = CORPUS, *, first_t_end: float = 1.0, stu
     latency_models = importlib.import_module("dirac_systems.latency_models").MODELS
     compile_bytecode(pythonpath)
     rows: list[LatencyRow] = []
-    baselines_done: dict[str, LatencyRow] = {}
     baseline_runs: dict[str, list[LatencyRow]] = {}
+    baseline_row: dict[str, int] = {}  # where each baseline's row stands in ``rows`` (filled at the end)
     references: dict[str, list[list[float]] | None] = {}
 
     def say(text: str) -> None:
@@ -441,11 +441,11 @@ def run_latency(models: Sequence[str] = CORPUS, *, first_t_end: float = 1.0, stu
                              pythonpath, timeout, None))
                     _global_error(baseline_runs[model.baseline][-1], references[model.baseline])
             rows.extend(median_row(runs[tolerance]) for tolerance in tolerances)
-            if scipy and model.baseline not in baselines_done:  # its runs go on beside later systems of its kind
-                baselines_done[model.baseline] = baseline_runs[model.baseline][0]
-                rows.append(baselines_done[model.baseline])
-    for kind, done in baselines_done.items():  # each baseline's row: the medians of all its runs
-        rows[next(k for k, row in enumerate(rows) if row is done)] = median_row(baseline_runs[kind])
+            if scipy and model.baseline not in baseline_row:  # its runs go on beside later systems of its kind
+                baseline_row[model.baseline] = len(rows)
+                rows.append(baseline_runs[model.baseline][0])
+    for kind, index in baseline_row.items():  # each baseline's row: the medians of all its runs
+        rows[index] = median_row(baseline_runs[kind])
     for name in analyze:
         say(f"latency: dirac analyze {name}")
         rows.append(_row(name, "dirac analyze", ["-m", "dirac", "analyze", name], pythonpath, timeout,

@@ -38,6 +38,7 @@ from dirac.flows.methods.whole_span import (
     ORDER_SLACK,
     coarse_check,
     refined_steps,
+    sample_spacing,
     state_vector,
 )
 from dirac.flows.problems import Problem
@@ -365,8 +366,7 @@ def _checked_over_the_whole_span(run, dt: float | None, method_object: Method, c
     while check.error is not None and check.error > tolerance and refinements < MAX_REFINEMENTS:
         per_interval = refined_steps(loop.per_interval, check.error, tolerance, order)
         predicted = check.error * (loop.per_interval / per_interval) ** order
-        spacing = float(times[1] - times[0]) if times[0] == 0.0 else float(times[0])
-        loop, solution = run(spacing / per_interval, True, dict(extra, auto=dict(extra["auto"])))
+        loop, solution = run(sample_spacing(times) / per_interval, True, dict(extra, auto=dict(extra["auto"])))
         assert loop.states is not None and loop.per_interval is not None
         # the refined run is checked as the first was (at about twice its step), not by Richardson's rule
         # between the two runs: that extrapolates by r^p over the ratio r of their steps, past an error that

@@ -56,7 +56,7 @@ import numpy as np
 
 from dirac.flows.methods.base import Method, StepFailure
 
-__all__ = ["ENERGY_TRIGGER", "MAX_REFINEMENTS", "ORDER_SLACK", "WholeSpanCheck", "coarse_check", "refined_steps", "state_vector"]
+__all__ = ["ENERGY_TRIGGER", "MAX_REFINEMENTS", "ORDER_SLACK", "WholeSpanCheck", "coarse_check", "refined_steps", "sample_spacing", "state_vector"]
 
 #: runs made again after the first when the estimate exceeds the tolerance
 MAX_REFINEMENTS = 2
@@ -108,6 +108,11 @@ class WholeSpanCheck:
     why: str = ""
 
 
+def sample_spacing(times: np.ndarray) -> float:
+    """The spacing of the sample times of a run (the first at ``0``, or at the first spacing)."""
+    return float(times[1] - times[0]) if times[0] == 0.0 else float(times[0])
+
+
 def coarse_check(method: Method, problem: Any, outputs: tuple[str, ...], options: dict, times: np.ndarray,
                  per_interval: int, fine_states: Sequence[np.ndarray]) -> WholeSpanCheck:
     """The estimate of a run of ``per_interval`` steps per sample interval (its states
@@ -115,7 +120,7 @@ def coarse_check(method: Method, problem: Any, outputs: tuple[str, ...], options
     about twice the step (see the module docstring)."""
     starts_at_zero = bool(times[0] == 0.0)
     ends = times[1:] if starts_at_zero else times
-    spacing = float(ends[0]) if not starts_at_zero else float(times[1] - times[0])
+    spacing = sample_spacing(times)
     states = list(fine_states[1:]) if starts_at_zero else list(fine_states)
     if per_interval >= 2:
         coarse, every = per_interval // 2, 1
